@@ -1,0 +1,36 @@
+//! A spinner on stderr for long steps; silent when stderr is not a terminal.
+
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+pub struct Steps {
+    bar: ProgressBar,
+    started: Instant,
+}
+
+impl Steps {
+    pub fn new(title: &str) -> Steps {
+        let bar = ProgressBar::new_spinner();
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {prefix}: {msg} [{elapsed}]")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.set_prefix(title.to_string());
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Steps {
+            bar,
+            started: Instant::now(),
+        }
+    }
+
+    pub fn step(&self, message: &str) {
+        self.bar.set_message(message.to_string());
+    }
+
+    /// Seconds since the spinner started.
+    pub fn finish(self) -> f64 {
+        self.bar.finish_and_clear();
+        self.started.elapsed().as_secs_f64()
+    }
+}

@@ -1,0 +1,38 @@
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use slayer::scene::{SceneKind, SceneSpec, generate};
+
+use crate::progress::Steps;
+
+pub fn run(
+    name: &str,
+    triangles: Option<usize>,
+    seed: u64,
+    output: &Path,
+) -> anyhow::Result<ExitCode> {
+    let kind: SceneKind = name.parse()?;
+    let spec = SceneSpec {
+        kind,
+        triangles: triangles.unwrap_or(kind.default_triangles()),
+        seed,
+    };
+    slayer::io::Format::of_path(output)?;
+    let steps = Steps::new(kind.name());
+    steps.step(&format!("generating {} triangles", spec.triangles));
+    let mesh = generate(&spec)?;
+    steps.step(&format!("writing {}", output.display()));
+    slayer::io::write_mesh(&mesh, output).context("writing the scene")?;
+    let seconds = steps.finish();
+    println!(
+        "{}: {} layers, {} vertices, {} faces, mean edge {:.6} -> {} ({seconds:.1} s)",
+        kind,
+        mesh.layer_count(),
+        mesh.live_vertex_count(),
+        mesh.live_face_count(),
+        mesh.mean_edge_length(),
+        output.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,159 @@
+//! `slayer check`: what a mesh file holds and everything wrong with it.
+
+use serde::Serialize;
+
+use crate::collide::find_intersections;
+use crate::io::LoadNotes;
+use crate::mesh::Mesh;
+
+/// Figures and defects of one mesh. Field names are part of the `--json` interface.
+#[derive(Debug, Clone, Serialize)]
+pub struct CheckReport {
+    pub file: String,
+    pub vertices: usize,
+    pub faces: usize,
+    pub layers: usize,
+    pub layer_names: Vec<String>,
+    pub faces_per_layer: Vec<usize>,
+    pub components: usize,
+    pub components_per_layer: Vec<usize>,
+    pub mean_edge_length: f64,
+    pub edge_length_cv: f64,
+    pub min_edge_length: f64,
+    pub max_edge_length: f64,
+    pub valid: bool,
+    pub validation_error: Option<String>,
+    pub non_finite: usize,
+    pub intersections: usize,
+    pub intersections_between_layers: usize,
+    pub intersections_within_layers: usize,
+    pub intersection_examples: Vec<[u32; 2]>,
+    /// One line per defect; empty when the mesh is clean.
+    pub defects: Vec<String>,
+}
+
+impl CheckReport {
+    pub fn is_clean(&self) -> bool {
+        self.defects.is_empty()
+    }
+}
+
+/// Measures a loaded mesh. `progress` is told which step is running.
+pub fn check_mesh(
+    mesh: &Mesh,
+    notes: &LoadNotes,
+    file: &str,
+    mut progress: impl FnMut(&str),
+) -> CheckReport {
+    progress("measuring edges");
+    let stats = mesh.edge_length_stats();
+    progress("labelling components");
+    let components = mesh.components();
+    progress("validating");
+    let validation = mesh.validate();
+    let non_finite = notes
+        .non_finite_vertices
+        .max(mesh.positions().iter().filter(|p| !p.is_finite()).count());
+    progress("testing triangle pairs for intersections");
+    let intersections = find_intersections(mesh);
+
+    let faces = mesh.live_face_count();
+    let mut defects = Vec::new();
+    if faces == 0 {
+        defects.push("the mesh has no faces".to_string());
+    }
+    if non_finite > 0 {
+        let at = notes
+            .first_non_finite_line
+            .map(|l| format!(" (first at line {l})"))
+            .unwrap_or_default();
+        defects.push(format!(
+            "{non_finite} vertices have non-finite coordinates{at}"
+        ));
+    }
+    if let Err(e) = &validation {
+        defects.push(format!("invalid mesh: {e}"));
+    }
+    if intersections.total() > 0 {
+        defects.push(format!(
+            "{} intersecting triangle pairs ({} between layers, {} within a layer), e.g. faces {:?}",
+            intersections.total(),
+            intersections.between_layers,
+            intersections.within_layers,
+            intersections
+                .examples
+                .iter()
+                .map(|p| [p.face_a, p.face_b])
+                .take(3)
+                .collect::<Vec<_>>()
+        ));
+    }
+    CheckReport {
+        file: file.to_string(),
+        vertices: mesh.live_vertex_count(),
+        faces,
+        layers: mesh.layer_count(),
+        layer_names: mesh.layer_names().to_vec(),
+        faces_per_layer: mesh.faces_per_layer(),
+        components: components.count(),
+        components_per_layer: components.per_layer(mesh.layer_count()),
+        mean_edge_length: stats.mean,
+        edge_length_cv: stats.coefficient_of_variation(),
+        min_edge_length: stats.min,
+        max_edge_length: stats.max,
+        valid: validation.is_ok(),
+        validation_error: validation.err().map(|e| e.to_string()),
+        non_finite,
+        intersections: intersections.total(),
+        intersections_between_layers: intersections.between_layers,
+        intersections_within_layers: intersections.within_layers,
+        intersection_examples: intersections
+            .examples
+            .iter()
+            .map(|p| [p.face_a, p.face_b])
+            .collect(),
+        defects,
+    }
+}
+
+impl std::fmt::Display for CheckReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "{}", self.file)?;
+        writeln!(f, "  vertices          {}", self.vertices)?;
+        writeln!(f, "  faces             {}", self.faces)?;
+        writeln!(f, "  layers            {}", self.layers)?;
+        for (i, name) in self.layer_names.iter().enumerate() {
+            writeln!(
+                f,
+                "    {i}: {name:<14} {:>9} faces  {:>5} components",
+                self.faces_per_layer.get(i).copied().unwrap_or(0),
+                self.components_per_layer.get(i).copied().unwrap_or(0)
+            )?;
+        }
+        writeln!(f, "  components        {}", self.components)?;
+        writeln!(
+            f,
+            "  mean edge length  {:.6}  (cv {:.3}, min {:.6}, max {:.6})",
+            self.mean_edge_length, self.edge_length_cv, self.min_edge_length, self.max_edge_length
+        )?;
+        writeln!(
+            f,
+            "  valid             {}",
+            if self.valid { "yes" } else { "no" }
+        )?;
+        writeln!(f, "  non-finite        {}", self.non_finite)?;
+        writeln!(
+            f,
+            "  intersections     {}  ({} between layers, {} within a layer)",
+            self.intersections, self.intersections_between_layers, self.intersections_within_layers
+        )?;
+        if self.defects.is_empty() {
+            write!(f, "  ok: no defects")
+        } else {
+            for d in &self.defects {
+                writeln!(f, "  defect: {d}")?;
+            }
+            write!(f, "  {} defect(s)", self.defects.len())
+        }
+    }
+}

@@ -1,0 +1,211 @@
+//! Counting intersecting triangle pairs exactly.
+//!
+//! Broad phase: each face's bounding box is filed in every grid cell it overlaps (cells of about
+//! two edge lengths, so a face touches a handful); faces sharing a cell are paired, and a pair is
+//! counted only in the cell holding the lowest corner of the two boxes' overlap, so each pair is
+//! tested once. Narrow phase: [`triangles_intersect`] on exact predicates. Pairs that share a
+//! vertex are a face's own neighbourhood and never count.
+
+use glam::{I64Vec3, Vec3};
+use rayon::prelude::*;
+
+use crate::geom::{Aabb, triangles_intersect};
+use crate::mesh::{INVALID, Mesh};
+
+/// A face spanning more cells than this is tested against every face instead of being filed
+/// (only absurd input has such faces; it keeps the broad phase bounded).
+const MAX_CELLS_PER_FACE: i64 = 512;
+/// Cell coordinates are clamped to ±2^20 so that three fit in one `u64` key.
+const CELL_LIMIT: i64 = 1 << 20;
+
+/// Two faces that share a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct IntersectingPair {
+    pub face_a: u32,
+    pub face_b: u32,
+}
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IntersectionReport {
+    /// Intersecting pairs of faces on different layers.
+    pub between_layers: usize,
+    /// Intersecting pairs on the same layer that share no vertex (self-intersections).
+    pub within_layers: usize,
+    /// A few pairs, lowest face indices first, to point a user at the problem.
+    pub examples: Vec<IntersectingPair>,
+    /// Faces left out because a vertex is not finite.
+    pub skipped_faces: usize,
+}
+
+impl IntersectionReport {
+    pub fn total(&self) -> usize {
+        self.between_layers + self.within_layers
+    }
+}
+
+/// Finds every pair of live faces that intersect (closed triangles, so touching counts), skipping
+/// pairs that share a vertex.
+pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
+    let faces = mesh.faces();
+    let positions = mesh.positions();
+    let usable: Vec<bool> = faces
+        .par_iter()
+        .map(|t| t[0] != INVALID && t.iter().all(|&v| positions[v as usize].is_finite()))
+        .collect();
+    let boxes: Vec<Aabb> = faces
+        .par_iter()
+        .zip(&usable)
+        .map(|(t, &ok)| {
+            if ok {
+                Aabb::of_points(&t.map(|v| positions[v as usize]))
+            } else {
+                Aabb::EMPTY
+            }
+        })
+        .collect();
+    let skipped_faces = faces
+        .iter()
+        .zip(&usable)
+        .filter(|(t, ok)| t[0] != INVALID && !**ok)
+        .count();
+
+    let cell_size = broad_phase_cell_size(&boxes, &usable);
+    let cell_of = |p: Vec3| -> I64Vec3 {
+        let c = (p.as_dvec3() / cell_size).floor();
+        I64Vec3::new(c.x as i64, c.y as i64, c.z as i64)
+            .clamp(I64Vec3::splat(-CELL_LIMIT), I64Vec3::splat(CELL_LIMIT - 1))
+    };
+    let key_of = |c: I64Vec3| -> u64 {
+        let b = (c + I64Vec3::splat(CELL_LIMIT)).as_u64vec3();
+        (b.x << 42) | (b.y << 21) | b.z
+    };
+
+    // File each box in its cells.
+    let (filed, oversized): (Vec<Vec<(u64, u32)>>, Vec<Option<u32>>) = boxes
+        .par_iter()
+        .enumerate()
+        .filter(|(f, _)| usable[*f])
+        .map(|(f, b)| {
+            let (lo, hi) = (cell_of(b.min), cell_of(b.max));
+            let span = hi - lo + I64Vec3::ONE;
+            if span.x * span.y * span.z > MAX_CELLS_PER_FACE {
+                return (Vec::new(), Some(f as u32));
+            }
+            let mut entries = Vec::with_capacity((span.x * span.y * span.z) as usize);
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        entries.push((key_of(I64Vec3::new(x, y, z)), f as u32));
+                    }
+                }
+            }
+            (entries, None)
+        })
+        .unzip();
+    let mut entries: Vec<(u64, u32)> = filed.into_iter().flatten().collect();
+    entries.par_sort_unstable();
+    let oversized: Vec<u32> = oversized.into_iter().flatten().collect();
+
+    let mut group_starts: Vec<usize> = (0..entries.len())
+        .into_par_iter()
+        .filter(|&i| i == 0 || entries[i].0 != entries[i - 1].0)
+        .collect();
+    group_starts.push(entries.len());
+
+    let shares_vertex = |a: u32, b: u32| {
+        faces[a as usize]
+            .iter()
+            .any(|v| faces[b as usize].contains(v))
+    };
+    let test = |a: u32, b: u32| -> bool {
+        !shares_vertex(a, b)
+            && triangles_intersect(
+                mesh.face_positions(a as usize),
+                mesh.face_positions(b as usize),
+            )
+    };
+
+    let mut pairs: Vec<IntersectingPair> = group_starts
+        .par_windows(2)
+        .flat_map_iter(|w| {
+            let group = &entries[w[0]..w[1]];
+            let cell_key = group[0].0;
+            let mut found = Vec::new();
+            for (i, &(_, a)) in group.iter().enumerate() {
+                for &(_, b) in &group[i + 1..] {
+                    let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
+                    if !ba.overlaps(bb) {
+                        continue;
+                    }
+                    // Count the pair only in the cell of the overlap's lowest corner.
+                    if key_of(cell_of(ba.min.max(bb.min))) != cell_key {
+                        continue;
+                    }
+                    if test(a, b) {
+                        found.push(IntersectingPair {
+                            face_a: a.min(b),
+                            face_b: a.max(b),
+                        });
+                    }
+                }
+            }
+            found
+        })
+        .collect();
+
+    // Oversized faces against everything (each pair once).
+    let is_oversized = {
+        let mut flags = vec![false; faces.len()];
+        for &f in &oversized {
+            flags[f as usize] = true;
+        }
+        flags
+    };
+    for &a in &oversized {
+        let found: Vec<IntersectingPair> = (0..faces.len() as u32)
+            .into_par_iter()
+            .filter(|&b| {
+                b != a
+                    && usable[b as usize]
+                    && !(is_oversized[b as usize] && b < a)
+                    && boxes[a as usize].overlaps(&boxes[b as usize])
+                    && test(a, b)
+            })
+            .map(|b| IntersectingPair {
+                face_a: a.min(b),
+                face_b: a.max(b),
+            })
+            .collect();
+        pairs.extend(found);
+    }
+
+    pairs.par_sort_unstable();
+    let layers = mesh.face_layers();
+    let between_layers = pairs
+        .iter()
+        .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
+        .count();
+    IntersectionReport {
+        between_layers,
+        within_layers: pairs.len() - between_layers,
+        examples: pairs.iter().take(8).copied().collect(),
+        skipped_faces,
+    }
+}
+
+/// Twice the mean largest box extent: a face then overlaps a few cells and a cell holds a few
+/// dozen faces. Falls back to 1 for empty or degenerate input.
+fn broad_phase_cell_size(boxes: &[Aabb], usable: &[bool]) -> f64 {
+    let (sum, count) = boxes
+        .par_iter()
+        .zip(usable)
+        .filter(|(_, ok)| **ok)
+        .map(|(b, _)| ((b.max - b.min).max_element() as f64, 1usize))
+        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let size = 2.0 * sum / count.max(1) as f64;
+    if size.is_finite() && size > 0.0 {
+        size
+    } else {
+        1.0
+    }
+}

@@ -1,0 +1,53 @@
+//! Geometric primitives shared by the grid, collision and the checks: closest point on a triangle
+//! (Ericson, Real-Time Collision Detection §5.1.5), ray–triangle (Möller–Trumbore) and an exact
+//! triangle–triangle intersection test on Shewchuk's adaptive predicates.
+
+mod closest_point;
+mod ray;
+mod tri_tri;
+
+pub use closest_point::{closest_point_on_triangle, point_triangle_distance_squared};
+pub use ray::{Ray, ray_triangle};
+pub use tri_tri::triangles_intersect;
+
+use glam::Vec3;
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn of_points(points: &[Vec3]) -> Aabb {
+        points.iter().fold(Aabb::EMPTY, |b, &p| b.including(p))
+    }
+
+    pub fn including(self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    pub fn expanded(self, by: f32) -> Aabb {
+        Aabb {
+            min: self.min - Vec3::splat(by),
+            max: self.max + Vec3::splat(by),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.min.cmpgt(self.max).any()
+    }
+
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
+}

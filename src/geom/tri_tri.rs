@@ -1,0 +1,174 @@
+//! Exact triangle–triangle intersection on closed triangles (touching counts), built only from
+//! Shewchuk's adaptive-precision orientation predicates (`robust` crate), so no rounding can hide
+//! or invent a crossing.
+//!
+//! Two non-coplanar triangles meet in a segment of the line where their planes cross; an end of
+//! that segment lies on an edge of one triangle and inside the other. So they intersect exactly
+//! when one of the six edges meets the other triangle. Coplanar triangles are tested in 2D.
+
+use glam::{DVec3, Vec3};
+use robust::{Coord, Coord3D, orient2d, orient3d};
+
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    orient3d(c3(a), c3(b), c3(c), c3(d))
+}
+
+fn sign(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// True when the closed triangles `a` and `b` share at least one point.
+pub fn triangles_intersect(a: [Vec3; 3], b: [Vec3; 3]) -> bool {
+    let a = a.map(|p| p.as_dvec3());
+    let b = b.map(|p| p.as_dvec3());
+    let side_a = a.map(|p| sign(orient(b[0], b[1], b[2], p)));
+    if side_a.iter().all(|&s| s > 0) || side_a.iter().all(|&s| s < 0) {
+        return false;
+    }
+    let side_b = b.map(|p| sign(orient(a[0], a[1], a[2], p)));
+    if side_b.iter().all(|&s| s > 0) || side_b.iter().all(|&s| s < 0) {
+        return false;
+    }
+    let a_flat = is_degenerate(a);
+    let b_flat = is_degenerate(b);
+    if a_flat && b_flat {
+        // Two zero-area triangles (segments or points): out of scope, `validate` and the
+        // quality checks report degenerate faces on their own.
+        return false;
+    }
+    if side_a.iter().all(|&s| s == 0) && !b_flat {
+        return coplanar_intersect(a, b, b);
+    }
+    if side_b.iter().all(|&s| s == 0) && !a_flat {
+        return coplanar_intersect(a, b, a);
+    }
+    let edges = |t: [DVec3; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+    (!b_flat
+        && edges(a)
+            .iter()
+            .any(|&(p, q)| segment_meets_triangle(p, q, b)))
+        || (!a_flat
+            && edges(b)
+                .iter()
+                .any(|&(p, q)| segment_meets_triangle(p, q, a)))
+}
+
+/// Collinear (or coincident) corners: orient2d is zero in every axis-aligned projection.
+fn is_degenerate(t: [DVec3; 3]) -> bool {
+    (0..3).all(|axis| project_orient(t[0], t[1], t[2], axis) == 0.0)
+}
+
+/// Segment `pq` against a non-degenerate triangle `t`, both closed.
+fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let sp = sign(orient(t[0], t[1], t[2], p));
+    let sq = sign(orient(t[0], t[1], t[2], q));
+    if sp * sq > 0 {
+        return false;
+    }
+    if sp == 0 && sq == 0 {
+        return coplanar_segment_triangle(p, q, t);
+    }
+    // The segment crosses the plane once; the crossing is inside the triangle when the line pq
+    // passes on the same side of all three edges (Plücker signs; zero means on an edge).
+    let s = [
+        sign(orient(p, q, t[0], t[1])),
+        sign(orient(p, q, t[1], t[2])),
+        sign(orient(p, q, t[2], t[0])),
+    ];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+/// The axis to drop so that the plane of `t` projects without collapsing.
+fn projection_axis(t: [DVec3; 3]) -> usize {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).abs();
+    if n.x >= n.y && n.x >= n.z {
+        0
+    } else if n.y >= n.z {
+        1
+    } else {
+        2
+    }
+}
+
+fn drop_axis(p: DVec3, axis: usize) -> Coord<f64> {
+    match axis {
+        0 => Coord { x: p.y, y: p.z },
+        1 => Coord { x: p.z, y: p.x },
+        _ => Coord { x: p.x, y: p.y },
+    }
+}
+
+fn project_orient(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> f64 {
+    orient2d(drop_axis(a, axis), drop_axis(b, axis), drop_axis(c, axis))
+}
+
+/// Both triangles lie in one plane (that of `reference`, which is not degenerate).
+fn coplanar_intersect(a: [DVec3; 3], b: [DVec3; 3], reference: [DVec3; 3]) -> bool {
+    let axis = projection_axis(reference);
+    let pa = a.map(|p| drop_axis(p, axis));
+    let pb = b.map(|p| drop_axis(p, axis));
+    let edges = |t: [Coord<f64>; 3]| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+    edges(pa).iter().any(|&(p, q)| {
+        edges(pb)
+            .iter()
+            .any(|&(r, s)| segments_intersect_2d(p, q, r, s))
+    }) || point_in_triangle_2d(pa[0], pb)
+        || point_in_triangle_2d(pb[0], pa)
+}
+
+fn coplanar_segment_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let axis = projection_axis(t);
+    let (pp, pq) = (drop_axis(p, axis), drop_axis(q, axis));
+    let pt = t.map(|x| drop_axis(x, axis));
+    point_in_triangle_2d(pp, pt)
+        || point_in_triangle_2d(pq, pt)
+        || [(pt[0], pt[1]), (pt[1], pt[2]), (pt[2], pt[0])]
+            .iter()
+            .any(|&(r, s)| segments_intersect_2d(pp, pq, r, s))
+}
+
+fn orient_sign_2d(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>) -> i8 {
+    sign(orient2d(a, b, c))
+}
+
+fn point_in_triangle_2d(p: Coord<f64>, t: [Coord<f64>; 3]) -> bool {
+    let s = [
+        orient_sign_2d(t[0], t[1], p),
+        orient_sign_2d(t[1], t[2], p),
+        orient_sign_2d(t[2], t[0], p),
+    ];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+fn on_segment_2d(p: Coord<f64>, q: Coord<f64>, r: Coord<f64>) -> bool {
+    // r is collinear with pq: inside the closed box of pq means on the segment.
+    r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+}
+
+fn segments_intersect_2d(p: Coord<f64>, q: Coord<f64>, r: Coord<f64>, s: Coord<f64>) -> bool {
+    let d1 = orient_sign_2d(r, s, p);
+    let d2 = orient_sign_2d(r, s, q);
+    let d3 = orient_sign_2d(p, q, r);
+    let d4 = orient_sign_2d(p, q, s);
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    (d1 == 0 && on_segment_2d(r, s, p))
+        || (d2 == 0 && on_segment_2d(r, s, q))
+        || (d3 == 0 && on_segment_2d(p, q, r))
+        || (d4 == 0 && on_segment_2d(p, q, s))
+}

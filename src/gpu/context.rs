@@ -1,0 +1,283 @@
+//! Adapter choice and the device every kernel runs on.
+//!
+//! Preference: a hardware GPU, then (only when software is allowed) a CPU rasterizer such as
+//! Mesa's lavapipe; `WGPU_ADAPTER_NAME` pins an adapter by name. Vulkan wins over GL for the
+//! same device.
+
+use std::sync::mpsc;
+
+use bytemuck::Pod;
+use thiserror::Error;
+use wgpu::util::DeviceExt;
+
+#[derive(Debug, Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found{0}")]
+    NoAdapter(String),
+    #[error("only a software adapter is available ({0}); allow software adapters to use it")]
+    OnlySoftware(String),
+    #[error("the adapter refused a device: {0}")]
+    RequestDevice(#[from] wgpu::RequestDeviceError),
+    #[error("reading back a GPU buffer failed: {0}")]
+    Readback(String),
+    #[error("GPU validation error: {0}")]
+    Validation(String),
+    #[error(transparent)]
+    Shader(#[from] super::shaders::ShaderError),
+}
+
+/// Which adapters may be used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AdapterChoice {
+    /// Accept a CPU rasterizer (lavapipe, llvmpipe) when no hardware GPU is present.
+    pub allow_software: bool,
+}
+
+/// What a user needs to know about an adapter.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct AdapterSummary {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub software: bool,
+}
+
+impl AdapterSummary {
+    fn of(info: &wgpu::AdapterInfo) -> Self {
+        AdapterSummary {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
+            software: info.device_type == wgpu::DeviceType::Cpu,
+        }
+    }
+}
+
+impl std::fmt::Display for AdapterSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} ({}, {}{})",
+            self.name,
+            self.backend,
+            self.device_type,
+            if self.driver.is_empty() {
+                String::new()
+            } else {
+                format!(", {}", self.driver)
+            }
+        )
+    }
+}
+
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+/// Higher is better.
+fn rank(info: &wgpu::AdapterInfo) -> u32 {
+    let device = match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 40,
+        wgpu::DeviceType::IntegratedGpu => 30,
+        wgpu::DeviceType::VirtualGpu => 20,
+        wgpu::DeviceType::Cpu => 10,
+        wgpu::DeviceType::Other => 0,
+    };
+    let backend = match info.backend {
+        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 2,
+        wgpu::Backend::Gl => 1,
+        _ => 0,
+    };
+    device + backend
+}
+
+/// Every adapter wgpu can see, best first.
+pub fn list_adapters() -> Vec<AdapterSummary> {
+    let mut adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
+    adapters.sort_by_key(|a| std::cmp::Reverse(rank(&a.get_info())));
+    adapters
+        .iter()
+        .map(|a| AdapterSummary::of(&a.get_info()))
+        .collect()
+}
+
+/// A device and queue on the chosen adapter.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter: AdapterSummary,
+    pub limits: wgpu::Limits,
+}
+
+impl GpuContext {
+    /// Opens the best adapter allowed by `choice` (and by `WGPU_ADAPTER_NAME`, if set).
+    pub fn new(choice: AdapterChoice) -> Result<GpuContext, GpuError> {
+        let instance = instance();
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let pinned = std::env::var("WGPU_ADAPTER_NAME")
+            .ok()
+            .filter(|s| !s.is_empty());
+        if let Some(name) = &pinned {
+            let wanted = name.to_lowercase();
+            adapters.retain(|a| a.get_info().name.to_lowercase().contains(&wanted));
+        }
+        adapters.sort_by_key(|a| std::cmp::Reverse(rank(&a.get_info())));
+        let Some(adapter) = adapters.into_iter().next() else {
+            let detail = match pinned {
+                Some(name) => format!(" matching WGPU_ADAPTER_NAME={name}"),
+                None => " (is a Vulkan driver installed? `tools/test.sh` installs Mesa's lavapipe)"
+                    .into(),
+            };
+            return Err(GpuError::NoAdapter(detail));
+        };
+        let info = adapter.get_info();
+        let summary = AdapterSummary::of(&info);
+        if summary.software && !choice.allow_software {
+            return Err(GpuError::OnlySoftware(summary.to_string()));
+        }
+        let limits = adapter.limits();
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("slayer"),
+                required_features: wgpu::Features::empty(),
+                required_limits: limits.clone(),
+                ..Default::default()
+            }))?;
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter: summary,
+            limits,
+        })
+    }
+
+    /// A compute pipeline for kernel `name` (entry point `main`, layout from the shader).
+    pub fn compute_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
+        let source = super::shaders::kernel_source(name)?;
+        // Validate with naga first: its messages carry source locations.
+        super::shaders::validate(name, &source)?;
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: None,
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Validation(error.to_string()));
+        }
+        Ok(pipeline)
+    }
+
+    /// A storage buffer holding `data` (at least 4 bytes, so empty inputs stay legal).
+    pub fn storage_buffer<T: Pod>(&self, label: &str, data: &[T], writable: bool) -> wgpu::Buffer {
+        let mut usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        if writable {
+            usage |= wgpu::BufferUsages::COPY_DST;
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let padded;
+        let contents = if bytes.len() < 4 {
+            padded = [0u8; 4];
+            &padded[..]
+        } else {
+            bytes
+        };
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+    }
+
+    /// A zeroed storage buffer for `count` elements of `T`.
+    pub fn output_buffer<T: Pod>(&self, label: &str, count: usize) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: (count * std::mem::size_of::<T>()).max(4) as u64,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    pub fn uniform_buffer<T: Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::bytes_of(value),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+    }
+
+    /// Copies the first `count` elements of `buffer` back to the CPU.
+    pub fn read_buffer<T: Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+        count: usize,
+    ) -> Result<Vec<T>, GpuError> {
+        let size = (count * std::mem::size_of::<T>()) as u64;
+        if size == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let (sender, receiver) = mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |result| {
+            let _ = sender.send(result);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let view = staging
+            .get_mapped_range(..)
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let values = bytemuck::cast_slice::<u8, T>(&view).to_vec();
+        drop(view);
+        staging.unmap();
+        Ok(values)
+    }
+
+    /// Workgroup counts covering `invocations` threads of `workgroup_size`, folded into y when
+    /// x would pass the adapter's per-dimension limit (kernels flatten with `flat_index`).
+    pub fn dispatch_size(&self, invocations: usize, workgroup_size: u32) -> (u32, u32) {
+        let groups = invocations.div_ceil(workgroup_size as usize) as u64;
+        let max_x = self.limits.max_compute_workgroups_per_dimension.max(1) as u64;
+        if groups <= max_x {
+            (groups as u32, 1)
+        } else {
+            (max_x as u32, groups.div_ceil(max_x) as u32)
+        }
+    }
+}

@@ -1,0 +1,141 @@
+//! Mesh files: OBJ (tobj underneath, one layer per `o`/`g`) and PLY (per-vertex BRDF and layer
+//! ids). Readers never panic on malformed input: every problem becomes an [`IoError`] naming the
+//! file and, where it applies, the line. Writers go through a temporary file and a rename, so a
+//! failed write never leaves half a mesh where a good one was.
+
+mod error;
+mod obj;
+mod ply;
+
+pub use error::IoError;
+pub use obj::{ObjReport, parse_obj, write_obj};
+pub use ply::{parse_ply, write_ply};
+
+use std::fs;
+use std::io::Write;
+use std::path::Path;
+
+use crate::mesh::Mesh;
+
+/// File formats by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Obj,
+    Ply,
+}
+
+impl Format {
+    pub fn of_path(path: &Path) -> Result<Format, IoError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("obj") => Ok(Format::Obj),
+            Some("ply") => Ok(Format::Ply),
+            _ => Err(IoError::UnsupportedFormat {
+                path: path.display().to_string(),
+            }),
+        }
+    }
+}
+
+/// What a lenient load found besides the mesh.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LoadNotes {
+    /// Vertices with a non-finite coordinate, and the first such line (OBJ).
+    pub non_finite_vertices: usize,
+    pub first_non_finite_line: Option<usize>,
+}
+
+/// Reads a mesh and checks it: malformed files, non-finite values and broken meshes are errors.
+pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
+    let (mesh, notes) = load_mesh(path)?;
+    let file = path.display().to_string();
+    if notes.non_finite_vertices > 0 {
+        return Err(IoError::Parse {
+            path: file,
+            line: notes.first_non_finite_line,
+            message: format!(
+                "{} vertices have a non-finite coordinate (NaN or infinity)",
+                notes.non_finite_vertices
+            ),
+        });
+    }
+    mesh.validate()
+        .map_err(|source| IoError::mesh(file, source, &mesh))?;
+    Ok(mesh)
+}
+
+/// Reads a mesh that is well-formed as a file and as a manifold surface, but lets non-finite
+/// or out-of-range values through (counted in the notes) so that `slayer check` can report them.
+pub fn load_mesh(path: &Path) -> Result<(Mesh, LoadNotes), IoError> {
+    let format = Format::of_path(path)?;
+    let bytes = fs::read(path).map_err(|source| IoError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let name = path.display().to_string();
+    match format {
+        Format::Obj => {
+            let (mesh, report) = parse_obj(&bytes, &name)?;
+            Ok((
+                mesh,
+                LoadNotes {
+                    non_finite_vertices: report.non_finite_vertices,
+                    first_non_finite_line: report.first_non_finite_line,
+                },
+            ))
+        }
+        Format::Ply => {
+            let mesh = parse_ply(&bytes, &name)?;
+            let non_finite = mesh.positions().iter().filter(|p| !p.is_finite()).count();
+            Ok((
+                mesh,
+                LoadNotes {
+                    non_finite_vertices: non_finite,
+                    first_non_finite_line: None,
+                },
+            ))
+        }
+    }
+}
+
+/// Writes a mesh in the format its extension names, atomically.
+pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
+    let format = Format::of_path(path)?;
+    let mut bytes = Vec::new();
+    match format {
+        Format::Obj => write_obj(mesh, &mut bytes),
+        Format::Ply => write_ply(mesh, &mut bytes),
+    }
+    .map_err(|source| IoError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    write_atomically(path, &bytes)
+}
+
+/// Writes `bytes` to a temporary file beside `path`, syncs it, and renames it over `path`.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    let io_error = |source| IoError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "mesh".into());
+    let temporary = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut file = fs::File::create(&temporary)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        fs::rename(&temporary, path)
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&temporary);
+    }
+    result.map_err(io_error)
+}

@@ -1,0 +1,287 @@
+//! Wavefront OBJ. tobj parses and triangulates; a pre-scan of our own finds what tobj would
+//! reject or mis-handle (bad numbers, indices out of range or zero, non-finite values) and names
+//! the line, since tobj's errors carry none. Each object or group becomes a layer, and vertices
+//! at identical positions within a layer are welded.
+
+use std::io::{self, BufRead, Write};
+
+use glam::Vec3;
+use rustc_hash::FxHashMap;
+
+use super::IoError;
+use crate::mesh::{INVALID, LayerId, MAX_COORDINATE, Mesh, VertexFlags};
+
+/// What parsing found besides the mesh.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjReport {
+    pub non_finite_vertices: usize,
+    pub first_non_finite_line: Option<usize>,
+    pub welded_vertices: usize,
+}
+
+/// Parses OBJ bytes into a mesh (`name` is used in messages).
+pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let line = 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        IoError::parse(name, Some(line), "not a text file (invalid UTF-8)")
+    })?;
+    let mut report = prescan(text, name)?;
+
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let mut reader = LineCounter {
+        inner: io::BufReader::new(text.as_bytes()),
+        lines: 0,
+    };
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
+
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut face_layers: Vec<LayerId> = Vec::new();
+    let mut layer_names: Vec<String> = Vec::new();
+    for model in &models {
+        let m = &model.mesh;
+        if m.indices.len() < 3 {
+            continue;
+        }
+        let layer = layer_names.len() as LayerId;
+        layer_names.push(if model.name.is_empty() || model.name == "unnamed_object" {
+            format!("layer{layer}")
+        } else {
+            model.name.clone()
+        });
+        // Weld by exact bit pattern (+0 and -0 are one point); NaN never welds.
+        let mut welded: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+        let mut local_to_global = Vec::with_capacity(m.positions.len() / 3);
+        for p in m.positions.chunks_exact(3) {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            let key = (p + Vec3::ZERO).to_array().map(f32::to_bits);
+            let index = if p.is_nan() {
+                None
+            } else {
+                welded.get(&key).copied()
+            };
+            let global = index.unwrap_or_else(|| {
+                positions.push(p);
+                let g = (positions.len() - 1) as u32;
+                if !p.is_nan() {
+                    welded.insert(key, g);
+                }
+                g
+            });
+            if index.is_some() {
+                report.welded_vertices += 1;
+            }
+            local_to_global.push(global);
+        }
+        for (k, tri) in m.indices.chunks_exact(3).enumerate() {
+            let face = [tri[0], tri[1], tri[2]]
+                .map(|i| local_to_global.get(i as usize).copied().unwrap_or(INVALID));
+            if face.contains(&INVALID) {
+                return Err(IoError::parse(
+                    name,
+                    None,
+                    format!(
+                        "object `{}`: triangle {k} has a vertex index out of range",
+                        model.name
+                    ),
+                ));
+            }
+            if face[0] == face[1] || face[1] == face[2] || face[0] == face[2] {
+                return Err(IoError::parse(
+                    name,
+                    None,
+                    format!(
+                        "object `{}`: triangle {k} uses the same point twice (coincident corners)",
+                        model.name
+                    ),
+                ));
+            }
+            faces.push(face);
+            face_layers.push(layer);
+        }
+    }
+    if faces.is_empty() {
+        return Err(IoError::parse(name, None, "no faces"));
+    }
+    let mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
+        .map_err(|e| IoError::building(name, e, &positions))?;
+    Ok((mesh, report))
+}
+
+/// Checks every `v` and `f` line for what tobj would reject without a line number or accept
+/// wrongly: unparsable or missing numbers, index 0, indices past the vertices defined so far.
+fn prescan(text: &str, name: &str) -> Result<ObjReport, IoError> {
+    let mut report = ObjReport::default();
+    let (mut positions, mut texcoords, mut normals) = (0usize, 0usize, 0usize);
+    for (number, line) in text.lines().enumerate() {
+        let number = number + 1;
+        let fail = |message: String| Err(IoError::parse(name, Some(number), message));
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let mut coordinates = [0f32; 3];
+                for (axis, slot) in coordinates.iter_mut().enumerate() {
+                    match words.next().map(str::parse::<f32>) {
+                        Some(Ok(value)) => *slot = value,
+                        Some(Err(_)) => {
+                            return fail(format!("vertex coordinate {axis} is not a number"));
+                        }
+                        None => return fail("vertex needs three coordinates".into()),
+                    }
+                }
+                if coordinates.iter().any(|c| !c.is_finite()) {
+                    report.non_finite_vertices += 1;
+                    report.first_non_finite_line.get_or_insert(number);
+                } else if coordinates.iter().any(|c| c.abs() > MAX_COORDINATE) {
+                    return fail(format!(
+                        "vertex coordinate beyond the supported range ±{MAX_COORDINATE:e}"
+                    ));
+                }
+                positions += 1;
+            }
+            Some("vt") => texcoords += 1,
+            Some("vn") => normals += 1,
+            Some("f") => {
+                let mut corners = 0;
+                for word in words {
+                    corners += 1;
+                    let counts = [
+                        ("vertex", positions),
+                        ("texture", texcoords),
+                        ("normal", normals),
+                    ];
+                    for (field, (what, defined)) in word.split('/').zip(counts) {
+                        if field.is_empty() && what != "vertex" {
+                            continue;
+                        }
+                        let index = match field.parse::<i64>() {
+                            Ok(i) => i,
+                            Err(_) => {
+                                return fail(format!(
+                                    "face {what} index `{field}` is not an integer"
+                                ));
+                            }
+                        };
+                        let in_range = if index > 0 {
+                            index as u64 <= defined as u64
+                        } else {
+                            index != 0 && index.unsigned_abs() <= defined as u64
+                        };
+                        if !in_range {
+                            return fail(format!(
+                                "face {what} index {index} is out of range ({defined} defined so far)"
+                            ));
+                        }
+                    }
+                    if word.split('/').count() > 3 {
+                        return fail(format!("face corner `{word}` has more than three indices"));
+                    }
+                }
+                if corners < 3 {
+                    return fail(format!("face has {corners} corners; at least 3 are needed"));
+                }
+            }
+            Some("o") | Some("g") if words.next().is_none() => {
+                return fail("object or group without a name".into());
+            }
+            _ => {}
+        }
+    }
+    Ok(report)
+}
+
+/// Counts lines as tobj reads them, to put a line number on tobj's errors.
+struct LineCounter<R> {
+    inner: R,
+    lines: usize,
+}
+
+impl<R: BufRead> io::Read for LineCounter<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.lines += buf[..n].iter().filter(|&&b| b == b'\n').count();
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for LineCounter<R> {
+    fn fill_buf(&mut self) -> io::Result<&[u8]> {
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, amount: usize) {
+        if let Ok(buf) = self.inner.fill_buf() {
+            let n = amount.min(buf.len());
+            self.lines += buf[..n].iter().filter(|&&b| b == b'\n').count();
+        }
+        self.inner.consume(amount);
+    }
+}
+
+/// Writes the live mesh as OBJ: one `o` per layer, its vertices then its faces.
+pub fn write_obj(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+    let live_faces = mesh.live_face_count();
+    writeln!(
+        out,
+        "# slayer mesh: {} vertices, {} faces, {} layers",
+        mesh.live_vertex_count(),
+        live_faces,
+        mesh.layer_count()
+    )?;
+    let mut file_index = vec![0u32; mesh.vertex_count()];
+    let mut next_index = 1u32;
+    for (layer, layer_name) in mesh.layer_names().iter().enumerate() {
+        let layer = layer as LayerId;
+        let has_faces = mesh
+            .faces()
+            .iter()
+            .zip(mesh.face_layers())
+            .any(|(t, &l)| l == layer && t[0] != INVALID);
+        if !has_faces {
+            continue;
+        }
+        writeln!(out, "o {}", sanitize_name(layer_name))?;
+        for (v, p) in mesh.positions().iter().enumerate() {
+            if mesh.vertex_layers()[v] == layer
+                && !mesh.flags()[v].contains(VertexFlags::DEAD)
+                && mesh.adjacency().vertex_corner[v] != INVALID
+            {
+                writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+                file_index[v] = next_index;
+                next_index += 1;
+            }
+        }
+        for (t, &l) in mesh.faces().iter().zip(mesh.face_layers()) {
+            if l == layer && t[0] != INVALID {
+                let [a, b, c] = t.map(|v| file_index[v as usize]);
+                writeln!(out, "f {a} {b} {c}")?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// OBJ names end at whitespace.
+fn sanitize_name(name: &str) -> String {
+    let cleaned: String = name
+        .chars()
+        .map(|c| if c.is_whitespace() { '_' } else { c })
+        .collect();
+    if cleaned.is_empty() {
+        "layer".into()
+    } else {
+        cleaned
+    }
+}

@@ -1,0 +1,537 @@
+//! Stanford PLY, ASCII and binary. Written as binary little-endian with the full vertex state
+//! (position, normal, BRDF, layer, mask flag) and a face layer; layer names travel in comments.
+//! The reader takes any property order and scalar type, skips elements and properties it does
+//! not know, triangulates polygons as fans, and never trusts a count in the header to size an
+//! allocation.
+
+use std::io::{self, Write};
+
+use glam::Vec3;
+
+use super::IoError;
+use crate::mesh::{Brdf, INVALID, LayerId, Mesh, VertexFlags};
+
+/// Layer ids above this are treated as corrupt (a layer is a user-facing label, not an index
+/// space).
+const MAX_LAYERS: u32 = 65_536;
+
+const BRDF_PROPERTIES: [&str; 7] = [
+    "diffuse_r",
+    "diffuse_g",
+    "diffuse_b",
+    "specular_r",
+    "specular_g",
+    "specular_b",
+    "roughness",
+];
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Encoding {
+    Ascii,
+    Binary { little_endian: bool },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(word: &str) -> Option<Scalar> {
+        Some(match word {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Property {
+    name: String,
+    value: Scalar,
+    /// `Some(count type)` for list properties.
+    list: Option<Scalar>,
+}
+
+#[derive(Debug, Clone)]
+struct Element {
+    name: String,
+    count: usize,
+    properties: Vec<Property>,
+}
+
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    layer_names: Vec<(u32, String)>,
+    /// Byte offset of the body.
+    body: usize,
+    /// Lines in the header, for ASCII line numbers.
+    lines: usize,
+}
+
+fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
+    let fail = |line: usize, message: &str| Err(IoError::parse(name, Some(line), message));
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut layer_names = Vec::new();
+    let mut offset = 0;
+    let mut line_number = 0;
+    loop {
+        let Some(end) = bytes[offset..].iter().position(|&b| b == b'\n') else {
+            return fail(line_number + 1, "header ends before `end_header`");
+        };
+        line_number += 1;
+        let raw = &bytes[offset..offset + end];
+        offset += end + 1;
+        let Ok(line) = std::str::from_utf8(raw) else {
+            return fail(line_number, "header is not text");
+        };
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if line_number == 1 {
+            if words != ["ply"] {
+                return fail(1, "not a PLY file (first line must be `ply`)");
+            }
+            continue;
+        }
+        match words.as_slice() {
+            ["format", kind, _version] => {
+                encoding = Some(match *kind {
+                    "ascii" => Encoding::Ascii,
+                    "binary_little_endian" => Encoding::Binary {
+                        little_endian: true,
+                    },
+                    "binary_big_endian" => Encoding::Binary {
+                        little_endian: false,
+                    },
+                    _ => return fail(line_number, "unknown PLY format"),
+                })
+            }
+            ["comment", "slayer", "layer", id, rest @ ..] => {
+                if let Ok(id) = id.parse::<u32>() {
+                    layer_names.push((id, rest.join(" ")));
+                }
+            }
+            ["comment", ..] | ["obj_info", ..] | [] => {}
+            ["element", element, count] => {
+                let Ok(count) = count.parse::<usize>() else {
+                    return fail(line_number, "element count is not a non-negative integer");
+                };
+                elements.push(Element {
+                    name: element.to_string(),
+                    count,
+                    properties: Vec::new(),
+                });
+            }
+            ["property", "list", count_type, value_type, property] => {
+                let (Some(count), Some(value)) =
+                    (Scalar::parse(count_type), Scalar::parse(value_type))
+                else {
+                    return fail(line_number, "unknown property type");
+                };
+                if !count.is_integer() {
+                    return fail(line_number, "list count type must be an integer type");
+                }
+                let Some(element) = elements.last_mut() else {
+                    return fail(line_number, "property before any element");
+                };
+                element.properties.push(Property {
+                    name: property.to_string(),
+                    value,
+                    list: Some(count),
+                });
+            }
+            ["property", value_type, property] => {
+                let Some(value) = Scalar::parse(value_type) else {
+                    return fail(line_number, "unknown property type");
+                };
+                let Some(element) = elements.last_mut() else {
+                    return fail(line_number, "property before any element");
+                };
+                element.properties.push(Property {
+                    name: property.to_string(),
+                    value,
+                    list: None,
+                });
+            }
+            ["end_header"] => break,
+            _ => {
+                return fail(
+                    line_number,
+                    &format!("unexpected header line `{}`", line.trim()),
+                );
+            }
+        }
+    }
+    let Some(encoding) = encoding else {
+        return fail(line_number, "header has no `format` line");
+    };
+    Ok(Header {
+        encoding,
+        elements,
+        layer_names,
+        body: offset,
+        lines: line_number,
+    })
+}
+
+/// Reads values from the body in either encoding.
+struct Body<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    encoding: Encoding,
+    /// ASCII: the current line's words.
+    words: Vec<&'a str>,
+    word: usize,
+    line: usize,
+    name: &'a str,
+}
+
+impl<'a> Body<'a> {
+    fn error(&self, message: impl Into<String>) -> IoError {
+        let line = match self.encoding {
+            Encoding::Ascii => Some(self.line),
+            Encoding::Binary { .. } => None,
+        };
+        IoError::parse(self.name, line, message)
+    }
+
+    /// ASCII rows are lines; a new element row starts on a new line.
+    fn start_row(&mut self) -> Result<(), IoError> {
+        if self.encoding != Encoding::Ascii {
+            return Ok(());
+        }
+        loop {
+            if self.at >= self.bytes.len() {
+                return Err(self.error("file ends before all elements are read"));
+            }
+            let end = self.bytes[self.at..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(self.bytes.len(), |e| self.at + e);
+            let raw = &self.bytes[self.at..end];
+            self.at = end + 1;
+            self.line += 1;
+            let text = std::str::from_utf8(raw).map_err(|_| self.error("body line is not text"))?;
+            self.words = text.split_whitespace().collect();
+            self.word = 0;
+            if !self.words.is_empty() {
+                return Ok(());
+            }
+        }
+    }
+
+    fn read(&mut self, scalar: Scalar) -> Result<f64, IoError> {
+        match self.encoding {
+            Encoding::Ascii => {
+                let Some(word) = self.words.get(self.word) else {
+                    return Err(self.error("row has too few values"));
+                };
+                self.word += 1;
+                let value = if scalar.is_integer() {
+                    word.parse::<i64>().map(|v| v as f64).ok()
+                } else {
+                    word.parse::<f64>().ok()
+                };
+                value.ok_or_else(|| self.error(format!("`{word}` is not a valid {scalar:?}")))
+            }
+            Encoding::Binary { little_endian } => {
+                let size = scalar.size();
+                let Some(raw) = self.bytes.get(self.at..self.at + size) else {
+                    return Err(self.error("file ends before all elements are read"));
+                };
+                self.at += size;
+                let mut buf = [0u8; 8];
+                buf[..size].copy_from_slice(raw);
+                if !little_endian {
+                    buf[..size].reverse();
+                }
+                Ok(match scalar {
+                    Scalar::I8 => buf[0] as i8 as f64,
+                    Scalar::U8 => buf[0] as f64,
+                    Scalar::I16 => i16::from_le_bytes([buf[0], buf[1]]) as f64,
+                    Scalar::U16 => u16::from_le_bytes([buf[0], buf[1]]) as f64,
+                    Scalar::I32 => i32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]]) as f64,
+                    Scalar::U32 => u32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]]) as f64,
+                    Scalar::F32 => f32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]]) as f64,
+                    Scalar::F64 => f64::from_le_bytes(buf),
+                })
+            }
+        }
+    }
+
+    fn remaining(&self) -> usize {
+        self.bytes.len().saturating_sub(self.at)
+    }
+}
+
+/// An index-like value: a non-negative integer that fits in `u32`.
+fn as_index(value: f64) -> Option<u32> {
+    (value >= 0.0 && value < INVALID as f64 && value.fract() == 0.0).then_some(value as u32)
+}
+
+/// Parses PLY bytes (`name` is used in messages).
+pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
+    let header = parse_header(bytes, name)?;
+    let mut body = Body {
+        bytes,
+        at: header.body,
+        encoding: header.encoding,
+        words: Vec::new(),
+        word: 0,
+        line: header.lines,
+        name,
+    };
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut brdfs: Vec<Brdf> = Vec::new();
+    let mut masked: Vec<bool> = Vec::new();
+    let mut has_brdf = false;
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut face_layers: Vec<LayerId> = Vec::new();
+    let mut saw_vertices = false;
+
+    for element in &header.elements {
+        // Never reserve more rows than the remaining bytes could hold.
+        let capacity = element.count.min(body.remaining() + 1);
+        let is_vertex = element.name == "vertex";
+        let is_face = element.name == "face";
+        if is_vertex {
+            if saw_vertices {
+                return Err(body.error("more than one vertex element"));
+            }
+            saw_vertices = true;
+            for axis in ["x", "y", "z"] {
+                if !element
+                    .properties
+                    .iter()
+                    .any(|p| p.name == axis && p.list.is_none())
+                {
+                    return Err(body.error(format!("vertex element has no `{axis}` property")));
+                }
+            }
+            has_brdf = BRDF_PROPERTIES
+                .iter()
+                .all(|b| element.properties.iter().any(|p| p.name == *b));
+            positions.reserve(capacity);
+        }
+        if is_face
+            && !element.properties.iter().any(|p| {
+                p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
+            })
+        {
+            return Err(body.error("face element has no `vertex_indices` list"));
+        }
+        for row in 0..element.count {
+            body.start_row()?;
+            let mut position = [0f32; 3];
+            let mut brdf = [0f32; 7];
+            let mut flags = 0u32;
+            let mut polygon: Vec<u32> = Vec::new();
+            let mut layer = 0u32;
+            for property in &element.properties {
+                if let Some(count_type) = property.list {
+                    let count = body.read(count_type)?;
+                    let Some(count) = as_index(count) else {
+                        return Err(body.error(format!("{} {row}: bad list length", element.name)));
+                    };
+                    let wanted = is_face
+                        && (property.name == "vertex_indices" || property.name == "vertex_index");
+                    for _ in 0..count {
+                        let value = body.read(property.value)?;
+                        if wanted {
+                            let Some(index) = as_index(value) else {
+                                return Err(body.error(format!(
+                                    "face {row}: vertex index {value} is not a valid index"
+                                )));
+                            };
+                            polygon.push(index);
+                        }
+                    }
+                    continue;
+                }
+                let value = body.read(property.value)?;
+                if is_vertex {
+                    match property.name.as_str() {
+                        "x" => position[0] = value as f32,
+                        "y" => position[1] = value as f32,
+                        "z" => position[2] = value as f32,
+                        "flags" => flags = as_index(value).unwrap_or(0),
+                        other => {
+                            if let Some(k) = BRDF_PROPERTIES.iter().position(|b| *b == other) {
+                                brdf[k] = value as f32;
+                            }
+                        }
+                    }
+                } else if is_face && property.name == "layer" {
+                    layer = match as_index(value) {
+                        Some(l) if l < MAX_LAYERS => l,
+                        _ => {
+                            return Err(body.error(format!(
+                                "face {row}: layer {value} is not a valid layer id"
+                            )));
+                        }
+                    };
+                }
+            }
+            if is_vertex {
+                positions.push(Vec3::from_array(position));
+                brdfs.push(Brdf::from_array(brdf));
+                masked.push(flags & VertexFlags::MASKED.bits() != 0);
+            } else if is_face {
+                if polygon.len() < 3 {
+                    return Err(body.error(format!(
+                        "face {row} has {} corners; at least 3 are needed",
+                        polygon.len()
+                    )));
+                }
+                if let Some(&bad) = polygon.iter().find(|&&i| i as usize >= positions.len()) {
+                    return Err(body.error(format!(
+                        "face {row}: vertex index {bad} is out of range ({} vertices)",
+                        positions.len()
+                    )));
+                }
+                for k in 1..polygon.len() - 1 {
+                    faces.push([polygon[0], polygon[k], polygon[k + 1]]);
+                    face_layers.push(layer);
+                }
+            }
+        }
+    }
+    if faces.is_empty() {
+        return Err(IoError::parse(name, None, "no faces"));
+    }
+    let layer_count = face_layers.iter().max().map_or(0, |&l| l + 1);
+    let layer_names = (0..layer_count)
+        .map(|l| {
+            header
+                .layer_names
+                .iter()
+                .find(|(id, _)| *id == l)
+                .map(|(_, n)| n.clone())
+                .unwrap_or_else(|| format!("layer{l}"))
+        })
+        .collect();
+    // Vertices no face uses are dropped rather than rejected: PLY writers often leave them.
+    let mut used = vec![false; positions.len()];
+    for f in &faces {
+        for &v in f {
+            used[v as usize] = true;
+        }
+    }
+    let mut remap = vec![INVALID; positions.len()];
+    let mut kept = 0u32;
+    for (v, slot) in remap.iter_mut().enumerate() {
+        if used[v] {
+            *slot = kept;
+            kept += 1;
+        }
+    }
+    let keep = |v: &usize| used[*v];
+    let positions: Vec<Vec3> = (0..positions.len())
+        .filter(keep)
+        .map(|v| positions[v])
+        .collect();
+    let brdfs: Vec<Brdf> = (0..brdfs.len()).filter(keep).map(|v| brdfs[v]).collect();
+    let masked: Vec<bool> = (0..masked.len()).filter(keep).map(|v| masked[v]).collect();
+    for f in &mut faces {
+        *f = f.map(|v| remap[v as usize]);
+    }
+    let mut mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
+        .map_err(|e| IoError::building(name, e, &positions))?;
+    if has_brdf {
+        mesh.set_brdfs(brdfs)
+            .map_err(|e| IoError::building(name, e, &positions))?;
+    }
+    if masked.contains(&true) {
+        for (flag, m) in mesh.flags_mut().iter_mut().zip(masked) {
+            flag.set(VertexFlags::MASKED, m);
+        }
+    }
+    Ok(mesh)
+}
+
+/// Writes the live mesh as binary little-endian PLY.
+pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+    let live: Vec<usize> = (0..mesh.vertex_count())
+        .filter(|&v| {
+            !mesh.flags()[v].contains(VertexFlags::DEAD)
+                && mesh.adjacency().vertex_corner[v] != INVALID
+        })
+        .collect();
+    let mut file_index = vec![INVALID; mesh.vertex_count()];
+    for (i, &v) in live.iter().enumerate() {
+        file_index[v] = i as u32;
+    }
+    let live_faces = mesh.live_face_count();
+    writeln!(out, "ply")?;
+    writeln!(out, "format binary_little_endian 1.0")?;
+    writeln!(out, "comment written by slayer")?;
+    for (id, layer_name) in mesh.layer_names().iter().enumerate() {
+        writeln!(out, "comment slayer layer {id} {layer_name}")?;
+    }
+    writeln!(out, "element vertex {}", live.len())?;
+    for p in ["x", "y", "z", "nx", "ny", "nz"]
+        .iter()
+        .chain(&BRDF_PROPERTIES)
+    {
+        writeln!(out, "property float {p}")?;
+    }
+    writeln!(out, "property uint layer")?;
+    writeln!(out, "property uint flags")?;
+    writeln!(out, "element face {live_faces}")?;
+    writeln!(out, "property list uchar uint vertex_indices")?;
+    writeln!(out, "property uint layer")?;
+    writeln!(out, "end_header")?;
+    let mut buffer: Vec<u8> = Vec::with_capacity(live.len() * 60 + live_faces * 17);
+    for &v in &live {
+        let p = mesh.positions()[v];
+        let n = mesh.normals()[v];
+        for value in [p.x, p.y, p.z, n.x, n.y, n.z]
+            .into_iter()
+            .chain(mesh.brdfs()[v].as_array())
+        {
+            buffer.extend_from_slice(&value.to_le_bytes());
+        }
+        buffer.extend_from_slice(&mesh.vertex_layers()[v].to_le_bytes());
+        let persistent = mesh.flags()[v] & VertexFlags::MASKED;
+        buffer.extend_from_slice(&persistent.bits().to_le_bytes());
+    }
+    for (t, &layer) in mesh.faces().iter().zip(mesh.face_layers()) {
+        if t[0] == INVALID {
+            continue;
+        }
+        buffer.push(3);
+        for &v in t {
+            buffer.extend_from_slice(&file_index[v as usize].to_le_bytes());
+        }
+        buffer.extend_from_slice(&layer.to_le_bytes());
+    }
+    out.write_all(&buffer)
+}

@@ -1,0 +1,18 @@
+//! slayer — sculpting engine for detailed multi-layered materials.
+//!
+//! Layers of one triangle mesh are brushed together, collide instead of passing through each
+//! other (sLayer, Algorithm 2), are remeshed to keep their detail uniform, and carry a per-vertex
+//! BRDF. The hot loop runs as WGSL compute passes through wgpu, each mirrored on the CPU.
+//!
+//! Data flows one way: [`mesh`] ← [`grid`] ← [`collide`] ← the program.
+
+pub mod check;
+pub mod collide;
+pub mod cpu;
+pub mod geom;
+pub mod gpu;
+pub mod grid;
+pub mod io;
+pub mod material;
+pub mod mesh;
+pub mod scene;

@@ -1,0 +1,70 @@
+//! Per-vertex attributes that travel with the geometry: reflectance and flags.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Index of a layer. Layers are labels on faces and vertices (DESIGN §1), not separate meshes.
+pub type LayerId = u32;
+
+/// A per-vertex BRDF in a linear parametrization: diffuse albedo, specular albedo and a linearized
+/// roughness of a microfacet model with the Blinn–Phong distribution (after AppIm, Di Renzo et al.
+/// 2014). Every field is meant to be blended linearly, so a weighted sum of two BRDFs is a
+/// meaningful in-between material.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct Brdf {
+    pub diffuse: [f32; 3],
+    pub specular: [f32; 3],
+    /// Linearized roughness in [0, 1]: 0 is a mirror, 1 is fully rough.
+    pub roughness: f32,
+}
+
+impl Brdf {
+    pub const fn new(diffuse: [f32; 3], specular: [f32; 3], roughness: f32) -> Self {
+        Self {
+            diffuse,
+            specular,
+            roughness,
+        }
+    }
+
+    /// Neutral grey clay, the material of a vertex nobody has painted.
+    pub const CLAY: Brdf = Brdf::new([0.6, 0.6, 0.6], [0.04, 0.04, 0.04], 0.6);
+
+    pub fn as_array(&self) -> [f32; 7] {
+        let [dr, dg, db] = self.diffuse;
+        let [sr, sg, sb] = self.specular;
+        [dr, dg, db, sr, sg, sb, self.roughness]
+    }
+
+    pub fn from_array(values: [f32; 7]) -> Self {
+        Self::new(
+            [values[0], values[1], values[2]],
+            [values[3], values[4], values[5]],
+            values[6],
+        )
+    }
+
+    pub fn is_finite(&self) -> bool {
+        self.as_array().iter().all(|v| v.is_finite())
+    }
+}
+
+impl Default for Brdf {
+    fn default() -> Self {
+        Brdf::CLAY
+    }
+}
+
+bitflags::bitflags! {
+    /// Per-vertex state bits.
+    #[repr(transparent)]
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Pod, Zeroable)]
+    pub struct VertexFlags: u32 {
+        /// Held in place by a collision during the current stroke.
+        const LOCKED = 1;
+        /// Protected by the user's mask: brushes never move it.
+        const MASKED = 1 << 1;
+        /// Deleted; removed by the next compaction.
+        const DEAD = 1 << 2;
+    }
+}

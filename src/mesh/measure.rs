@@ -1,0 +1,157 @@
+//! Edge lengths, normals and bounds: the measurements every later stage leans on. The grid's cell
+//! size is the mean edge length (sLayer's "edge length assumption").
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{INVALID, Mesh, face_of, next, prev};
+
+/// Length statistics over the unique edges of the live faces.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EdgeLengthStats {
+    pub edges: usize,
+    pub mean: f64,
+    pub std_dev: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl EdgeLengthStats {
+    /// Coefficient of variation (standard deviation over mean), 0 for an empty mesh.
+    pub fn coefficient_of_variation(&self) -> f64 {
+        if self.mean > 0.0 {
+            self.std_dev / self.mean
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Mesh {
+    /// Calls `f(a, b)` once per undirected edge of the live faces.
+    pub fn for_each_edge(&self, mut f: impl FnMut(u32, u32)) {
+        let opposite = &self.adjacency.opposite;
+        for c in 0..(self.faces.len() * 3) as u32 {
+            let o = opposite[c as usize];
+            if self.faces[face_of(c) as usize][0] == INVALID || (o != INVALID && o < c) {
+                continue;
+            }
+            f(self.corner_vertex(next(c)), self.corner_vertex(prev(c)));
+        }
+    }
+
+    /// Unique edges of the live faces as vertex pairs.
+    pub fn edges(&self) -> Vec<[u32; 2]> {
+        let mut edges = Vec::with_capacity(self.faces.len() * 3 / 2 + 16);
+        self.for_each_edge(|a, b| edges.push([a, b]));
+        edges
+    }
+
+    /// Mean, spread and range of edge lengths (f64 sums, so a million edges lose nothing).
+    pub fn edge_length_stats(&self) -> EdgeLengthStats {
+        let lengths: Vec<f64> = self
+            .edges()
+            .par_iter()
+            .map(|&[a, b]| {
+                (self.positions[a as usize].as_dvec3() - self.positions[b as usize].as_dvec3())
+                    .length()
+            })
+            .collect();
+        if lengths.is_empty() {
+            return EdgeLengthStats::default();
+        }
+        let n = lengths.len() as f64;
+        let mean = lengths.par_iter().sum::<f64>() / n;
+        let variance = lengths
+            .par_iter()
+            .map(|l| (l - mean) * (l - mean))
+            .sum::<f64>()
+            / n;
+        let min = lengths
+            .par_iter()
+            .copied()
+            .reduce(|| f64::INFINITY, f64::min);
+        let max = lengths
+            .par_iter()
+            .copied()
+            .reduce(|| f64::NEG_INFINITY, f64::max);
+        EdgeLengthStats {
+            edges: lengths.len(),
+            mean,
+            std_dev: variance.sqrt(),
+            min,
+            max,
+        }
+    }
+
+    /// Mean length of the unique edges of the live faces (0 for an empty mesh).
+    pub fn mean_edge_length(&self) -> f32 {
+        self.edge_length_stats().mean as f32
+    }
+
+    /// Area-weighted vertex normals of the whole mesh.
+    pub fn recompute_normals(&mut self) {
+        let normals: Vec<Vec3> = (0..self.vertex_count() as u32)
+            .into_par_iter()
+            .map(|v| self.area_weighted_normal(v))
+            .collect();
+        self.normals = normals;
+    }
+
+    /// Recomputes the normals of the given vertices only (after a brush step).
+    pub fn recompute_normals_at(&mut self, vertices: &[u32]) {
+        let updated: Vec<Vec3> = vertices
+            .par_iter()
+            .map(|&v| self.area_weighted_normal(v))
+            .collect();
+        for (&v, n) in vertices.iter().zip(updated) {
+            self.normals[v as usize] = n;
+        }
+    }
+
+    /// Sum of the incident faces' cross products, normalized; +Z where that sum vanishes
+    /// (a vertex of only degenerate faces) so that normals are always finite.
+    fn area_weighted_normal(&self, vertex: u32) -> Vec3 {
+        if self.adjacency.vertex_corner[vertex as usize] == INVALID {
+            return Vec3::Z;
+        }
+        let mut sum = Vec3::ZERO;
+        for face in self.faces_around(vertex) {
+            let [a, b, c] = self.face_positions(face as usize);
+            sum += (b - a).cross(c - a);
+        }
+        sum.try_normalize().unwrap_or(Vec3::Z)
+    }
+
+    /// Unit normal of a face (zero for a degenerate one).
+    pub fn face_normal(&self, face: usize) -> Vec3 {
+        let [a, b, c] = self.face_positions(face);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// Axis-aligned bounds of the live vertices, `None` when there are none.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut any = false;
+        for (v, p) in self.positions.iter().enumerate() {
+            if self.adjacency.vertex_corner[v] != INVALID {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+                any = true;
+            }
+        }
+        any.then_some((lo, hi))
+    }
+
+    /// Live faces per layer.
+    pub fn faces_per_layer(&self) -> Vec<usize> {
+        let mut counts = vec![0; self.layer_count()];
+        for (tri, &layer) in self.faces.iter().zip(&self.face_layers) {
+            if tri[0] != INVALID {
+                counts[layer as usize] += 1;
+            }
+        }
+        counts
+    }
+}

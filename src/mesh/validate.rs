@@ -1,0 +1,225 @@
+//! `Mesh::validate`: every invariant the rest of the engine relies on, each failure naming the
+//! element that broke. Tests call it after every topology edit (STYLE: a validator no test runs is
+//! worse than none).
+
+use super::{
+    CornerTable, INVALID, MAX_COORDINATE, Mesh, MeshError, VertexFlags, face_of, next, prev,
+};
+
+impl Mesh {
+    /// Checks attribute lengths, indices, layers, finiteness, the corner table's links and the
+    /// manifoldness of every vertex. Dead elements are skipped.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        self.validate_lengths()?;
+        self.validate_faces()?;
+        self.validate_vertices()?;
+        self.validate_opposites()?;
+        self.validate_vertex_corners()?;
+        // Local checks passed; a fresh table from the faces alone must agree link for link,
+        // which catches two faces sharing an edge without being linked.
+        let rebuilt = CornerTable::build(&self.faces, self.vertex_count())?;
+        if let Some(c) = (0..self.adjacency.opposite.len())
+            .find(|&c| rebuilt.opposite[c] != self.adjacency.opposite[c])
+        {
+            return Err(MeshError::BrokenOpposite {
+                corner: c,
+                detail: format!(
+                    "stored {} but the faces say {}",
+                    show(self.adjacency.opposite[c]),
+                    show(rebuilt.opposite[c])
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    fn validate_lengths(&self) -> Result<(), MeshError> {
+        let n = self.positions.len();
+        let f = self.faces.len();
+        let checks: [(&'static str, usize, usize); 7] = [
+            ("normals", self.normals.len(), n),
+            ("brdfs", self.brdfs.len(), n),
+            ("vertex_layers", self.vertex_layers.len(), n),
+            ("flags", self.flags.len(), n),
+            ("vertex_corner", self.adjacency.vertex_corner.len(), n),
+            ("face_layers", self.face_layers.len(), f),
+            ("opposite", self.adjacency.opposite.len(), 3 * f),
+        ];
+        for (attribute, len, expected) in checks {
+            if len != expected {
+                return Err(MeshError::AttributeLength {
+                    attribute,
+                    len,
+                    expected,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_faces(&self) -> Result<(), MeshError> {
+        let vertex_count = self.vertex_count();
+        for (face, tri) in self.faces.iter().enumerate() {
+            if tri[0] == INVALID {
+                continue;
+            }
+            let layer = self.face_layers[face];
+            if layer as usize >= self.layer_count() {
+                return Err(MeshError::LayerOutOfRange {
+                    face,
+                    layer,
+                    layer_count: self.layer_count(),
+                });
+            }
+            for (k, &v) in tri.iter().enumerate() {
+                if v as usize >= vertex_count {
+                    return Err(MeshError::IndexOutOfRange {
+                        face,
+                        corner: face * 3 + k,
+                        vertex: v,
+                        vertex_count,
+                    });
+                }
+                if self.flags[v as usize].contains(VertexFlags::DEAD) {
+                    return Err(MeshError::DeadVertexInFace { face, vertex: v });
+                }
+                if self.vertex_layers[v as usize] != layer {
+                    return Err(MeshError::LayerMismatch {
+                        face,
+                        vertex: v,
+                        face_layer: layer,
+                        vertex_layer: self.vertex_layers[v as usize],
+                    });
+                }
+                if tri[(k + 1) % 3] == v {
+                    return Err(MeshError::DegenerateFace { face, vertex: v });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_vertices(&self) -> Result<(), MeshError> {
+        for (v, p) in self.positions.iter().enumerate() {
+            if self.flags[v].contains(VertexFlags::DEAD) {
+                continue;
+            }
+            let vertex = v as u32;
+            if !p.is_finite() {
+                return Err(MeshError::NonFinitePosition {
+                    vertex,
+                    position: p.to_array(),
+                });
+            }
+            if let Some(&value) = p.to_array().iter().find(|c| c.abs() > MAX_COORDINATE) {
+                return Err(MeshError::CoordinateOutOfRange {
+                    vertex,
+                    value,
+                    limit: MAX_COORDINATE,
+                });
+            }
+            if !self.normals[v].is_finite() {
+                return Err(MeshError::NonFiniteAttribute {
+                    vertex,
+                    attribute: "normal",
+                });
+            }
+            if !self.brdfs[v].is_finite() {
+                return Err(MeshError::NonFiniteAttribute {
+                    vertex,
+                    attribute: "BRDF",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_opposites(&self) -> Result<(), MeshError> {
+        let opposite = &self.adjacency.opposite;
+        for c in 0..opposite.len() as u32 {
+            if self.is_face_dead(face_of(c) as usize) {
+                continue;
+            }
+            let o = opposite[c as usize];
+            if o == INVALID {
+                continue;
+            }
+            let broken = |detail: String| MeshError::BrokenOpposite {
+                corner: c as usize,
+                detail,
+            };
+            if o as usize >= opposite.len() {
+                return Err(broken(format!("points past the end, to corner {o}")));
+            }
+            if self.is_face_dead(face_of(o) as usize) {
+                return Err(broken(format!("points into dead face {}", face_of(o))));
+            }
+            if face_of(o) == face_of(c) {
+                return Err(broken(format!("points into its own face, corner {o}")));
+            }
+            if opposite[o as usize] != c {
+                return Err(broken(format!(
+                    "corner {o} points back to {} instead",
+                    show(opposite[o as usize])
+                )));
+            }
+            let here = (self.corner_vertex(next(c)), self.corner_vertex(prev(c)));
+            let there = (self.corner_vertex(prev(o)), self.corner_vertex(next(o)));
+            if here != there {
+                return Err(broken(format!(
+                    "edge {here:?} faces edge {there:?} of corner {o}"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_vertex_corners(&self) -> Result<(), MeshError> {
+        let mut incidence = vec![0u32; self.vertex_count()];
+        for tri in self.faces.iter().filter(|t| t[0] != INVALID) {
+            for &v in tri {
+                incidence[v as usize] += 1;
+            }
+        }
+        for v in 0..self.vertex_count() {
+            if self.flags[v].contains(VertexFlags::DEAD) {
+                continue;
+            }
+            let vertex = v as u32;
+            let c = self.adjacency.vertex_corner[v];
+            if incidence[v] == 0 {
+                return Err(MeshError::IsolatedVertex { vertex });
+            }
+            let broken = |detail: String| MeshError::BrokenVertexCorner { vertex, detail };
+            if c == INVALID || c as usize >= self.adjacency.opposite.len() {
+                return Err(broken(format!("corner {} is not a corner", show(c))));
+            }
+            if self.is_face_dead(face_of(c) as usize) || self.corner_vertex(c) != vertex {
+                return Err(broken(format!("corner {c} belongs to another vertex")));
+            }
+            // A fan walk must end where the boundary ends, and see every incident corner.
+            let walked = self.adjacency.fan_len(c);
+            if walked != incidence[v] {
+                let has_boundary = self
+                    .adjacency
+                    .corners_around(vertex)
+                    .any(|k| self.adjacency.swing_right(k) == INVALID);
+                if has_boundary && self.adjacency.swing_left(c) != INVALID {
+                    return Err(broken(format!(
+                        "corner {c} is not the first of its boundary fan"
+                    )));
+                }
+                return Err(MeshError::NonManifoldVertex { vertex });
+            }
+        }
+        Ok(())
+    }
+}
+
+fn show(corner: u32) -> String {
+    if corner == INVALID {
+        "none".to_string()
+    } else {
+        corner.to_string()
+    }
+}
