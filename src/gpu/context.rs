@@ -74,8 +74,14 @@ impl std::fmt::Display for AdapterSummary {
     }
 }
 
+/// Vulkan, Metal and DX12 by default (GL lacks what the kernels need and its EGL probing is
+/// noisy on headless machines); `WGPU_BACKEND` overrides.
 fn instance() -> wgpu::Instance {
-    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+    let descriptor = wgpu::InstanceDescriptor {
+        backends: wgpu::Backends::PRIMARY,
+        ..wgpu::InstanceDescriptor::new_without_display_handle()
+    };
+    wgpu::Instance::new(descriptor.with_env())
 }
 
 /// Higher is better.

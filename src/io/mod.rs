@@ -51,11 +51,17 @@ pub struct LoadNotes {
 
 /// Reads a mesh and checks it: malformed files, non-finite values and broken meshes are errors.
 pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
-    let (mesh, notes) = load_mesh(path)?;
-    let file = path.display().to_string();
+    let format = Format::of_path(path)?;
+    let bytes = read_bytes(path)?;
+    read_mesh_bytes(&bytes, format, &path.display().to_string())
+}
+
+/// [`read_mesh`] on bytes already in memory (`name` is used in messages).
+pub fn read_mesh_bytes(bytes: &[u8], format: Format, name: &str) -> Result<Mesh, IoError> {
+    let (mesh, notes) = load_mesh_bytes(bytes, format, name)?;
     if notes.non_finite_vertices > 0 {
         return Err(IoError::Parse {
-            path: file,
+            path: name.to_string(),
             line: notes.first_non_finite_line,
             message: format!(
                 "{} vertices have a non-finite coordinate (NaN or infinity)",
@@ -64,7 +70,7 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
         });
     }
     mesh.validate()
-        .map_err(|source| IoError::mesh(file, source, &mesh))?;
+        .map_err(|source| IoError::mesh(name.to_string(), source, &mesh))?;
     Ok(mesh)
 }
 
@@ -72,14 +78,19 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
 /// or out-of-range values through (counted in the notes) so that `slayer check` can report them.
 pub fn load_mesh(path: &Path) -> Result<(Mesh, LoadNotes), IoError> {
     let format = Format::of_path(path)?;
-    let bytes = fs::read(path).map_err(|source| IoError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
-    let name = path.display().to_string();
+    let bytes = read_bytes(path)?;
+    load_mesh_bytes(&bytes, format, &path.display().to_string())
+}
+
+/// [`load_mesh`] on bytes already in memory.
+pub fn load_mesh_bytes(
+    bytes: &[u8],
+    format: Format,
+    name: &str,
+) -> Result<(Mesh, LoadNotes), IoError> {
     match format {
         Format::Obj => {
-            let (mesh, report) = parse_obj(&bytes, &name)?;
+            let (mesh, report) = parse_obj(bytes, name)?;
             Ok((
                 mesh,
                 LoadNotes {
@@ -89,7 +100,7 @@ pub fn load_mesh(path: &Path) -> Result<(Mesh, LoadNotes), IoError> {
             ))
         }
         Format::Ply => {
-            let mesh = parse_ply(&bytes, &name)?;
+            let mesh = parse_ply(bytes, name)?;
             let non_finite = mesh.positions().iter().filter(|p| !p.is_finite()).count();
             Ok((
                 mesh,
@@ -102,19 +113,28 @@ pub fn load_mesh(path: &Path) -> Result<(Mesh, LoadNotes), IoError> {
     }
 }
 
+fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
+    fs::read(path).map_err(|source| IoError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// The bytes of a mesh in `format`.
+pub fn encode_mesh(mesh: &Mesh, format: Format) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    // Writing into a Vec cannot fail.
+    let _ = match format {
+        Format::Obj => write_obj(mesh, &mut bytes),
+        Format::Ply => write_ply(mesh, &mut bytes),
+    };
+    bytes
+}
+
 /// Writes a mesh in the format its extension names, atomically.
 pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
     let format = Format::of_path(path)?;
-    let mut bytes = Vec::new();
-    match format {
-        Format::Obj => write_obj(mesh, &mut bytes),
-        Format::Ply => write_ply(mesh, &mut bytes),
-    }
-    .map_err(|source| IoError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
-    write_atomically(path, &bytes)
+    write_atomically(path, &encode_mesh(mesh, format))
 }
 
 /// Writes `bytes` to a temporary file beside `path`, syncs it, and renames it over `path`.

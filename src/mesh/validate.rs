@@ -223,3 +223,82 @@ fn show(corner: u32) -> String {
         corner.to_string()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Corrupting the private links directly: each corruption is caught and names the element.
+    use super::*;
+    use crate::scene::shapes;
+
+    #[test]
+    fn broken_opposite_link_is_named() {
+        let mut mesh = shapes::octahedron();
+        let o = mesh.adjacency.opposite[0];
+        mesh.adjacency.opposite[0] = INVALID;
+        match mesh.validate() {
+            Err(MeshError::BrokenOpposite { corner, .. }) => {
+                assert!(corner == o as usize || corner == 0)
+            }
+            other => panic!("expected a broken opposite, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn opposite_pointing_at_the_wrong_edge_is_named() {
+        let mut mesh = shapes::octahedron();
+        let (a, b) = (mesh.adjacency.opposite[0], mesh.adjacency.opposite[1]);
+        mesh.adjacency.opposite[0] = b;
+        mesh.adjacency.opposite[1] = a;
+        assert!(matches!(
+            mesh.validate(),
+            Err(MeshError::BrokenOpposite { corner: 0, .. })
+        ));
+    }
+
+    #[test]
+    fn vertex_corner_of_another_vertex_is_named() {
+        let mut mesh = shapes::tetrahedron();
+        mesh.adjacency.vertex_corner[2] = mesh.adjacency.vertex_corner[1];
+        assert!(matches!(
+            mesh.validate(),
+            Err(MeshError::BrokenVertexCorner { vertex: 2, .. })
+        ));
+    }
+
+    #[test]
+    fn boundary_vertex_must_start_its_fan() {
+        let mut mesh = shapes::fan(6);
+        // Vertex 1 sits on the rim in faces 0 and 5; store the corner that does not start the fan.
+        let start = mesh.adjacency.vertex_corner[1];
+        let other = mesh.adjacency.swing_right(start);
+        assert_ne!(other, INVALID);
+        mesh.adjacency.vertex_corner[1] = other;
+        assert!(matches!(
+            mesh.validate(),
+            Err(MeshError::BrokenVertexCorner { vertex: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn wrong_attribute_length_is_named() {
+        let mut mesh = shapes::triangle();
+        mesh.normals.pop();
+        assert!(matches!(
+            mesh.validate(),
+            Err(MeshError::AttributeLength {
+                attribute: "normals",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn live_face_on_dead_vertex_is_named() {
+        let mut mesh = shapes::tetrahedron();
+        mesh.flags[3].insert(VertexFlags::DEAD);
+        assert!(matches!(
+            mesh.validate(),
+            Err(MeshError::DeadVertexInFace { vertex: 3, .. })
+        ));
+    }
+}

@@ -7,6 +7,7 @@
 //! always give the same mesh, bit for bit.
 
 mod noise;
+pub mod shapes;
 mod sheet;
 mod sphere;
 

@@ -1,0 +1,270 @@
+//! The multi-layer mesh over meshes grouped by kind: closed, open, several components, tiny,
+//! high valence; each construction error names its element.
+
+use glam::Vec3;
+use slayer::mesh::{INVALID, Mesh, MeshError, VertexFlags};
+use slayer::scene::shapes;
+
+fn kinds() -> Vec<(&'static str, Mesh)> {
+    vec![
+        ("triangle", shapes::triangle()),
+        ("tetrahedron", shapes::tetrahedron()),
+        ("octahedron", shapes::octahedron()),
+        ("fan of 3", shapes::fan(3)),
+        ("fan of 24 (high valence)", shapes::fan(24)),
+        ("two patches", shapes::two_patches()),
+        (
+            "three stacked sheets",
+            shapes::stacked_sheets(3, 6, 5, 1.0, 3.0),
+        ),
+        (
+            "geodesic sphere",
+            slayer::scene::geodesic_sphere(6, 1.0).unwrap(),
+        ),
+    ]
+}
+
+fn euler_characteristic(mesh: &Mesh) -> i64 {
+    mesh.live_vertex_count() as i64 - mesh.edges().len() as i64 + mesh.live_face_count() as i64
+}
+
+#[test]
+fn every_kind_validates_and_has_consistent_adjacency() {
+    for (name, mesh) in kinds() {
+        mesh.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let csr = mesh.vertex_faces();
+        for v in 0..mesh.vertex_count() as u32 {
+            let mut from_fan: Vec<u32> = mesh.faces_around(v).collect();
+            from_fan.sort_unstable();
+            assert_eq!(from_fan, csr.of(v), "{name}: vertex {v} fan vs CSR");
+            let ring = mesh.neighbours(v);
+            let expected_ring = if mesh.is_boundary_vertex(v) {
+                from_fan.len() + 1
+            } else {
+                from_fan.len()
+            };
+            assert_eq!(ring.len(), expected_ring, "{name}: one-ring of {v}");
+        }
+    }
+}
+
+#[test]
+fn euler_characteristic_and_components_by_kind() {
+    let expect = [
+        ("triangle", 1, 1),
+        ("tetrahedron", 2, 1),
+        ("octahedron", 2, 1),
+        ("fan of 3", 1, 1),
+        ("fan of 24 (high valence)", 1, 1),
+        ("two patches", 2, 2),
+        ("three stacked sheets", 3, 3),
+        ("geodesic sphere", 2, 1),
+    ];
+    for ((name, mesh), (expected_name, chi, components)) in kinds().into_iter().zip(expect) {
+        assert_eq!(name, expected_name);
+        assert_eq!(euler_characteristic(&mesh), chi, "{name}");
+        assert_eq!(mesh.components().count(), components, "{name}");
+    }
+}
+
+#[test]
+fn stacked_sheets_label_layers_and_components() {
+    let mesh = shapes::stacked_sheets(3, 4, 4, 1.0, 2.0);
+    assert_eq!(mesh.layer_count(), 3);
+    assert_eq!(mesh.faces_per_layer(), vec![32, 32, 32]);
+    let components = mesh.components();
+    assert_eq!(components.per_layer(3), vec![1, 1, 1]);
+    for (v, &layer) in mesh.vertex_layers().iter().enumerate() {
+        assert_eq!(mesh.positions()[v].z, layer as f32 * 2.0);
+    }
+}
+
+#[test]
+fn mean_edge_length_and_normals() {
+    let fan = shapes::fan(6);
+    // A regular hexagon fan: all 12 edges have length 1.
+    assert!((fan.mean_edge_length() - 1.0).abs() < 1e-6);
+    assert!(fan.edge_length_stats().coefficient_of_variation() < 1e-6);
+    for n in fan.normals() {
+        assert!((n.z - 1.0).abs() < 1e-6);
+    }
+    let sphere = slayer::scene::geodesic_sphere(8, 2.0).unwrap();
+    for (p, n) in sphere.positions().iter().zip(sphere.normals()) {
+        assert!(p.normalize().dot(*n) > 0.99, "sphere normals point outward");
+    }
+    assert_eq!(
+        Mesh::new(vec![], vec![], vec![], vec![])
+            .unwrap()
+            .mean_edge_length(),
+        0.0
+    );
+}
+
+#[test]
+fn versions_count_changes() {
+    let mut mesh = shapes::fan(5);
+    let before = mesh.version();
+    mesh.positions_mut()[0].z = 0.5;
+    mesh.recompute_normals_at(&[0, 1, 2]);
+    assert_eq!(mesh.version().positions, before.positions + 1);
+    mesh.brdfs_mut()[0].roughness = 0.1;
+    assert_eq!(mesh.version().attributes, before.attributes + 1);
+    mesh.kill_face(0);
+    assert_eq!(mesh.version().topology, before.topology + 1);
+    assert!(mesh.version().total() > before.total());
+}
+
+#[test]
+fn killing_faces_then_compacting_keeps_the_mesh_valid() {
+    let mut mesh = shapes::stacked_sheets(2, 5, 5, 1.0, 3.0);
+    let faces_before = mesh.live_face_count();
+    // Remove a whole boundary row of the first sheet: 10 faces, a clean cut.
+    for f in 0..10 {
+        mesh.kill_face(f);
+        mesh.validate()
+            .unwrap_or_else(|e| panic!("after killing face {f}: {e}"));
+    }
+    assert_eq!(mesh.live_face_count(), faces_before - 10);
+    let dead_vertices = mesh
+        .flags()
+        .iter()
+        .filter(|f| f.contains(VertexFlags::DEAD))
+        .count();
+    assert_eq!(
+        dead_vertices, 6,
+        "the bottom row of vertices lost all faces"
+    );
+    let map = mesh.compact();
+    mesh.validate().unwrap();
+    assert_eq!(mesh.face_count(), faces_before - 10);
+    assert_eq!(map.face_map[0], INVALID);
+    assert_eq!(map.face_map[10], 0);
+    assert_eq!(mesh.live_vertex_count(), mesh.vertex_count());
+    assert_eq!(mesh.components().count(), 2);
+}
+
+#[test]
+fn killing_faces_that_pinch_a_vertex_is_reported() {
+    // A hexagon fan without faces 1 and 4 leaves the centre joining two separate fans.
+    let mut mesh = shapes::fan(6);
+    mesh.kill_face(1);
+    mesh.validate().unwrap();
+    mesh.kill_face(4);
+    assert_eq!(
+        mesh.validate(),
+        Err(MeshError::NonManifoldVertex { vertex: 0 })
+    );
+}
+
+fn one_layer(positions: Vec<Vec3>, faces: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
+    let layers = vec![0; faces.len()];
+    Mesh::new(positions, faces, layers, vec!["l".into()])
+}
+
+fn points(n: usize) -> Vec<Vec3> {
+    (0..n)
+        .map(|i| Vec3::new(i as f32, (i * i % 7) as f32, (i % 3) as f32))
+        .collect()
+}
+
+#[test]
+fn construction_errors_name_the_element() {
+    // Three faces on one edge.
+    let e = one_layer(points(5), vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::NonManifoldEdge {
+                a: 0,
+                b: 1,
+                faces: 3
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("edge (0, 1)"));
+
+    // Two faces walking an edge the same way.
+    let e = one_layer(points(4), vec![[0, 1, 2], [0, 1, 3]]).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::InconsistentOrientation {
+                face_a: 0,
+                face_b: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+
+    // A bow-tie: two triangles meeting at vertex 0 only.
+    let e = one_layer(points(5), vec![[0, 1, 2], [0, 3, 4]]).unwrap_err();
+    assert_eq!(e, MeshError::NonManifoldVertex { vertex: 0 });
+
+    // Two closed fans at one vertex (two tetrahedra sharing an apex).
+    let mut faces = vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+    faces.extend([[0, 4, 5], [0, 6, 4], [0, 5, 6], [4, 6, 5]]);
+    let e = one_layer(points(7), faces).unwrap_err();
+    assert_eq!(e, MeshError::NonManifoldVertex { vertex: 0 });
+
+    let e = one_layer(points(3), vec![[0, 1, 1]]).unwrap_err();
+    assert!(
+        matches!(e, MeshError::DegenerateFace { face: 0, vertex: 1 }),
+        "{e}"
+    );
+
+    let e = one_layer(points(3), vec![[0, 1, 7]]).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::IndexOutOfRange {
+                face: 0,
+                corner: 2,
+                vertex: 7,
+                ..
+            }
+        ),
+        "{e}"
+    );
+
+    let e = one_layer(points(4), vec![[0, 1, 2]]).unwrap_err();
+    assert_eq!(e, MeshError::IsolatedVertex { vertex: 3 });
+
+    let e = Mesh::new(
+        points(4),
+        vec![[0, 1, 2], [2, 1, 3]],
+        vec![0, 1],
+        vec!["a".into(), "b".into()],
+    )
+    .unwrap_err();
+    assert!(matches!(e, MeshError::LayerMismatch { face: 1, .. }), "{e}");
+
+    let e = Mesh::new(points(3), vec![[0, 1, 2]], vec![4], vec!["a".into()]).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MeshError::LayerOutOfRange {
+                face: 0,
+                layer: 4,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn validate_reports_non_finite_and_huge_coordinates() {
+    let mut mesh = shapes::fan(4);
+    mesh.positions_mut()[2] = Vec3::new(f32::NAN, 0.0, 0.0);
+    assert!(matches!(
+        mesh.validate(),
+        Err(MeshError::NonFinitePosition { vertex: 2, .. })
+    ));
+    mesh.positions_mut()[2] = Vec3::new(3e19, 0.0, 0.0);
+    assert!(matches!(
+        mesh.validate(),
+        Err(MeshError::CoordinateOutOfRange { vertex: 2, .. })
+    ));
+}

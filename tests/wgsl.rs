@@ -1,0 +1,106 @@
+//! Every shader in `wgsl/` is registered, validates with naga, and the host structs match
+//! naga's layout of their WGSL declarations.
+
+use std::path::Path;
+
+use slayer::gpu::shaders::{KERNELS, SHARED, expand_imports, kernel_source, validate};
+
+fn wgsl_files(folder: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(folder)
+        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()))
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn every_kernel_file_is_registered_and_validates() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("wgsl");
+    let files = wgsl_files(&root);
+    assert!(!files.is_empty());
+    for name in &files {
+        assert!(
+            KERNELS.iter().any(|(k, _)| k == name),
+            "wgsl/{name}.wgsl is not registered in gpu::shaders::KERNELS"
+        );
+        let on_disk = std::fs::read_to_string(root.join(format!("{name}.wgsl"))).unwrap();
+        let source = expand_imports(name, &on_disk).expect("imports expand");
+        let (module, _) = validate(name, &source).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            module.entry_points.iter().any(|e| e.name == "main"),
+            "wgsl/{name}.wgsl has no entry point `main`"
+        );
+    }
+    assert_eq!(
+        KERNELS.len(),
+        files.len(),
+        "KERNELS names a file that does not exist"
+    );
+}
+
+#[test]
+fn every_shared_file_is_registered() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("wgsl/shared");
+    for name in wgsl_files(&root) {
+        let import = format!("shared/{name}");
+        assert!(
+            SHARED.iter().any(|(k, _)| *k == import),
+            "wgsl/shared/{name}.wgsl is not registered in gpu::shaders::SHARED"
+        );
+    }
+}
+
+#[test]
+fn unknown_imports_are_reported() {
+    let error = expand_imports("x", "#import shared/nope\n").unwrap_err();
+    assert!(error.to_string().contains("shared/nope"));
+}
+
+/// Size and member offsets of a named struct in a kernel, per naga.
+fn naga_struct(kernel: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let source = kernel_source(kernel).unwrap();
+    let (module, _) = validate(kernel, &source).unwrap();
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("{kernel}: no struct {name}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct");
+    };
+    let offsets = members
+        .iter()
+        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+        .collect();
+    (layouter[handle].size, offsets)
+}
+
+macro_rules! assert_layout {
+    ($kernel:expr, $ty:ident { $($field:ident),* $(,)? }) => {{
+        let (size, offsets) = naga_struct($kernel, stringify!($ty));
+        assert_eq!(size as usize, std::mem::size_of::<slayer::gpu::$ty>(), "size of {}", stringify!($ty));
+        let host: Vec<(String, u32)> = vec![
+            $((stringify!($field).to_string(), std::mem::offset_of!(slayer::gpu::$ty, $field) as u32)),*
+        ];
+        assert_eq!(offsets, host, "field offsets of {}", stringify!($ty));
+    }};
+}
+
+#[test]
+fn host_structs_match_naga_layout() {
+    assert_layout!(
+        "cell_keys",
+        CellKeyParams {
+            count,
+            table_mask,
+            inv_cell_size,
+            _pad
+        }
+    );
+}

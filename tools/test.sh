@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Runs the whole test suite in release mode, installing what it needs first.
+#
+# The GPU tests run for real on whatever Vulkan adapter is present; on a machine without a GPU
+# that is Mesa's lavapipe, installed here from Debian's `mesa-vulkan-drivers` when no Vulkan
+# driver is found (as root, or through sudo).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! command -v cargo >/dev/null 2>&1 && [ -f "$HOME/.cargo/env" ]; then
+    # shellcheck disable=SC1091
+    . "$HOME/.cargo/env"
+fi
+command -v cargo >/dev/null 2>&1 || { echo "tools/test.sh: cargo not found; install Rust from https://rustup.rs" >&2; exit 1; }
+
+have_vulkan_driver() {
+    local dir
+    for dir in /usr/share/vulkan/icd.d /etc/vulkan/icd.d /usr/local/share/vulkan/icd.d; do
+        compgen -G "$dir/*.json" >/dev/null && return 0
+    done
+    [ -n "${VK_ICD_FILENAMES:-}${VK_DRIVER_FILES:-}" ]
+}
+
+if ! have_vulkan_driver || ! ldconfig -p 2>/dev/null | grep -q libvulkan.so.1; then
+    echo "tools/test.sh: no Vulkan driver found; installing Mesa's lavapipe (mesa-vulkan-drivers)"
+    if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $sudo apt-get update -qq
+    $sudo apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1 >/dev/null
+fi
+
+# Mesa's window-system probing complains without a runtime dir; headless runs have none.
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+    XDG_RUNTIME_DIR=$(mktemp -d)
+    export XDG_RUNTIME_DIR
+    chmod 700 "$XDG_RUNTIME_DIR"
+fi
+
+echo "tools/test.sh: building (release)"
+cargo build --release --all-targets --quiet
+
+echo "tools/test.sh: GPU adapters, best first (the GPU tests use the first):"
+target/release/slayer adapters | sed 's/^/    /'
+
+cargo test --release --all-targets
+cargo test --release --doc --quiet
+echo "tools/test.sh: all tests passed"
