@@ -12,7 +12,7 @@ mod sheet;
 mod sphere;
 
 pub use noise::WaveNoise;
-pub use sheet::{Lattice, SheetLayer, build_sheets, kept_face_count};
+pub use sheet::{Lattice, SheetLayer, build_sheets, kept_face_count, kept_faces};
 pub use sphere::{frequency_for, geodesic_sphere};
 
 use std::fmt;
@@ -164,16 +164,28 @@ fn sheet_scene<'a>(
     let full_layer_edge = |faces: f64| (2.0 / (3f64.sqrt() * faces)).sqrt() as f32;
     let layer_count = layers_at(1.0).len() as f64;
     let mut edge = full_layer_edge(triangles as f64 / layer_count);
+    // Masks alone first (cheap), then with the cleanup, which drops small patches and matters
+    // at small sizes.
     for _ in 0..8 {
-        let kept = faces_at(edge).max(1) as f64;
-        let ratio = kept / triangles as f64;
+        let ratio = faces_at(edge).max(1) as f64 / triangles as f64;
         if (ratio - 1.0).abs() < 0.004 {
             break;
         }
         edge *= ratio.sqrt() as f32;
     }
-    let lattice = Lattice::covering(size, edge);
-    Ok(build_sheets(&lattice, &layers_at(edge), MIN_PATCH_FACES)?)
+    let mut lattice = Lattice::covering(size, edge);
+    let mut kept = kept_faces(&lattice, &layers_at(edge), MIN_PATCH_FACES);
+    for _ in 0..4 {
+        let count: usize = kept.iter().map(Vec::len).sum();
+        let ratio = count.max(1) as f64 / triangles as f64;
+        if (ratio - 1.0).abs() < 0.015 {
+            break;
+        }
+        edge *= ratio.sqrt() as f32;
+        lattice = Lattice::covering(size, edge);
+        kept = kept_faces(&lattice, &layers_at(edge), MIN_PATCH_FACES);
+    }
+    Ok(build_sheets(&lattice, &layers_at(edge), &kept)?)
 }
 
 /// Smooth ramp from 0 at `x ≤ a` to 1 at `x ≥ b`.

@@ -96,29 +96,42 @@ pub fn kept_face_count(lattice: &Lattice, masks: &[&(dyn Fn(Vec2) -> bool + Sync
         .sum()
 }
 
-/// Builds the mesh of all layers on one lattice. Faces a mask keeps are cleaned so that every
-/// vertex has one fan (no bow-ties) and patches smaller than `min_patch_faces` are dropped.
-pub fn build_sheets(
+/// The lattice faces each layer keeps: those its mask keeps, cleaned so that every vertex has
+/// one fan (no bow-ties) and without patches smaller than `min_patch_faces`.
+pub fn kept_faces(
     lattice: &Lattice,
     layers: &[SheetLayer<'_>],
     min_patch_faces: usize,
+) -> Vec<Vec<[u32; 3]>> {
+    layers
+        .iter()
+        .map(|layer| {
+            let mut kept: Vec<[u32; 3]> = (0..lattice.face_count())
+                .into_par_iter()
+                .map(|k| lattice.face(k))
+                .filter(|&f| (layer.keep)(lattice.centroid(f)))
+                .collect();
+            remove_bowties(&mut kept, lattice.point_count());
+            drop_small_patches(&mut kept, lattice.point_count(), min_patch_faces);
+            kept
+        })
+        .collect()
+}
+
+/// Builds the mesh of all layers on one lattice from the faces [`kept_faces`] chose.
+pub fn build_sheets(
+    lattice: &Lattice,
+    layers: &[SheetLayer<'_>],
+    kept: &[Vec<[u32; 3]>],
 ) -> Result<Mesh, MeshError> {
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     let mut face_layers = Vec::new();
     let mut brdfs = Vec::new();
-    for (layer_index, layer) in layers.iter().enumerate() {
-        let mut kept: Vec<[u32; 3]> = (0..lattice.face_count())
-            .into_par_iter()
-            .map(|k| lattice.face(k))
-            .filter(|&f| (layer.keep)(lattice.centroid(f)))
-            .collect();
-        remove_bowties(&mut kept, lattice.point_count());
-        drop_small_patches(&mut kept, lattice.point_count(), min_patch_faces);
-
+    for (layer_index, (layer, kept)) in layers.iter().zip(kept).enumerate() {
         // Number the used lattice points in lattice order, so output is independent of threads.
         let mut new_index = vec![u32::MAX; lattice.point_count()];
-        for f in &kept {
+        for f in kept {
             for &p in f {
                 new_index[p as usize] = 0;
             }
