@@ -28,7 +28,7 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
             .count();
         IoError::parse(name, Some(line), "not a text file (invalid UTF-8)")
     })?;
-    let mut report = prescan(text, name)?;
+    let (mut report, file_positions) = prescan(text, name)?;
 
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -45,6 +45,15 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
+
+    // tobj numbers each object's vertices in the order faces first use them; putting them back
+    // in file order keeps vertex numbers stable across a write and a read.
+    let mut file_order: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    for (i, p) in file_positions.iter().enumerate() {
+        if !p.is_nan() {
+            file_order.entry(weld_key(*p)).or_insert(i as u32);
+        }
+    }
 
     let mut positions: Vec<Vec3> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
@@ -63,28 +72,47 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         });
         // Weld by exact bit pattern (+0 and -0 are one point); NaN never welds.
         let mut welded: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-        let mut local_to_global = Vec::with_capacity(m.positions.len() / 3);
-        for p in m.positions.chunks_exact(3) {
+        let mut local_to_welded = Vec::with_capacity(m.positions.len() / 3);
+        let mut welded_points: Vec<(u64, Vec3)> = Vec::new();
+        for (i, p) in m.positions.chunks_exact(3).enumerate() {
             let p = Vec3::new(p[0], p[1], p[2]);
-            let key = (p + Vec3::ZERO).to_array().map(f32::to_bits);
-            let index = if p.is_nan() {
+            let unmatched = (1u64 << 32) + i as u64;
+            let order = if p.is_nan() {
+                unmatched
+            } else {
+                file_order
+                    .get(&weld_key(p))
+                    .map_or(unmatched, |&o| o as u64)
+            };
+            let existing = if p.is_nan() {
                 None
             } else {
-                welded.get(&key).copied()
+                welded.get(&weld_key(p)).copied()
             };
-            let global = index.unwrap_or_else(|| {
-                positions.push(p);
-                let g = (positions.len() - 1) as u32;
+            let id = existing.unwrap_or_else(|| {
+                welded_points.push((order, p));
+                let id = (welded_points.len() - 1) as u32;
                 if !p.is_nan() {
-                    welded.insert(key, g);
+                    welded.insert(weld_key(p), id);
                 }
-                g
+                id
             });
-            if index.is_some() {
+            if existing.is_some() {
                 report.welded_vertices += 1;
             }
-            local_to_global.push(global);
+            local_to_welded.push(id);
         }
+        let mut by_order: Vec<u32> = (0..welded_points.len() as u32).collect();
+        by_order.sort_by_key(|&id| welded_points[id as usize].0);
+        let mut welded_to_global = vec![0u32; welded_points.len()];
+        for &id in &by_order {
+            welded_to_global[id as usize] = positions.len() as u32;
+            positions.push(welded_points[id as usize].1);
+        }
+        let local_to_global: Vec<u32> = local_to_welded
+            .iter()
+            .map(|&id| welded_to_global[id as usize])
+            .collect();
         for (k, tri) in m.indices.chunks_exact(3).enumerate() {
             let face = [tri[0], tri[1], tri[2]]
                 .map(|i| local_to_global.get(i as usize).copied().unwrap_or(INVALID));
@@ -122,8 +150,9 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
 
 /// Checks every `v` and `f` line for what tobj would reject without a line number or accept
 /// wrongly: unparsable or missing numbers, index 0, indices past the vertices defined so far.
-fn prescan(text: &str, name: &str) -> Result<ObjReport, IoError> {
+fn prescan(text: &str, name: &str) -> Result<(ObjReport, Vec<Vec3>), IoError> {
     let mut report = ObjReport::default();
+    let mut file_positions = Vec::new();
     let (mut positions, mut texcoords, mut normals) = (0usize, 0usize, 0usize);
     for (number, line) in text.lines().enumerate() {
         let number = number + 1;
@@ -150,6 +179,7 @@ fn prescan(text: &str, name: &str) -> Result<ObjReport, IoError> {
                     ));
                 }
                 positions += 1;
+                file_positions.push(Vec3::from_array(coordinates));
             }
             Some("vt") => texcoords += 1,
             Some("vn") => normals += 1,
@@ -199,7 +229,12 @@ fn prescan(text: &str, name: &str) -> Result<ObjReport, IoError> {
             _ => {}
         }
     }
-    Ok(report)
+    Ok((report, file_positions))
+}
+
+/// Welding identity of a point: its bits, with -0 folded into +0.
+fn weld_key(p: Vec3) -> [u32; 3] {
+    (p + Vec3::ZERO).to_array().map(f32::to_bits)
 }
 
 /// Counts lines as tobj reads them, to put a line number on tobj's errors.

@@ -427,7 +427,18 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
     if faces.is_empty() {
         return Err(IoError::parse(name, None, "no faces"));
     }
-    let layer_count = face_layers.iter().max().map_or(0, |&l| l + 1);
+    // Named layers count even when no face uses them any more.
+    let named = header
+        .layer_names
+        .iter()
+        .map(|(id, _)| id + 1)
+        .filter(|&n| n <= MAX_LAYERS);
+    let layer_count = face_layers
+        .iter()
+        .map(|&l| l + 1)
+        .chain(named)
+        .max()
+        .unwrap_or(0);
     let layer_names = (0..layer_count)
         .map(|l| {
             header

@@ -28,8 +28,11 @@ use crate::mesh::{Mesh, MeshError};
 
 /// Vertical gap between stacked layers, in lattice edge lengths.
 pub const LAYER_GAP_EDGES: f32 = 3.0;
-/// Patches smaller than this are dropped: crumbs a few triangles wide are noise, not material.
-const MIN_PATCH_FACES: usize = 40;
+/// Patches smaller than this share of the faces (at least 6, at most 40 faces) are dropped:
+/// crumbs a few triangles wide are noise, not material.
+fn min_patch_faces(triangles: usize) -> usize {
+    (triangles / 1000).clamp(6, 40)
+}
 /// Accepted range of `--triangles`.
 pub const MIN_TRIANGLES: usize = 100;
 pub const MAX_TRIANGLES: usize = 64_000_000;
@@ -174,7 +177,7 @@ fn sheet_scene<'a>(
         edge *= ratio.sqrt() as f32;
     }
     let mut lattice = Lattice::covering(size, edge);
-    let mut kept = kept_faces(&lattice, &layers_at(edge), MIN_PATCH_FACES);
+    let mut kept = kept_faces(&lattice, &layers_at(edge), min_patch_faces(triangles));
     for _ in 0..4 {
         let count: usize = kept.iter().map(Vec::len).sum();
         let ratio = count.max(1) as f64 / triangles as f64;
@@ -183,7 +186,7 @@ fn sheet_scene<'a>(
         }
         edge *= ratio.sqrt() as f32;
         lattice = Lattice::covering(size, edge);
-        kept = kept_faces(&lattice, &layers_at(edge), MIN_PATCH_FACES);
+        kept = kept_faces(&lattice, &layers_at(edge), min_patch_faces(triangles));
     }
     Ok(build_sheets(&lattice, &layers_at(edge), &kept)?)
 }

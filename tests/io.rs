@@ -1,0 +1,310 @@
+//! Mesh files: round trips, every malformed case with its message, and a few thousand mangled
+//! inputs that must give an error or a valid mesh, never a panic.
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use slayer::io::{Format, encode_mesh, load_mesh_bytes, read_mesh_bytes};
+use slayer::mesh::{Brdf, Mesh, VertexFlags};
+use slayer::scene::{SceneKind, SceneSpec, generate, shapes};
+
+fn small_scene() -> Mesh {
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 5_000,
+        seed: 4,
+    })
+    .unwrap();
+    assert!(mesh.faces_per_layer().iter().all(|&f| f > 0));
+    mesh
+}
+
+fn read(text: &str) -> Result<Mesh, String> {
+    read_mesh_bytes(text.as_bytes(), Format::Obj, "t.obj").map_err(|e| e.to_string())
+}
+
+#[test]
+fn obj_round_trip_keeps_positions_faces_and_layers() {
+    let mesh = small_scene();
+    let bytes = encode_mesh(&mesh, Format::Obj);
+    let back = read_mesh_bytes(&bytes, Format::Obj, "p.obj").unwrap();
+    assert!(
+        back.positions() == mesh.positions(),
+        "positions are written exactly, in order"
+    );
+    assert!(back.faces() == mesh.faces());
+    assert_eq!(back.face_layers(), mesh.face_layers());
+    assert_eq!(back.layer_names(), mesh.layer_names());
+    // And the second trip writes the same bytes.
+    assert!(encode_mesh(&back, Format::Obj) == bytes);
+}
+
+#[test]
+fn ply_round_trip_keeps_brdfs_layers_and_masks() {
+    let mut mesh = small_scene();
+    mesh.brdfs_mut()[5] = Brdf::new([0.1, 0.2, 0.3], [0.4, 0.5, 0.6], 0.77);
+    mesh.flags_mut()[9].insert(VertexFlags::MASKED);
+    mesh.flags_mut()[10].insert(VertexFlags::LOCKED);
+    let bytes = encode_mesh(&mesh, Format::Ply);
+    let back = read_mesh_bytes(&bytes, Format::Ply, "p.ply").unwrap();
+    assert!(back.positions() == mesh.positions());
+    assert!(back.faces() == mesh.faces());
+    assert!(back.brdfs() == mesh.brdfs());
+    assert!(back.vertex_layers() == mesh.vertex_layers());
+    assert_eq!(back.layer_names(), mesh.layer_names());
+    assert!(back.flags()[9].contains(VertexFlags::MASKED));
+    assert!(
+        !back.flags()[10].contains(VertexFlags::LOCKED),
+        "locks are per stroke, not saved"
+    );
+}
+
+#[test]
+fn ascii_ply_with_quads_and_extra_properties() {
+    let text = "ply\nformat ascii 1.0\ncomment hand made\nelement vertex 7\nproperty double x\n\
+                property double y\nproperty double z\nproperty uchar red\nelement face 2\n\
+                property list uchar int vertex_indices\nproperty int layer\nelement edge 1\n\
+                property int a\nproperty int b\nend_header\n0 0 0 255\n1 0 0 0\n1 1 0 0\n0 1 0 0\n\
+                9 9 9 0\n9 8 9 0\n8 9 9 0\n4 0 1 2 3 0\n3 4 4 4 1\n0 1\n";
+    // The second face repeats a vertex: an error naming the face.
+    let e = read_mesh_bytes(text.as_bytes(), Format::Ply, "q.ply")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("face") && e.contains("repeats"), "{e}");
+    let fixed = text.replace("3 4 4 4 1", "3 4 5 6 1");
+    let mesh = read_mesh_bytes(fixed.as_bytes(), Format::Ply, "q.ply").unwrap();
+    assert_eq!(mesh.live_face_count(), 3, "a quad becomes two triangles");
+    assert_eq!(mesh.layer_count(), 2);
+}
+
+#[test]
+fn obj_objects_and_groups_become_layers_and_duplicates_weld() {
+    let text = "# two layers\no bottom\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n\
+                g top\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 5 6 7\nf 8 9 10\n";
+    let mesh = read(text).unwrap();
+    assert_eq!(mesh.layer_names(), ["bottom", "top"]);
+    assert_eq!(mesh.faces_per_layer(), vec![2, 2]);
+    assert_eq!(
+        mesh.live_vertex_count(),
+        8,
+        "the top layer's repeated corners weld"
+    );
+    assert_eq!(mesh.components().count(), 2);
+}
+
+#[test]
+fn obj_polygons_are_triangulated_and_negative_indices_work() {
+    let mesh = read("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 0.5 0\nf -5 -4 -3 -2 -1\n").unwrap();
+    assert_eq!(mesh.live_face_count(), 3);
+}
+
+#[test]
+fn malformed_obj_names_file_line_and_problem() {
+    let cases: [(&str, &str); 12] = [
+        (
+            "v 0 0 0\nv 1 0\n",
+            "t.obj:2: vertex needs three coordinates",
+        ),
+        (
+            "v 0 0 0\nv 1 x 0\n",
+            "t.obj:2: vertex coordinate 1 is not a number",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            "t.obj:4: face vertex index 4 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n",
+            "t.obj:4: face vertex index 0 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 2 3\n",
+            "t.obj:4: face vertex index -4 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+            "t.obj:4: face has 2 corners",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a\n",
+            "t.obj:4: face vertex index `a` is not an integer",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n",
+            "t.obj:4: face texture index 1 is out of range",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n",
+            "t.obj:3: 1 vertices have a non-finite coordinate",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 1e30 1 0\nf 1 2 3\n",
+            "t.obj:3: vertex coordinate beyond the supported range",
+        ),
+        ("# nothing here\n", "t.obj: no faces"),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 0 0\nf 1 2 3\n",
+            "uses the same point twice",
+        ),
+    ];
+    for (text, expected) in cases {
+        let e = read(text).unwrap_err();
+        assert!(
+            e.contains(expected),
+            "{text:?}\n  got:      {e}\n  expected: {expected}"
+        );
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
+}
+
+#[test]
+fn non_manifold_obj_names_the_edge_and_where_it_is() {
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    let e = read(text).unwrap_err();
+    assert!(
+        e.contains("non-manifold edge") && e.contains("at (0, 0, 0)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn malformed_ply_is_reported() {
+    let cases: [(&[u8], &str); 6] = [
+        (b"ply\nformat ascii 1.0\nelement vertex 1\n", "header ends before `end_header`"),
+        (b"plx\n", "not a PLY file"),
+        (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n0\n0\n0\n", "no `y` property"),
+        (
+            b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0",
+            "file ends before all elements are read",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n",
+            "vertex index 9 is out of range",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -2\n",
+            "is not a valid index",
+        ),
+    ];
+    for (bytes, expected) in cases {
+        let e = read_mesh_bytes(bytes, Format::Ply, "t.ply")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(expected), "got: {e}\nexpected: {expected}");
+    }
+}
+
+/// Mangles a valid file in one of the ways real files break.
+fn mangle(original: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let mut bytes = original.to_vec();
+    match rng.random_range(0..8) {
+        0 => bytes.truncate(rng.random_range(0..=bytes.len())),
+        1 => {
+            for _ in 0..rng.random_range(1..20) {
+                let i = rng.random_range(0..bytes.len().max(1));
+                if let Some(b) = bytes.get_mut(i) {
+                    *b = rng.random();
+                }
+            }
+        }
+        2 => {
+            let n = rng.random_range(0..200);
+            bytes = (0..n).map(|_| rng.random()).collect();
+        }
+        3 => bytes.clear(),
+        _ => {
+            // Replace one number-like token with an absurd one.
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            let tokens: Vec<&str> = text.split(' ').collect();
+            let i = rng.random_range(0..tokens.len());
+            let replacement = [
+                "-1",
+                "-999999",
+                "0",
+                "4294967296",
+                "99999999999999999999",
+                "nan",
+                "NaN",
+                "inf",
+                "-inf",
+                "1e39",
+                "1e30",
+                "-0",
+                "",
+                "1.5",
+                "0x10",
+                "\n",
+                "/",
+                "//",
+                "1//",
+            ][rng.random_range(0..19)];
+            let mut out = tokens.clone();
+            out[i] = replacement;
+            bytes = out.join(" ").into_bytes();
+        }
+    }
+    bytes
+}
+
+#[test]
+fn thousands_of_mangled_files_give_an_error_or_a_valid_mesh() {
+    let mut rng = ChaCha8Rng::seed_from_u64(2024);
+    let tiny = shapes::stacked_sheets(2, 3, 2, 1.0, 2.0);
+    let mut sources: Vec<(Format, Vec<u8>)> = Vec::new();
+    for mesh in [&tiny, &shapes::tetrahedron(), &shapes::fan(5)] {
+        sources.push((Format::Obj, encode_mesh(mesh, Format::Obj)));
+        sources.push((Format::Ply, encode_mesh(mesh, Format::Ply)));
+    }
+    // An ASCII PLY too, so token mangling reaches PLY numbers.
+    sources.push((
+        Format::Ply,
+        b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+          property float roughness\nelement face 2\nproperty list uchar uint vertex_indices\nproperty uint layer\n\
+          end_header\n0 0 0 0.5\n1 0 0 0.5\n1 1 0 0.5\n0 1 0 0.5\n3 0 1 2 0\n3 0 2 3 0\n"
+            .to_vec(),
+    ));
+    let (mut ok, mut errors) = (0, 0);
+    for round in 0..3000 {
+        let (format, original) = &sources[round % sources.len()];
+        let bytes = mangle(original, &mut rng);
+        match read_mesh_bytes(&bytes, *format, "mangled") {
+            Ok(mesh) => {
+                mesh.validate().expect("an accepted mesh is valid");
+                assert!(mesh.positions().iter().all(|p| p.is_finite()));
+                ok += 1;
+            }
+            Err(e) => {
+                assert!(!e.to_string().is_empty());
+                errors += 1;
+            }
+        }
+        // The lenient path used by `slayer check` must not panic either.
+        let _ = load_mesh_bytes(&bytes, *format, "mangled");
+    }
+    assert!(
+        ok > 100 && errors > 1000,
+        "{ok} accepted, {errors} rejected"
+    );
+}
+
+#[test]
+fn writing_is_atomic_and_reports_unwritable_paths() {
+    let dir = std::env::temp_dir().join(format!("slayer-io-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("m.ply");
+    let mesh = shapes::octahedron();
+    slayer::io::write_mesh(&mesh, &path).unwrap();
+    let back = slayer::io::read_mesh(&path).unwrap();
+    assert_eq!(back.positions(), mesh.positions());
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
+    let e = slayer::io::write_mesh(&mesh, &dir.join("missing/m.obj")).unwrap_err();
+    assert!(e.to_string().contains("missing/m.obj"));
+    let e = slayer::io::write_mesh(&mesh, &dir.join("m.stl")).unwrap_err();
+    assert!(e.to_string().contains("unsupported"));
+    std::fs::remove_dir_all(&dir).unwrap();
+    let _ = Vec3::ZERO;
+}
