@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use crate::collide::find_intersections;
+use crate::grid::SpatialHash;
 use crate::io::LoadNotes;
 use crate::mesh::Mesh;
 
@@ -28,6 +29,8 @@ pub struct CheckReport {
     pub intersections_between_layers: usize,
     pub intersections_within_layers: usize,
     pub intersection_examples: Vec<[u32; 2]>,
+    /// The vertex grid the engine would build (cell = mean edge length).
+    pub grid: Option<GridFigures>,
     /// One line per defect; empty when the mesh is clean.
     pub defects: Vec<String>,
 }
@@ -36,6 +39,16 @@ impl CheckReport {
     pub fn is_clean(&self) -> bool {
         self.defects.is_empty()
     }
+}
+
+/// The spatial hash over the mesh's vertices, as the brush pipeline builds it per stroke.
+#[derive(Debug, Clone, Serialize)]
+pub struct GridFigures {
+    pub cell_size: f64,
+    pub occupied_cells: usize,
+    pub max_vertices_per_cell: usize,
+    pub build_ms: f64,
+    pub memory_bytes: usize,
 }
 
 /// Measures a loaded mesh. `progress` is told which step is running.
@@ -54,6 +67,20 @@ pub fn check_mesh(
     let non_finite = notes
         .non_finite_vertices
         .max(mesh.positions().iter().filter(|p| !p.is_finite()).count());
+    progress("building the spatial hash");
+    let grid = (non_finite == 0)
+        .then(|| {
+            let started = std::time::Instant::now();
+            let grid = SpatialHash::build(mesh, stats.mean as f32).ok()?;
+            Some(GridFigures {
+                cell_size: grid.cell_size() as f64,
+                occupied_cells: grid.occupied_cells(),
+                max_vertices_per_cell: grid.max_cell_occupancy(),
+                build_ms: started.elapsed().as_secs_f64() * 1e3,
+                memory_bytes: grid.memory_bytes(),
+            })
+        })
+        .flatten();
     progress("testing triangle pairs for intersections");
     let intersections = find_intersections(mesh);
 
@@ -112,6 +139,7 @@ pub fn check_mesh(
             .iter()
             .map(|p| [p.face_a, p.face_b])
             .collect(),
+        grid,
         defects,
     }
 }
@@ -147,6 +175,16 @@ impl std::fmt::Display for CheckReport {
             "  intersections     {}  ({} between layers, {} within a layer)",
             self.intersections, self.intersections_between_layers, self.intersections_within_layers
         )?;
+        if let Some(g) = &self.grid {
+            writeln!(
+                f,
+                "  spatial hash      {} cells, at most {} vertices a cell, {:.1} MiB, built in {:.1} ms",
+                g.occupied_cells,
+                g.max_vertices_per_cell,
+                g.memory_bytes as f64 / (1024.0 * 1024.0),
+                g.build_ms
+            )?;
+        }
         if self.defects.is_empty() {
             write!(f, "  ok: no defects")
         } else {

@@ -99,6 +99,22 @@ impl SpatialHash {
         self.heads.len()
     }
 
+    /// Heap bytes held: the per-vertex links and the cell table (keys, heads, control bytes).
+    pub fn memory_bytes(&self) -> usize {
+        let per_vertex = std::mem::size_of::<IVec3>() + 2 * std::mem::size_of::<u32>();
+        let per_cell = std::mem::size_of::<(IVec3, u32)>() + 1;
+        self.cell_of.capacity() * per_vertex + self.heads.capacity() * per_cell
+    }
+
+    /// The most vertices filed in one cell.
+    pub fn max_cell_occupancy(&self) -> usize {
+        self.heads
+            .keys()
+            .map(|&cell| self.cell_vertices(cell).count())
+            .max()
+            .unwrap_or(0)
+    }
+
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }

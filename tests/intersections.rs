@@ -1,0 +1,120 @@
+//! The exact triangle–triangle test on hand-made cases, and the whole-mesh count against an
+//! all-pairs brute force.
+
+use glam::Vec3;
+use proptest::prelude::*;
+use slayer::collide::find_intersections;
+use slayer::geom::triangles_intersect;
+use slayer::mesh::Mesh;
+use slayer::scene::shapes;
+
+fn t(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [Vec3; 3] {
+    [Vec3::from(a), Vec3::from(b), Vec3::from(c)]
+}
+
+#[test]
+fn hand_made_cases() {
+    let base = t([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+    let cases = [
+        ("piercing", t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.5, 1.5, 1.0]), true),
+        ("above", t([0.5, 0.5, 0.1], [1.0, 0.5, 0.2], [0.5, 1.0, 0.3]), false),
+        ("touching at a corner from above", t([0.5, 0.5, 0.0], [1.0, 0.5, 1.0], [0.5, 1.0, 1.0]), true),
+        ("edge on the surface", t([0.2, 0.2, 0.0], [1.0, 0.2, 0.0], [0.5, 0.5, 1.0]), true),
+        ("coplanar overlapping", t([0.5, 0.5, 0.0], [3.0, 0.5, 0.0], [0.5, 3.0, 0.0]), true),
+        ("coplanar containing", t([0.1, 0.1, 0.0], [0.3, 0.1, 0.0], [0.1, 0.3, 0.0]), true),
+        ("coplanar apart", t([3.0, 3.0, 0.0], [4.0, 3.0, 0.0], [3.0, 4.0, 0.0]), false),
+        ("coplanar sharing an edge line", t([2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]), true),
+        ("crossing the plane beside it", t([3.0, 3.0, -1.0], [3.0, 3.0, 1.0], [4.0, 3.0, 0.0]), false),
+        ("parallel below", t([0.0, 0.0, -1e-7], [2.0, 0.0, -1e-7], [0.0, 2.0, -1e-7]), false),
+        ("degenerate segment piercing", t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.5, 0.5, 0.0]), true),
+        ("degenerate segment beside", t([3.5, 0.5, -1.0], [3.5, 0.5, 1.0], [3.5, 0.5, 0.0]), false),
+    ];
+    for (name, other, expected) in cases {
+        assert_eq!(triangles_intersect(base, other), expected, "{name}");
+        assert_eq!(triangles_intersect(other, base), expected, "{name} (swapped)");
+    }
+}
+
+#[test]
+fn nearly_touching_is_decided_exactly() {
+    // One f32 step below the plane is apart, on the plane touches: no tolerance either way.
+    let base = t([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let below = -f32::from_bits(1); // the smallest negative subnormal
+    let apart = t([0.25, 0.25, below], [0.5, 0.25, -1.0], [0.25, 0.5, -1.0]);
+    let touching = t([0.25, 0.25, 0.0], [0.5, 0.25, -1.0], [0.25, 0.5, -1.0]);
+    assert!(!triangles_intersect(base, apart));
+    assert!(triangles_intersect(base, touching));
+}
+
+fn brute_force(mesh: &Mesh) -> (usize, usize) {
+    let (mut between, mut within) = (0, 0);
+    for a in 0..mesh.face_count() {
+        for b in a + 1..mesh.face_count() {
+            let (fa, fb) = (mesh.faces()[a], mesh.faces()[b]);
+            if fa.iter().any(|v| fb.contains(v)) {
+                continue;
+            }
+            if triangles_intersect(mesh.face_positions(a), mesh.face_positions(b)) {
+                if mesh.face_layers()[a] == mesh.face_layers()[b] {
+                    within += 1;
+                } else {
+                    between += 1;
+                }
+            }
+        }
+    }
+    (between, within)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+
+    /// Two sheets squeezed together with random bumps: the grid count equals all pairs.
+    #[test]
+    fn grid_count_matches_all_pairs(
+        gap in 0.0f32..1.0,
+        bumps in prop::collection::vec((0usize..72, -1.5f32..1.5), 0..12),
+    ) {
+        let mut mesh = shapes::stacked_sheets(2, 5, 5, 1.0, gap);
+        let n = mesh.vertex_count();
+        for (v, dz) in bumps {
+            mesh.positions_mut()[v % n].z += dz;
+        }
+        let report = find_intersections(&mesh);
+        prop_assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+    }
+}
+
+#[test]
+fn a_layer_pushed_through_another_is_counted() {
+    let mut mesh = shapes::stacked_sheets(2, 8, 8, 1.0, 1.0);
+    assert_eq!(find_intersections(&mesh).total(), 0);
+    // Push the middle of the top sheet through the bottom one.
+    let middle = 81 + 4 * 9 + 4;
+    mesh.positions_mut()[middle].z = -1.0;
+    let report = find_intersections(&mesh);
+    assert!(report.between_layers > 0 && report.within_layers == 0, "{report:?}");
+    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+}
+
+#[test]
+fn self_intersection_within_a_layer_is_counted_but_neighbours_are_not() {
+    // A sheet folded through itself: lift one corner vertex across a far part of the sheet.
+    let mut mesh = shapes::stacked_sheets(1, 6, 6, 1.0, 0.0);
+    assert_eq!(find_intersections(&mesh).total(), 0, "adjacent faces share vertices");
+    mesh.positions_mut()[0] = Vec3::new(3.2, 3.3, 0.0) + Vec3::new(0.0, 0.0, 0.0);
+    let report = find_intersections(&mesh);
+    assert!(report.within_layers > 0);
+    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+}
+
+#[test]
+fn absurd_coordinates_stay_bounded() {
+    // A face spanning a huge box goes to the oversized path instead of millions of cells.
+    let mut mesh = shapes::stacked_sheets(2, 4, 4, 1.0, 2.0);
+    mesh.positions_mut()[0] = Vec3::new(1e12, -1e12, 5e11);
+    let report = find_intersections(&mesh);
+    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+    mesh.positions_mut()[1] = Vec3::new(f32::NAN, 0.0, 0.0);
+    assert!(find_intersections(&mesh).skipped_faces > 0);
+}
