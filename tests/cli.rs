@@ -36,14 +36,28 @@ fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
 fn scene_then_check_reports_clean_layers_as_json() {
     let dir = scratch("scene");
     let obj = dir.join("p.obj");
-    let out = slayer(&["scene", "plaster", "--triangles", "20000", "-o", obj.to_str().unwrap()]);
+    let out = slayer(&[
+        "scene",
+        "plaster",
+        "--triangles",
+        "20000",
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let out = slayer(&["check", obj.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "{}", text(&out.stdout));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     for field in [
-        "vertices", "faces", "layers", "components", "mean_edge_length", "edge_length_cv", "valid",
-        "non_finite", "intersections",
+        "vertices",
+        "faces",
+        "layers",
+        "components",
+        "mean_edge_length",
+        "edge_length_cv",
+        "valid",
+        "non_finite",
+        "intersections",
     ] {
         assert!(report.get(field).is_some(), "missing {field}");
     }
@@ -62,10 +76,22 @@ fn same_scene_arguments_write_identical_files() {
         let a = dir.join(format!("a.{ext}"));
         let b = dir.join(format!("b.{ext}"));
         for path in [&a, &b] {
-            let out = slayer(&["scene", "bark", "--triangles", "6000", "--seed", "9", "-o", path.to_str().unwrap()]);
+            let out = slayer(&[
+                "scene",
+                "bark",
+                "--triangles",
+                "6000",
+                "--seed",
+                "9",
+                "-o",
+                path.to_str().unwrap(),
+            ]);
             assert!(out.status.success());
         }
-        assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(), "{ext}");
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{ext}"
+        );
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -81,21 +107,42 @@ fn truncated_and_corrupted_files_fail_with_one_line() {
     let dir = scratch("bad");
     let good = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
     let truncated = write(&dir, "truncated.obj", &good.as_bytes()[..good.len() - 6]);
-    assert_one_line_error(&slayer(&["check", &truncated]), &["truncated.obj:7", "face"]);
+    assert_one_line_error(
+        &slayer(&["check", &truncated]),
+        &["truncated.obj:7", "face"],
+    );
 
-    let corrupted = write(&dir, "corrupted.obj", b"o a\nv 0 0 0\nv 1 0 \xff\xfe\nf 1 2 3\n");
-    assert_one_line_error(&slayer(&["check", &corrupted]), &["corrupted.obj:3", "not a text file"]);
+    let corrupted = write(
+        &dir,
+        "corrupted.obj",
+        b"o a\nv 0 0 0\nv 1 0 \xff\xfe\nf 1 2 3\n",
+    );
+    assert_one_line_error(
+        &slayer(&["check", &corrupted]),
+        &["corrupted.obj:3", "not a text file"],
+    );
 
-    let garbage = write(&dir, "garbage.ply", &[0x70, 0x6c, 0x79, 0x0a, 0xde, 0xad, 0xbe, 0xef]);
+    let garbage = write(
+        &dir,
+        "garbage.ply",
+        &[0x70, 0x6c, 0x79, 0x0a, 0xde, 0xad, 0xbe, 0xef],
+    );
     assert_one_line_error(&slayer(&["check", &garbage]), &["garbage.ply"]);
 
     let empty = write(&dir, "empty.obj", b"");
     assert_one_line_error(&slayer(&["check", &empty]), &["empty.obj", "no faces"]);
 
-    let bowtie = write(&dir, "bowtie.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n");
+    let bowtie = write(
+        &dir,
+        "bowtie.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n",
+    );
     assert_one_line_error(&slayer(&["check", &bowtie]), &["non-manifold vertex"]);
 
-    assert_one_line_error(&slayer(&["check", "/nonexistent/x.obj"]), &["/nonexistent/x.obj"]);
+    assert_one_line_error(
+        &slayer(&["check", "/nonexistent/x.obj"]),
+        &["/nonexistent/x.obj"],
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -116,25 +163,46 @@ fn defects_found_by_check_exit_non_zero() {
     let nan = write(&dir, "nan.obj", b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
     let out = slayer(&["check", &nan]);
     assert!(!out.status.success());
-    assert!(text(&out.stdout).contains("non-finite coordinates (first at line 3)"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("non-finite coordinates (first at line 3)"),
+        "{}",
+        text(&out.stdout)
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
 fn bad_arguments_are_clear() {
-    assert_one_line_error(&slayer(&["scene", "marble", "-o", "x.obj"]), &["unknown scene `marble`"]);
+    assert_one_line_error(
+        &slayer(&["scene", "marble", "-o", "x.obj"]),
+        &["unknown scene `marble`"],
+    );
     assert_one_line_error(
         &slayer(&["scene", "plane", "--triangles", "5", "-o", "x.obj"]),
         &["--triangles 5 is out of range"],
     );
-    assert_one_line_error(&slayer(&["scene", "plane", "-o", "x.stl"]), &["unsupported file type"]);
+    assert_one_line_error(
+        &slayer(&["scene", "plane", "-o", "x.stl"]),
+        &["unsupported file type"],
+    );
 }
 
 #[test]
 fn demo_writes_and_checks_the_default_material() {
     let dir = scratch("demo");
-    let out = slayer(&["demo", "--out", dir.to_str().unwrap(), "--triangles", "20000"]);
-    assert!(out.status.success(), "{}{}", text(&out.stdout), text(&out.stderr));
+    let out = slayer(&[
+        "demo",
+        "--out",
+        dir.to_str().unwrap(),
+        "--triangles",
+        "20000",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
     assert!(dir.join("plaster.ply").exists() && dir.join("plaster.obj").exists());
     assert!(text(&out.stdout).contains("ok: no defects"));
     std::fs::remove_dir_all(dir).unwrap();

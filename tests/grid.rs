@@ -161,11 +161,10 @@ proptest! {
             let mut brute: Option<(f32, u32)> = None;
             for f in 0..mesh.face_count() as u32 {
                 let [a, b, c] = mesh.face_positions(f as usize);
-                if let Some(t) = ray_triangle(&ray, a, b, c) {
-                    if brute.is_none_or(|(bt, bf)| t < bt || (t == bt && f < bf)) {
+                if let Some(t) = ray_triangle(&ray, a, b, c)
+                    && brute.is_none_or(|(bt, bf)| t < bt || (t == bt && f < bf)) {
                         brute = Some((t, f));
                     }
-                }
             }
             prop_assert_eq!(hit.map(|h| (h.t, h.face)), brute);
         }

@@ -16,22 +16,74 @@ fn t(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [Vec3; 3] {
 fn hand_made_cases() {
     let base = t([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
     let cases = [
-        ("piercing", t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.5, 1.5, 1.0]), true),
-        ("above", t([0.5, 0.5, 0.1], [1.0, 0.5, 0.2], [0.5, 1.0, 0.3]), false),
-        ("touching at a corner from above", t([0.5, 0.5, 0.0], [1.0, 0.5, 1.0], [0.5, 1.0, 1.0]), true),
-        ("edge on the surface", t([0.2, 0.2, 0.0], [1.0, 0.2, 0.0], [0.5, 0.5, 1.0]), true),
-        ("coplanar overlapping", t([0.5, 0.5, 0.0], [3.0, 0.5, 0.0], [0.5, 3.0, 0.0]), true),
-        ("coplanar containing", t([0.1, 0.1, 0.0], [0.3, 0.1, 0.0], [0.1, 0.3, 0.0]), true),
-        ("coplanar apart", t([3.0, 3.0, 0.0], [4.0, 3.0, 0.0], [3.0, 4.0, 0.0]), false),
-        ("coplanar sharing an edge line", t([2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]), true),
-        ("crossing the plane beside it", t([3.0, 3.0, -1.0], [3.0, 3.0, 1.0], [4.0, 3.0, 0.0]), false),
-        ("parallel below", t([0.0, 0.0, -1e-7], [2.0, 0.0, -1e-7], [0.0, 2.0, -1e-7]), false),
-        ("degenerate segment piercing", t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.5, 0.5, 0.0]), true),
-        ("degenerate segment beside", t([3.5, 0.5, -1.0], [3.5, 0.5, 1.0], [3.5, 0.5, 0.0]), false),
+        (
+            "piercing",
+            t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.5, 1.5, 1.0]),
+            true,
+        ),
+        (
+            "above",
+            t([0.5, 0.5, 0.1], [1.0, 0.5, 0.2], [0.5, 1.0, 0.3]),
+            false,
+        ),
+        (
+            "touching at a corner from above",
+            t([0.5, 0.5, 0.0], [1.0, 0.5, 1.0], [0.5, 1.0, 1.0]),
+            true,
+        ),
+        (
+            "edge on the surface",
+            t([0.2, 0.2, 0.0], [1.0, 0.2, 0.0], [0.5, 0.5, 1.0]),
+            true,
+        ),
+        (
+            "coplanar overlapping",
+            t([0.5, 0.5, 0.0], [3.0, 0.5, 0.0], [0.5, 3.0, 0.0]),
+            true,
+        ),
+        (
+            "coplanar containing",
+            t([0.1, 0.1, 0.0], [0.3, 0.1, 0.0], [0.1, 0.3, 0.0]),
+            true,
+        ),
+        (
+            "coplanar apart",
+            t([3.0, 3.0, 0.0], [4.0, 3.0, 0.0], [3.0, 4.0, 0.0]),
+            false,
+        ),
+        (
+            "coplanar sharing an edge line",
+            t([2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]),
+            true,
+        ),
+        (
+            "crossing the plane beside it",
+            t([3.0, 3.0, -1.0], [3.0, 3.0, 1.0], [4.0, 3.0, 0.0]),
+            false,
+        ),
+        (
+            "parallel below",
+            t([0.0, 0.0, -1e-7], [2.0, 0.0, -1e-7], [0.0, 2.0, -1e-7]),
+            false,
+        ),
+        (
+            "degenerate segment piercing",
+            t([0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.5, 0.5, 0.0]),
+            true,
+        ),
+        (
+            "degenerate segment beside",
+            t([3.5, 0.5, -1.0], [3.5, 0.5, 1.0], [3.5, 0.5, 0.0]),
+            false,
+        ),
     ];
     for (name, other, expected) in cases {
         assert_eq!(triangles_intersect(base, other), expected, "{name}");
-        assert_eq!(triangles_intersect(other, base), expected, "{name} (swapped)");
+        assert_eq!(
+            triangles_intersect(other, base),
+            expected,
+            "{name} (swapped)"
+        );
     }
 }
 
@@ -93,19 +145,32 @@ fn a_layer_pushed_through_another_is_counted() {
     let middle = 81 + 4 * 9 + 4;
     mesh.positions_mut()[middle].z = -1.0;
     let report = find_intersections(&mesh);
-    assert!(report.between_layers > 0 && report.within_layers == 0, "{report:?}");
-    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+    assert!(
+        report.between_layers > 0 && report.within_layers == 0,
+        "{report:?}"
+    );
+    assert_eq!(
+        (report.between_layers, report.within_layers),
+        brute_force(&mesh)
+    );
 }
 
 #[test]
 fn self_intersection_within_a_layer_is_counted_but_neighbours_are_not() {
     // A sheet folded through itself: lift one corner vertex across a far part of the sheet.
     let mut mesh = shapes::stacked_sheets(1, 6, 6, 1.0, 0.0);
-    assert_eq!(find_intersections(&mesh).total(), 0, "adjacent faces share vertices");
+    assert_eq!(
+        find_intersections(&mesh).total(),
+        0,
+        "adjacent faces share vertices"
+    );
     mesh.positions_mut()[0] = Vec3::new(3.2, 3.3, 0.0) + Vec3::new(0.0, 0.0, 0.0);
     let report = find_intersections(&mesh);
     assert!(report.within_layers > 0);
-    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+    assert_eq!(
+        (report.between_layers, report.within_layers),
+        brute_force(&mesh)
+    );
 }
 
 #[test]
@@ -114,7 +179,10 @@ fn absurd_coordinates_stay_bounded() {
     let mut mesh = shapes::stacked_sheets(2, 4, 4, 1.0, 2.0);
     mesh.positions_mut()[0] = Vec3::new(1e12, -1e12, 5e11);
     let report = find_intersections(&mesh);
-    assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+    assert_eq!(
+        (report.between_layers, report.within_layers),
+        brute_force(&mesh)
+    );
     mesh.positions_mut()[1] = Vec3::new(f32::NAN, 0.0, 0.0);
     assert!(find_intersections(&mesh).skipped_faces > 0);
 }

@@ -80,8 +80,9 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
         (b.x << 42) | (b.y << 21) | b.z
     };
 
-    // File each box in its cells.
-    let (filed, oversized): (Vec<Vec<(u64, u32)>>, Vec<Option<u32>>) = boxes
+    // File each box in its cells: (cell key, face) entries, or the face itself when oversized.
+    type Filing = (Vec<(u64, u32)>, Option<u32>);
+    let (filed, oversized): (Vec<_>, Vec<_>) = boxes
         .par_iter()
         .enumerate()
         .filter(|(f, _)| usable[*f])
@@ -101,6 +102,8 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             }
             (entries, None)
         })
+        .collect::<Vec<Filing>>()
+        .into_iter()
         .unzip();
     let mut entries: Vec<(u64, u32)> = filed.into_iter().flatten().collect();
     entries.par_sort_unstable();

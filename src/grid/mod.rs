@@ -233,10 +233,10 @@ impl SpatialHash {
                 if self.prev[v as usize] != prev {
                     return Err(format!("vertex {v}: back link broken"));
                 }
-                if let Some(p) = positions.get(v as usize) {
-                    if self.cell_of_point(*p) != cell {
-                        return Err(format!("vertex {v} at {p} is filed in stale cell {cell}"));
-                    }
+                if let Some(p) = positions.get(v as usize)
+                    && self.cell_of_point(*p) != cell
+                {
+                    return Err(format!("vertex {v} at {p} is filed in stale cell {cell}"));
                 }
                 seen += 1;
                 prev = v;

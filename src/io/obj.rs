@@ -35,7 +35,6 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = LineCounter {
         inner: io::BufReader::new(text.as_bytes()),

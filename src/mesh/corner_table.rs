@@ -27,7 +27,7 @@ pub fn next(corner: u32) -> u32 {
 
 #[inline]
 pub fn prev(corner: u32) -> u32 {
-    if corner % 3 == 0 {
+    if corner.is_multiple_of(3) {
         corner + 2
     } else {
         corner - 1

@@ -181,13 +181,13 @@ impl Mesh {
                 incidence[v as usize] += 1;
             }
         }
-        for v in 0..self.vertex_count() {
+        for (v, &incident) in incidence.iter().enumerate() {
             if self.flags[v].contains(VertexFlags::DEAD) {
                 continue;
             }
             let vertex = v as u32;
             let c = self.adjacency.vertex_corner[v];
-            if incidence[v] == 0 {
+            if incident == 0 {
                 return Err(MeshError::IsolatedVertex { vertex });
             }
             let broken = |detail: String| MeshError::BrokenVertexCorner { vertex, detail };
@@ -199,7 +199,7 @@ impl Mesh {
             }
             // A fan walk must end where the boundary ends, and see every incident corner.
             let walked = self.adjacency.fan_len(c);
-            if walked != incidence[v] {
+            if walked != incident {
                 let has_boundary = self
                     .adjacency
                     .corners_around(vertex)

@@ -292,7 +292,7 @@ impl BarkRecipe {
     }
 
     /// 0 on a crack line, 1 midway between cracks.
-    fn from_crack(&self, p: Vec2) -> f32 {
+    fn crack_distance(&self, p: Vec2) -> f32 {
         (std::f32::consts::PI * self.across(p)).sin().abs()
     }
 
@@ -311,7 +311,7 @@ impl BarkRecipe {
             * (4.0 * p.y + 0.37 * column + 0.3 * self.wobble.at(p.y, p.x)))
         .sin()
         .abs();
-        self.from_crack(p) > 0.18 && break_line > 0.1
+        self.crack_distance(p) > 0.18 && break_line > 0.1
     }
 
     fn layers(&self, edge: f32) -> Vec<SheetLayer<'_>> {
@@ -328,7 +328,7 @@ impl BarkRecipe {
                 brdf: material::INNER_BARK.brdf,
                 height: Box::new(move |p| self.layer_height(p, 1, gap)),
                 keep: Box::new(move |p| {
-                    self.from_crack(p) > 0.12 || self.short_cracks.at(p.x, p.y) < 0.2
+                    self.crack_distance(p) > 0.12 || self.short_cracks.at(p.x, p.y) < 0.2
                 }),
             },
             SheetLayer {

@@ -68,7 +68,7 @@ impl Lattice {
             (quad / (self.columns as usize - 1)) as u32,
         );
         let at = |di: u32, dj: u32| self.index(i + di, j + dj);
-        match (j % 2 == 0, k % 2 == 0) {
+        match (j % 2 == 0, k.is_multiple_of(2)) {
             (true, true) => [at(0, 0), at(1, 0), at(0, 1)],
             (true, false) => [at(1, 0), at(1, 1), at(0, 1)],
             (false, true) => [at(0, 0), at(1, 1), at(0, 1)],
