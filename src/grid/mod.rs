@@ -4,38 +4,37 @@
 //! within `r + longest edge`, so one vertex grid answers brush selection, the collision broad
 //! phase, picking and the remesher's proximity checks.
 //!
-//! Each cell holds an intrusive doubly linked list of its vertices (`next`/`prev` per vertex) and
-//! each vertex remembers its cell, so insert, remove and move are O(1) without allocating — the
-//! paper's "list of vertex-to-cell correspondences" with reference swapping.
+//! Cells live in a fixed-size table of buckets indexed by [`hash_cell`] (Teschner's scheme, the
+//! same table the GPU kernels build). Each bucket holds an intrusive doubly linked list of its
+//! vertices (`next`/`prev` per vertex) and each vertex remembers its cell, so insert, remove and
+//! move are O(1) without allocating — the paper's "list of vertex-to-cell correspondences" with
+//! reference swapping. Cells that hash to the same bucket share its list; queries filter by the
+//! stored cell. The table has at least twice as many buckets as vertices and grows when needed.
 
 mod hash;
 mod query;
 
 pub use hash::{CellKey, hash_cell};
+pub use query::RayHit;
 
 use glam::{IVec3, Vec3};
-use rustc_hash::FxHashMap;
+use rayon::prelude::*;
 
 use crate::geom::Aabb;
 use crate::mesh::{INVALID, Mesh};
 
-/// Why a grid could not be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum GridError {
-    #[error("grid cell size must be a positive finite length, got {0}")]
-    InvalidCellSize(f32),
-}
-
 /// Cell coordinate of a vertex that is not in the grid.
 const ABSENT: IVec3 = IVec3::new(i32::MIN, i32::MIN, i32::MIN);
+/// Smallest bucket table.
+const MIN_BUCKETS: usize = 1024;
 
 /// A uniform grid over vertex positions, stored sparsely.
 #[derive(Debug, Clone)]
 pub struct SpatialHash {
     cell_size: f32,
     inv_cell_size: f32,
-    /// First vertex of each non-empty cell.
-    heads: FxHashMap<IVec3, u32>,
+    /// First vertex of each bucket's list; the length is a power of two.
+    heads: Vec<u32>,
     /// Per vertex: its cell, or `ABSENT`.
     cell_of: Vec<IVec3>,
     next: Vec<u32>,
@@ -54,7 +53,7 @@ impl SpatialHash {
         Ok(SpatialHash {
             cell_size,
             inv_cell_size: 1.0 / cell_size,
-            heads: FxHashMap::default(),
+            heads: vec![INVALID; bucket_count_for(vertex_capacity)],
             cell_of: vec![ABSENT; vertex_capacity],
             next: vec![INVALID; vertex_capacity],
             prev: vec![INVALID; vertex_capacity],
@@ -63,15 +62,44 @@ impl SpatialHash {
         })
     }
 
-    /// A grid holding every live vertex of `mesh`, with cells of side `cell_size`.
+    /// A grid holding every live vertex of `mesh`, with cells of side `cell_size`. Cells are
+    /// computed in parallel; lists are linked in vertex order, so the result is deterministic.
     pub fn build(mesh: &Mesh, cell_size: f32) -> Result<Self, GridError> {
         let mut grid = SpatialHash::new(cell_size, mesh.vertex_count())?;
-        grid.heads.reserve(mesh.vertex_count());
-        for (v, p) in mesh.positions().iter().enumerate() {
-            if mesh.adjacency().vertex_corner[v] != INVALID {
-                grid.insert(v as u32, *p);
+        let inv = grid.inv_cell_size;
+        let corners = &mesh.adjacency().vertex_corner;
+        let cells: Vec<IVec3> = mesh
+            .positions()
+            .par_iter()
+            .enumerate()
+            .map(|(v, p)| {
+                if corners[v] != INVALID {
+                    cell_coordinates(*p, inv)
+                } else {
+                    ABSENT
+                }
+            })
+            .collect();
+        let bounds = mesh
+            .positions()
+            .par_iter()
+            .enumerate()
+            .filter(|(v, _)| corners[*v] != INVALID)
+            .map(|(_, p)| Aabb { min: *p, max: *p })
+            .reduce(
+                || Aabb::EMPTY,
+                |a, b| Aabb {
+                    min: a.min.min(b.min),
+                    max: a.max.max(b.max),
+                },
+            );
+        for (v, cell) in cells.into_iter().enumerate() {
+            if cell != ABSENT {
+                grid.link(v as u32, cell);
+                grid.len += 1;
             }
         }
+        grid.bounds = bounds;
         Ok(grid)
     }
 
@@ -94,25 +122,47 @@ impl SpatialHash {
         self.len == 0
     }
 
-    /// Number of non-empty cells.
-    pub fn occupied_cells(&self) -> usize {
+    /// Buckets in the table (a power of two).
+    pub fn bucket_count(&self) -> usize {
         self.heads.len()
     }
 
-    /// Heap bytes held: the per-vertex links and the cell table (keys, heads, control bytes).
-    pub fn memory_bytes(&self) -> usize {
-        let per_vertex = std::mem::size_of::<IVec3>() + 2 * std::mem::size_of::<u32>();
-        let per_cell = std::mem::size_of::<(IVec3, u32)>() + 1;
-        self.cell_of.capacity() * per_vertex + self.heads.capacity() * per_cell
+    /// Number of non-empty cells (counted on demand; for reports, not hot paths).
+    pub fn occupied_cells(&self) -> usize {
+        self.cell_counts().len()
     }
 
-    /// The most vertices filed in one cell.
+    /// The most vertices filed in one cell (counted on demand).
     pub fn max_cell_occupancy(&self) -> usize {
-        self.heads
-            .keys()
-            .map(|&cell| self.cell_vertices(cell).count())
+        self.cell_counts()
+            .into_iter()
+            .map(|(_, n)| n)
             .max()
             .unwrap_or(0)
+    }
+
+    fn cell_counts(&self) -> Vec<(IVec3, usize)> {
+        let mut cells: Vec<[i32; 3]> = self
+            .cell_of
+            .iter()
+            .filter(|&&c| c != ABSENT)
+            .map(|c| c.to_array())
+            .collect();
+        cells.par_sort_unstable();
+        let mut counts: Vec<(IVec3, usize)> = Vec::new();
+        for c in cells {
+            match counts.last_mut() {
+                Some((last, n)) if last.to_array() == c => *n += 1,
+                _ => counts.push((IVec3::from_array(c), 1)),
+            }
+        }
+        counts
+    }
+
+    /// Heap bytes held: the bucket table and the per-vertex links.
+    pub fn memory_bytes(&self) -> usize {
+        let per_vertex = std::mem::size_of::<IVec3>() + 2 * std::mem::size_of::<u32>();
+        self.heads.capacity() * std::mem::size_of::<u32>() + self.cell_of.capacity() * per_vertex
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -136,7 +186,7 @@ impl SpatialHash {
         self.cell_of_vertex(vertex).is_some()
     }
 
-    /// Files `vertex` at position `p`. O(1); a vertex already present is moved.
+    /// Files `vertex` at position `p`. O(1) amortized; a vertex already present is moved.
     pub fn insert(&mut self, vertex: u32, p: Vec3) {
         let v = vertex as usize;
         if v >= self.cell_of.len() {
@@ -148,6 +198,9 @@ impl SpatialHash {
         if self.cell_of[v] != ABSENT {
             self.move_to(vertex, p);
             return;
+        }
+        if 2 * (self.len + 1) > self.heads.len() {
+            self.grow();
         }
         self.link(vertex, self.cell_of_point(p));
         self.len += 1;
@@ -183,51 +236,67 @@ impl SpatialHash {
     pub fn cell_vertices(&self, cell: IVec3) -> CellIter<'_> {
         CellIter {
             grid: self,
-            current: self.heads.get(&cell).copied().unwrap_or(INVALID),
+            cell,
+            current: self.heads[self.bucket(cell)],
+        }
+    }
+
+    #[inline]
+    fn bucket(&self, cell: IVec3) -> usize {
+        hash_cell(cell, self.heads.len() as u32) as usize
+    }
+
+    /// Doubles the bucket table and relinks every vertex.
+    fn grow(&mut self) {
+        self.heads = vec![INVALID; self.heads.len() * 2];
+        for v in 0..self.cell_of.len() {
+            let cell = self.cell_of[v];
+            if cell != ABSENT {
+                self.link(v as u32, cell);
+            }
         }
     }
 
     fn link(&mut self, vertex: u32, cell: IVec3) {
         let v = vertex as usize;
-        let head = self.heads.entry(cell).or_insert(INVALID);
-        self.next[v] = *head;
+        let bucket = self.bucket(cell);
+        let head = self.heads[bucket];
+        self.next[v] = head;
         self.prev[v] = INVALID;
-        if *head != INVALID {
-            self.prev[*head as usize] = vertex;
+        if head != INVALID {
+            self.prev[head as usize] = vertex;
         }
-        *head = vertex;
+        self.heads[bucket] = vertex;
         self.cell_of[v] = cell;
     }
 
     fn unlink(&mut self, vertex: u32) {
         let v = vertex as usize;
-        let cell = self.cell_of[v];
         let (prev, next) = (self.prev[v], self.next[v]);
         if next != INVALID {
             self.prev[next as usize] = prev;
         }
         if prev != INVALID {
             self.next[prev as usize] = next;
-        } else if next == INVALID {
-            self.heads.remove(&cell);
         } else {
-            self.heads.insert(cell, next);
+            let bucket = self.bucket(self.cell_of[v]);
+            self.heads[bucket] = next;
         }
         self.next[v] = INVALID;
         self.prev[v] = INVALID;
     }
 
-    /// Checks the linked lists against the per-vertex cells (for tests).
+    /// Checks the bucket lists against the per-vertex cells (for tests).
     pub fn check_consistency(&self, positions: &[Vec3]) -> Result<(), String> {
         let mut seen = 0usize;
-        for (&cell, &head) in &self.heads {
+        for (bucket, &head) in self.heads.iter().enumerate() {
             let mut prev = INVALID;
             let mut v = head;
             while v != INVALID {
-                if self.cell_of[v as usize] != cell {
+                let cell = self.cell_of[v as usize];
+                if cell == ABSENT || self.bucket(cell) != bucket {
                     return Err(format!(
-                        "vertex {v} listed in {cell} but filed in {}",
-                        self.cell_of[v as usize]
+                        "vertex {v} listed in bucket {bucket} but filed in {cell}"
                     ));
                 }
                 if self.prev[v as usize] != prev {
@@ -250,6 +319,18 @@ impl SpatialHash {
     }
 }
 
+/// Buckets for `vertices` vertices: a power of two, at least twice as many.
+fn bucket_count_for(vertices: usize) -> usize {
+    (2 * vertices).next_power_of_two().max(MIN_BUCKETS)
+}
+
+/// Why a grid could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridError {
+    #[error("grid cell size must be a positive finite length, got {0}")]
+    InvalidCellSize(f32),
+}
+
 /// The cell of `p` for a grid with `1 / cell_size = inv_cell_size` (mirrored by the GPU kernels).
 #[inline]
 pub fn cell_coordinates(p: Vec3, inv_cell_size: f32) -> IVec3 {
@@ -258,9 +339,10 @@ pub fn cell_coordinates(p: Vec3, inv_cell_size: f32) -> IVec3 {
     IVec3::new(c.x as i32, c.y as i32, c.z as i32)
 }
 
-/// Iterator over the vertices of one cell.
+/// Iterator over the vertices of one cell (its bucket's list, filtered by cell).
 pub struct CellIter<'a> {
     grid: &'a SpatialHash,
+    cell: IVec3,
     current: u32,
 }
 
@@ -268,11 +350,13 @@ impl Iterator for CellIter<'_> {
     type Item = u32;
 
     fn next(&mut self) -> Option<u32> {
-        if self.current == INVALID {
-            return None;
+        while self.current != INVALID {
+            let v = self.current;
+            self.current = self.grid.next[v as usize];
+            if self.grid.cell_of[v as usize] == self.cell {
+                return Some(v);
+            }
         }
-        let v = self.current;
-        self.current = self.grid.next[v as usize];
-        Some(v)
+        None
     }
 }

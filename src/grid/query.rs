@@ -31,11 +31,11 @@ impl SpatialHash {
             return;
         }
         let cells = (b - a + IVec3::ONE).as_i64vec3();
-        if cells.x * cells.y * cells.z > self.heads.len() as i64 {
-            // Cheaper to scan the occupied cells than to probe the box cell by cell.
-            for (cell, _) in self.heads.iter() {
-                if cell.cmpge(a).all() && cell.cmple(b).all() {
-                    self.cell_vertices(*cell).for_each(&mut f);
+        if cells.x * cells.y * cells.z > 4 * self.cell_of.len() as i64 {
+            // Cheaper to scan the vertices than to probe the box cell by cell.
+            for (v, cell) in self.cell_of.iter().enumerate() {
+                if *cell != super::ABSENT && cell.cmpge(a).all() && cell.cmple(b).all() {
+                    f(v as u32);
                 }
             }
             return;
