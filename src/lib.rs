@@ -6,6 +6,8 @@
 //!
 //! Data flows one way: [`mesh`] ← [`grid`] ← [`collide`] ← the program.
 
+pub mod bench;
+pub mod brush;
 pub mod check;
 pub mod collide;
 pub mod cpu;
@@ -15,4 +17,5 @@ pub mod grid;
 pub mod io;
 pub mod material;
 pub mod mesh;
+pub mod pipeline;
 pub mod scene;

@@ -4,10 +4,12 @@
 
 mod closest_point;
 mod ray;
+mod separation;
 mod tri_tri;
 
 pub use closest_point::{closest_point_on_triangle, point_triangle_distance_squared};
 pub use ray::{Ray, ray_triangle};
+pub use separation::surely_disjoint;
 pub use tri_tri::triangles_intersect;
 
 use glam::Vec3;
@@ -45,6 +47,13 @@ impl Aabb {
 
     pub fn is_empty(&self) -> bool {
         self.min.cmpgt(self.max).any()
+    }
+
+    /// True when some point of the box is closer than `distance` to `p`.
+    #[inline]
+    pub fn within(&self, p: Vec3, distance: f32) -> bool {
+        let outside = (self.min - p).max(p - self.max).max(Vec3::ZERO);
+        outside.length_squared() < distance * distance
     }
 
     pub fn overlaps(&self, other: &Aabb) -> bool {

@@ -33,6 +33,9 @@ fn sign(x: f64) -> i8 {
 
 /// True when the closed triangles `a` and `b` share at least one point.
 pub fn triangles_intersect(a: [Vec3; 3], b: [Vec3; 3]) -> bool {
+    if super::surely_disjoint(a, b) {
+        return false;
+    }
     let a = a.map(|p| p.as_dvec3());
     let b = b.map(|p| p.as_dvec3());
     let side_a = a.map(|p| sign(orient(b[0], b[1], b[2], p)));

@@ -334,9 +334,20 @@ pub enum GridError {
 /// The cell of `p` for a grid with `1 / cell_size = inv_cell_size` (mirrored by the GPU kernels).
 #[inline]
 pub fn cell_coordinates(p: Vec3, inv_cell_size: f32) -> IVec3 {
-    let c = (p * inv_cell_size).floor();
-    // `as` saturates (and maps NaN to 0), so absurd input can't wrap around.
-    IVec3::new(c.x as i32, c.y as i32, c.z as i32)
+    let c = p * inv_cell_size;
+    IVec3::new(floor_to_i32(c.x), floor_to_i32(c.y), floor_to_i32(c.z))
+}
+
+/// `x.floor() as i32` without a libm call: truncate, then step down for negative non-integers.
+/// `as` saturates (and maps NaN to 0), so absurd input cannot wrap around.
+#[inline]
+fn floor_to_i32(x: f32) -> i32 {
+    let t = x as i32;
+    if (t as f32) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
 }
 
 /// Iterator over the vertices of one cell (its bucket's list, filtered by cell).

@@ -1,9 +1,12 @@
 //! The `slayer` command line: generate scenes, check mesh files, run the demo.
 
+mod bench;
 mod check;
 mod demo;
 mod progress;
 mod scene;
+mod sculpt;
+mod strokes;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -53,6 +56,62 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Apply a stroke file to a mesh and write the result (the input is never modified).
+    Sculpt {
+        #[arg(long)]
+        input: PathBuf,
+        /// Stroke file (JSON; see `slayer::brush` docs or README).
+        #[arg(long)]
+        strokes: PathBuf,
+        #[arg(long)]
+        output: PathBuf,
+        /// Write per-stroke phase timings and counts as JSON.
+        #[arg(long)]
+        stats: Option<PathBuf>,
+    },
+    /// Write the bench's seeded stroke script for a scene.
+    Strokes {
+        #[arg(long, default_value = "plaster")]
+        scene: String,
+        #[arg(long)]
+        triangles: Option<usize>,
+        #[arg(long, default_value_t = 40)]
+        count: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Every brush, pushed harder (the property tests' mix).
+        #[arg(long)]
+        torture: bool,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Time the brush pipeline on generated scenes, in the layout of the sLayer paper's Table 1.
+    Bench {
+        /// plaster, bark, metal, or all.
+        #[arg(long, default_value = "all")]
+        scene: String,
+        #[arg(long)]
+        triangles: Option<usize>,
+        #[arg(long, default_value_t = 40)]
+        strokes: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Write the figures as JSON (BENCHMARK.md's field names).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Also run the same strokes on plaster from 250K to 4M faces.
+        #[arg(long)]
+        scaling: bool,
+        /// Face counts for --scaling.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "250000,500000,1000000,2000000,4000000"
+        )]
+        scaling_sizes: Vec<usize>,
+        #[arg(long, default_value = "cpu")]
+        backend: String,
+    },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
         #[arg(long)]
@@ -72,6 +131,58 @@ fn main() -> ExitCode {
         } => scene::run(&name, triangles, seed, &output),
         Command::Check { file, json } => check::run(&file, json),
         Command::Adapters { json } => adapters(json),
+        Command::Sculpt {
+            input,
+            strokes,
+            output,
+            stats,
+        } => sculpt::run(&input, &strokes, &output, stats.as_deref()),
+        Command::Strokes {
+            scene,
+            triangles,
+            count,
+            seed,
+            torture,
+            output,
+        } => strokes::run(&scene, triangles, count, seed, torture, &output),
+        Command::Bench {
+            scene,
+            triangles,
+            strokes,
+            seed,
+            json,
+            scaling,
+            scaling_sizes,
+            backend,
+        } => {
+            let scenes = if scene == "all" {
+                vec![
+                    slayer::scene::SceneKind::Plaster,
+                    slayer::scene::SceneKind::Bark,
+                    slayer::scene::SceneKind::Metal,
+                ]
+            } else if scene == "none" {
+                Vec::new()
+            } else {
+                match scene.parse() {
+                    Ok(kind) => vec![kind],
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return ExitCode::FAILURE;
+                    }
+                }
+            };
+            bench::run(&bench::Options {
+                scenes,
+                triangles,
+                strokes,
+                seed,
+                json,
+                scaling,
+                scaling_sizes,
+                backend,
+            })
+        }
     };
     match result {
         Ok(code) => code,

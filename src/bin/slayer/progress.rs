@@ -34,3 +34,31 @@ impl Steps {
         self.started.elapsed().as_secs_f64()
     }
 }
+
+/// A progress bar over a known number of items; silent when stderr is not a terminal.
+pub struct Bar {
+    bar: ProgressBar,
+}
+
+impl Bar {
+    pub fn new(title: &str, total: u64) -> Bar {
+        let bar = ProgressBar::new(total);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{prefix}: [{bar:30}] {pos}/{len} {msg} [{elapsed} < {eta}]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_prefix(title.to_string());
+        Bar { bar }
+    }
+
+    pub fn inc(&self) {
+        self.bar.inc(1);
+    }
+
+    pub fn finish(self) {
+        self.bar.finish_and_clear();
+    }
+}

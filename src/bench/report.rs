@@ -1,0 +1,208 @@
+//! The bench's tables and the scaling plot.
+
+use std::fmt::Write;
+
+use super::{ScalingRow, SceneResult};
+
+/// The paper's Table 1 layout, plus our per-sample figures; the paper's rows follow for
+/// comparison.
+pub fn paper_table(results: &[SceneResult]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<9} {:>6} {:>9} {:>9} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9} {:>9} {:>6}",
+        "model",
+        "layers",
+        "vertices",
+        "faces",
+        "strokes",
+        "select",
+        "deform",
+        "grid",
+        "collide",
+        "remesh",
+        "ms/sample",
+        "ms/stroke",
+        "ms/remesh",
+        "isect"
+    );
+    for r in results {
+        let total = r.phase_ms.total().max(1e-9);
+        let pct = |x: f64| format!("{:.2}%", 100.0 * x / total);
+        let _ = writeln!(
+            out,
+            "{:<9} {:>6} {:>9} {:>9} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9.3} {:>9.1} {:>9.1} {:>6}",
+            r.name,
+            r.layers,
+            r.vertices,
+            r.faces,
+            r.strokes,
+            pct(r.phase_ms.selection),
+            pct(r.phase_ms.deformation),
+            pct(r.phase_ms.grid_update),
+            pct(r.phase_ms.collision),
+            pct(r.phase_ms.remesh),
+            r.ms_per_sample,
+            r.ms_per_stroke,
+            r.ms_per_remesh,
+            r.intersections
+        );
+    }
+    let _ = writeln!(
+        out,
+        "sLayer paper, Table 1 (i7-6700K, 4 cores; total per brush application):"
+    );
+    for (model, layers, vertices, faces, strokes, phases, total) in [
+        (
+            "plaster",
+            3,
+            "323K",
+            "640K",
+            279,
+            ["4.71%", "0.31%", "1.83%", "66.37%", "8.19%"],
+            "110 ms",
+        ),
+        (
+            "bark",
+            4,
+            "496K",
+            "981K",
+            6557,
+            ["3.66%", "0.30%", "1.26%", "68.13%", "3.98%"],
+            "130 ms",
+        ),
+        (
+            "metal",
+            3,
+            "265K",
+            "525K",
+            1100,
+            ["4.80%", "1.85%", "2.29%", "73.07%", "7.00%"],
+            "100 ms",
+        ),
+    ] {
+        let _ = writeln!(
+            out,
+            "{:<9} {:>6} {:>9} {:>9} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9}",
+            model,
+            layers,
+            vertices,
+            faces,
+            strokes,
+            phases[0],
+            phases[1],
+            phases[2],
+            phases[3],
+            phases[4],
+            total
+        );
+    }
+    out
+}
+
+pub fn scaling_table(rows: &[ScalingRow]) -> String {
+    let mut out = String::new();
+    let base = rows.first().map_or(1.0, |r| r.ms_per_sample.max(1e-9));
+    let _ = writeln!(
+        out,
+        "{:>10} {:>10} {:>10} {:>12}",
+        "faces", "ms/sample", "ms/remesh", "vs smallest"
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{:>10} {:>10.3} {:>10.1} {:>11.2}x",
+            r.faces,
+            r.ms_per_sample,
+            r.ms_per_remesh,
+            r.ms_per_sample / base
+        );
+    }
+    out
+}
+
+/// ms per sample against faces (log scale), as a small standalone SVG.
+pub fn scaling_svg(rows: &[ScalingRow], title: &str) -> String {
+    let (w, h, pad) = (640.0, 400.0, 60.0);
+    let max_ms = rows
+        .iter()
+        .map(|r| r.ms_per_sample.max(r.ms_per_remesh / 10.0))
+        .fold(1e-9, f64::max)
+        * 1.2;
+    let (min_f, max_f) = rows.iter().fold((f64::MAX, 0.0f64), |(lo, hi), r| {
+        (lo.min(r.faces as f64), hi.max(r.faces as f64))
+    });
+    let x = |faces: f64| {
+        let span = (max_f.ln() - min_f.ln()).max(1e-9);
+        pad + (faces.ln() - min_f.ln()) / span * (w - 2.0 * pad)
+    };
+    let y = |ms: f64| h - pad - ms / max_ms * (h - 2.0 * pad);
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        svg,
+        r#"<text x="{}" y="24" text-anchor="middle" font-size="15">{title}</text>"#,
+        w / 2.0
+    );
+    let _ = writeln!(
+        svg,
+        r#"<line x1="{pad}" y1="{}" x2="{}" y2="{}" stroke="black"/>"#,
+        h - pad,
+        w - pad,
+        h - pad
+    );
+    let _ = writeln!(
+        svg,
+        r#"<line x1="{pad}" y1="{pad}" x2="{pad}" y2="{}" stroke="black"/>"#,
+        h - pad
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="{}" y="{}" text-anchor="middle">faces (log scale)</text>"#,
+        w / 2.0,
+        h - 15.0
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="18" y="{}" transform="rotate(-90 18 {})" text-anchor="middle">ms per stroke sample</text>"#,
+        h / 2.0,
+        h / 2.0
+    );
+    for k in 0..=4 {
+        let ms = max_ms * k as f64 / 4.0;
+        let _ = writeln!(
+            svg,
+            r#"<text x="{}" y="{}" text-anchor="end">{ms:.2}</text>"#,
+            pad - 6.0,
+            y(ms) + 4.0
+        );
+    }
+    let points: Vec<String> = rows
+        .iter()
+        .map(|r| format!("{:.1},{:.1}", x(r.faces as f64), y(r.ms_per_sample)))
+        .collect();
+    let _ = writeln!(
+        svg,
+        r##"<polyline points="{}" fill="none" stroke="#c0392b" stroke-width="2"/>"##,
+        points.join(" ")
+    );
+    for r in rows {
+        let (px, py) = (x(r.faces as f64), y(r.ms_per_sample));
+        let _ = writeln!(
+            svg,
+            r##"<circle cx="{px:.1}" cy="{py:.1}" r="4" fill="#c0392b"/>"##
+        );
+        let _ = writeln!(
+            svg,
+            r#"<text x="{px:.1}" y="{}" text-anchor="middle">{}K</text>"#,
+            h - pad + 16.0,
+            r.faces / 1000
+        );
+    }
+    let _ = writeln!(svg, "</svg>");
+    svg
+}

@@ -1,0 +1,89 @@
+//! Brushes as deformation fields with a falloff (DESIGN §3), and strokes: polylines of samples
+//! resampled at a spacing relative to the radius.
+
+mod falloff;
+mod field;
+mod stroke;
+
+pub use falloff::Falloff;
+pub use field::{Dab, DabFrame, displacement};
+pub use stroke::{
+    LayerRef, MAX_RADIUS_OVER_EXTENT, Sample, SampleSpec, Stroke, StrokeError, StrokeFile,
+    StrokeSpec, resample,
+};
+
+use serde::{Deserialize, Serialize};
+
+/// The deformation a brush applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BrushKind {
+    /// Move along the brush normal (invert: push in).
+    Draw,
+    /// Move along each vertex normal (invert: deflate).
+    Inflate,
+    /// Inflate inverted.
+    Deflate,
+    /// Carry the vertices under the brush along with it.
+    #[serde(alias = "move")]
+    Grab,
+    /// Move each vertex toward the centroid of its neighbours.
+    Smooth,
+    /// Move toward the plane fitted under the brush (invert: away from it).
+    Flatten,
+    /// Pull toward the brush centre in the brush plane (invert: push away).
+    Pinch,
+    /// Draw inward while pinching: a sharp groove (invert: a sharp ridge).
+    Crease,
+    /// Turn about the brush normal through the centre.
+    Twist,
+}
+
+impl BrushKind {
+    pub const ALL: [BrushKind; 9] = [
+        BrushKind::Draw,
+        BrushKind::Inflate,
+        BrushKind::Deflate,
+        BrushKind::Grab,
+        BrushKind::Smooth,
+        BrushKind::Flatten,
+        BrushKind::Pinch,
+        BrushKind::Crease,
+        BrushKind::Twist,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BrushKind::Draw => "draw",
+            BrushKind::Inflate => "inflate",
+            BrushKind::Deflate => "deflate",
+            BrushKind::Grab => "grab",
+            BrushKind::Smooth => "smooth",
+            BrushKind::Flatten => "flatten",
+            BrushKind::Pinch => "pinch",
+            BrushKind::Crease => "crease",
+            BrushKind::Twist => "twist",
+        }
+    }
+}
+
+/// A brush: what it does, how big and how strong, and how its effect fades.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Brush {
+    pub kind: BrushKind,
+    /// World units.
+    pub radius: f32,
+    /// In [0, 1]: 1 moves a vertex under the centre by a tenth of the radius per sample (draw,
+    /// inflate), relaxes it fully (smooth, flatten) or turns it by half a radian (twist).
+    pub strength: f32,
+    pub falloff: Falloff,
+    pub invert: bool,
+}
+
+impl Brush {
+    /// +1, or −1 when inverted (deflate is inflate inverted).
+    pub fn direction(&self) -> f32 {
+        let inverted = self.invert ^ (self.kind == BrushKind::Deflate);
+        if inverted { -1.0 } else { 1.0 }
+    }
+}

@@ -1,0 +1,108 @@
+//! A dense grid of face boxes over one brush step's region: the collision broad phase.
+//!
+//! The global spatial hash files vertices; a proximity query through it must probe every cell
+//! within `d + longest edge` of the point (over a hundred hash probes). Per step we instead
+//! gather the region's faces once through the hash and file their boxes in a small dense array
+//! (counting sort, no hashing), so a query reads only the few cells its own box covers.
+
+use glam::{IVec3, Vec3};
+
+use crate::geom::Aabb;
+
+/// Cells per axis at most; larger regions get larger cells.
+const MAX_CELLS_PER_AXIS: f32 = 64.0;
+
+#[derive(Debug, Clone, Default)]
+pub struct LocalFaceGrid {
+    origin: Vec3,
+    inv_cell: f32,
+    dims: IVec3,
+    /// `offsets[c]..offsets[c + 1]` indexes `entries` for cell `c`.
+    offsets: Vec<u32>,
+    /// Local face indices (positions in the face list the grid was built from).
+    entries: Vec<u32>,
+    cursor: Vec<u32>,
+}
+
+impl LocalFaceGrid {
+    /// Files `boxes[i]` (local face `i`) in every cell it overlaps. `region` bounds all boxes;
+    /// `cell` is the preferred cell side.
+    pub fn build(&mut self, boxes: &[Aabb], region: Aabb, cell: f32) {
+        let extent = (region.max - region.min).max(Vec3::splat(cell));
+        let cell = cell.max(extent.max_element() / MAX_CELLS_PER_AXIS);
+        self.origin = region.min;
+        self.inv_cell = 1.0 / cell;
+        self.dims = ((extent * self.inv_cell).floor().as_ivec3() + IVec3::ONE).max(IVec3::ONE);
+        let cell_count = (self.dims.x * self.dims.y * self.dims.z) as usize;
+        self.offsets.clear();
+        self.offsets.resize(cell_count + 1, 0);
+        for b in boxes {
+            let (lo, hi) = self.cell_range(b);
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let c = self.index(IVec3::new(x, y, z));
+                        self.offsets[c + 1] += 1;
+                    }
+                }
+            }
+        }
+        for c in 0..cell_count {
+            self.offsets[c + 1] += self.offsets[c];
+        }
+        self.entries.clear();
+        self.entries.resize(self.offsets[cell_count] as usize, 0);
+        let mut cursor = std::mem::take(&mut self.cursor);
+        cursor.clear();
+        cursor.extend_from_slice(&self.offsets);
+        for (i, b) in boxes.iter().enumerate() {
+            let (lo, hi) = self.cell_range(b);
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let c = self.index(IVec3::new(x, y, z));
+                        self.entries[cursor[c] as usize] = i as u32;
+                        cursor[c] += 1;
+                    }
+                }
+            }
+        }
+        self.cursor = cursor;
+    }
+
+    /// Calls `f` with every local face filed in a cell overlapping `query` (a face may come
+    /// more than once; callers deduplicate).
+    pub fn for_each_candidate(&self, query: &Aabb, mut f: impl FnMut(u32)) {
+        if self.offsets.is_empty() {
+            return;
+        }
+        let (lo, hi) = self.cell_range(query);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let c = self.index(IVec3::new(x, y, z));
+                    for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize]
+                    {
+                        f(e);
+                    }
+                }
+            }
+        }
+    }
+
+    fn cell_range(&self, b: &Aabb) -> (IVec3, IVec3) {
+        // Truncation is floor here: everything below the origin clamps to cell 0 anyway.
+        let clamp = |p: Vec3| {
+            ((p - self.origin) * self.inv_cell)
+                .max(Vec3::ZERO)
+                .as_ivec3()
+                .min(self.dims - IVec3::ONE)
+        };
+        (clamp(b.min), clamp(b.max))
+    }
+
+    #[inline]
+    fn index(&self, c: IVec3) -> usize {
+        ((c.z * self.dims.y + c.y) * self.dims.x + c.x) as usize
+    }
+}

@@ -1,0 +1,398 @@
+//! The CPU backend: Algorithm 2 on all cores, and the same code single-threaded with brute-force
+//! search as the reference it is tested against.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::step::{Region, StrokeState, collide, deform, select};
+use super::{
+    PhaseTimes, PipelineError, PipelineSettings, SculptPipeline, StrokeHook, StrokeReport,
+};
+use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
+use crate::collide::neighbourhood::exclusion_ring;
+use crate::grid::SpatialHash;
+use crate::mesh::{INVALID, Mesh, MeshVersion};
+
+/// How nearby elements are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Search {
+    /// Through the spatial hash and a per-step face grid.
+    Grid,
+    /// By scanning every vertex and face: slow, obviously right, the reference.
+    Scan,
+}
+
+/// Steps per sample are capped; a sample asking for more is a runaway brush.
+const MAX_STEPS_PER_SAMPLE: usize = 256;
+
+pub struct CpuPipeline {
+    settings: PipelineSettings,
+    search: Search,
+    parallel: bool,
+    edge_length: Option<f32>,
+    /// Exclusion ring, cached per topology version.
+    ring: Option<(u64, u32)>,
+    hook: Option<Box<dyn StrokeHook>>,
+    region: Region,
+    grid: Option<KeptGrid>,
+}
+
+/// The grid between strokes, with the mesh version it matches.
+struct KeptGrid {
+    grid: SpatialHash,
+    version: MeshVersion,
+}
+
+impl CpuPipeline {
+    /// The fast backend: grids and all cores.
+    pub fn new(settings: PipelineSettings) -> CpuPipeline {
+        CpuPipeline::with_search(settings, Search::Grid, true)
+    }
+
+    /// The reference: brute-force search on one thread.
+    pub fn reference(settings: PipelineSettings) -> CpuPipeline {
+        CpuPipeline::with_search(settings, Search::Scan, false)
+    }
+
+    pub fn with_search(settings: PipelineSettings, search: Search, parallel: bool) -> CpuPipeline {
+        CpuPipeline {
+            edge_length: settings.edge_length,
+            settings,
+            search,
+            parallel,
+            ring: None,
+            hook: None,
+            region: Region::default(),
+            grid: None,
+        }
+    }
+
+    /// Runs `hook` after every stroke (remeshing).
+    pub fn set_hook(&mut self, hook: Box<dyn StrokeHook>) {
+        self.hook = Some(hook);
+    }
+
+    /// The edge length `L` the pipeline works with (known after the first stroke).
+    pub fn edge_length(&self) -> Option<f32> {
+        self.edge_length
+    }
+}
+
+/// Longest edge of the given faces (all live faces when `faces` is `None`).
+fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
+    let edge_max = |f: usize| {
+        if mesh.is_face_dead(f) {
+            return 0.0f32;
+        }
+        let [a, b, c] = mesh.face_positions(f);
+        a.distance(b).max(b.distance(c)).max(c.distance(a))
+    };
+    match faces {
+        Some(list) => list
+            .iter()
+            .map(|&f| edge_max(f as usize))
+            .fold(0.0, f32::max),
+        None => (0..mesh.face_count())
+            .into_par_iter()
+            .map(edge_max)
+            .reduce(|| 0.0, f32::max),
+    }
+}
+
+fn millis(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// The brush frame at a sample: the surface normal and centroid under the brush, weighted by
+/// falloff, summed in vertex order so every backend gets the same bits.
+fn frame_at(
+    mesh: &Mesh,
+    selection: &[(u32, f32)],
+    sample: &Sample,
+    previous: Option<Vec3>,
+) -> DabFrame {
+    let mut normal_sum = Vec3::ZERO;
+    let mut point_sum = Vec3::ZERO;
+    let mut weight_sum = 0.0f32;
+    for &(v, w) in selection {
+        normal_sum += mesh.normals()[v as usize] * w;
+        point_sum += mesh.positions()[v as usize] * w;
+        weight_sum += w;
+    }
+    let normal = sample
+        .normal
+        .or_else(|| normal_sum.try_normalize())
+        .unwrap_or(Vec3::Z);
+    DabFrame {
+        center: sample.position,
+        normal,
+        plane_point: if weight_sum > 0.0 {
+            point_sum / weight_sum
+        } else {
+            sample.position
+        },
+        motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
+    }
+}
+
+impl SculptPipeline for CpuPipeline {
+    fn name(&self) -> String {
+        match (self.search, self.parallel) {
+            (Search::Grid, true) => "cpu".into(),
+            (Search::Scan, false) => "cpu-reference".into(),
+            (Search::Grid, false) => "cpu-1-thread".into(),
+            (Search::Scan, true) => "cpu-scan".into(),
+        }
+    }
+
+    fn apply_stroke(
+        &mut self,
+        mesh: &mut Mesh,
+        stroke: &Stroke,
+    ) -> Result<StrokeReport, PipelineError> {
+        if let Some(&layer) = stroke
+            .layers
+            .iter()
+            .find(|&&l| l as usize >= mesh.layer_count())
+        {
+            return Err(PipelineError::LayerOutOfRange {
+                layer,
+                layer_count: mesh.layer_count(),
+            });
+        }
+        let edge = match self.edge_length {
+            Some(l) => l,
+            None => {
+                let l = mesh.mean_edge_length();
+                if !(l.is_finite() && l > 0.0) {
+                    return Err(PipelineError::NoEdges);
+                }
+                self.edge_length = Some(l);
+                l
+            }
+        };
+        let mut times = PhaseTimes::default();
+        let mut report = StrokeReport::default();
+
+        // Algorithm 2 rebuilds the grid per stroke. Ours is kept exact by every edit, so it is
+        // rebuilt only when something else changed the mesh (or when asked to, for comparison).
+        let started = Instant::now();
+        let version = mesh.version();
+        let stale = match &self.grid {
+            Some(kept) => {
+                self.settings.rebuild_grid_every_stroke
+                    || kept.version != version
+                    || kept.grid.len() != mesh.live_vertex_count()
+                    || kept.grid.cell_size() != edge
+            }
+            None => true,
+        };
+        if stale {
+            self.grid = Some(KeptGrid {
+                grid: SpatialHash::build(mesh, edge)?,
+                version,
+            });
+        }
+        let mut grid = match self.grid.take() {
+            Some(kept) => kept.grid,
+            None => SpatialHash::build(mesh, edge)?,
+        };
+        times.grid_update += millis(started);
+
+        let started = Instant::now();
+        let distance = self.settings.collision_distance * edge;
+        let topology = mesh.version().topology;
+        let ring = match self.ring {
+            Some((version, ring)) if version == topology => ring,
+            _ => {
+                let ring = exclusion_ring(mesh, distance);
+                self.ring = Some((topology, ring));
+                ring
+            }
+        };
+        let mut max_edge = longest_edge(mesh, None);
+        times.collision += millis(started);
+
+        let mut active = vec![false; mesh.layer_count()];
+        for &l in &stroke.layers {
+            active[l as usize] = true;
+        }
+        let step_limit = self.settings.max_step * edge;
+        let samples = resample(&stroke.samples, stroke.spacing * stroke.brush.radius);
+        report.samples = samples.len();
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        let mut touched = vec![false; mesh.vertex_count()];
+        let mut touched_list = Vec::new();
+        let mut moved_in_sample = Vec::new();
+        let mut previous: Option<Vec3> = None;
+        let mut captured: Option<Vec<(u32, f32)>> = None;
+        let is_grab = stroke.brush.kind == BrushKind::Grab;
+
+        let use_grid = self.search == Search::Grid;
+        let parallel = self.parallel;
+        fn state_for<'a>(
+            grid: Option<&'a SpatialHash>,
+            active: &'a [bool],
+            (parallel, distance, ring, max_edge): (bool, f32, u32, f32),
+        ) -> StrokeState<'a> {
+            StrokeState {
+                grid,
+                active,
+                parallel,
+                collision_distance: distance,
+                ring,
+                max_edge,
+            }
+        }
+        for sample in &samples {
+            let state = state_for(
+                use_grid.then_some(&grid),
+                &active,
+                (parallel, distance, ring, max_edge),
+            );
+            let started = Instant::now();
+            let probe = Dab {
+                brush: stroke.brush,
+                frame: DabFrame {
+                    center: sample.position,
+                    normal: Vec3::Z,
+                    plane_point: sample.position,
+                    motion: Vec3::ZERO,
+                },
+                pressure: sample.pressure,
+                share: 1.0,
+            };
+            let first_selection = match (&captured, is_grab) {
+                (Some(held), true) => held.clone(),
+                _ => select(&state, mesh, &probe),
+            };
+            if is_grab && captured.is_none() {
+                captured = Some(first_selection.clone());
+            }
+            let frame = frame_at(mesh, &first_selection, sample, previous);
+            previous = Some(sample.position);
+            times.selection += millis(started);
+            if first_selection.is_empty() {
+                continue;
+            }
+
+            // Split the sample's motion into steps of at most `max_step` edge lengths.
+            let started = Instant::now();
+            let whole = Dab { frame, ..probe };
+            let full = deform(&state, mesh, &whole, &first_selection);
+            let longest_move = first_selection
+                .iter()
+                .zip(&full)
+                .map(|(&(v, _), q)| mesh.positions()[v as usize].distance(*q))
+                .fold(0.0f32, f32::max);
+            let steps =
+                ((longest_move / step_limit).ceil() as usize).clamp(1, MAX_STEPS_PER_SAMPLE);
+            times.deformation += millis(started);
+            moved_in_sample.clear();
+
+            for step in 0..steps {
+                let state = state_for(
+                    use_grid.then_some(&grid),
+                    &active,
+                    (parallel, distance, ring, max_edge),
+                );
+                let dab = Dab {
+                    share: 1.0 / steps as f32,
+                    ..whole
+                };
+                let started = Instant::now();
+                let selection = if step == 0 || is_grab {
+                    first_selection.clone()
+                } else {
+                    select(&state, mesh, &dab)
+                };
+                times.selection += millis(started);
+
+                let started = Instant::now();
+                let targets = deform(&state, mesh, &dab, &selection);
+                times.deformation += millis(started);
+
+                let started = Instant::now();
+                for (i, &(v, _)) in selection.iter().enumerate() {
+                    target_of[v as usize] = i as u32;
+                }
+                let before: Vec<Vec3> = selection
+                    .iter()
+                    .map(|&(v, _)| mesh.positions()[v as usize])
+                    .collect();
+                let outcome = collide(
+                    &state,
+                    &mut self.region,
+                    mesh,
+                    &selection,
+                    &targets,
+                    &target_of,
+                );
+                for &(v, _) in &selection {
+                    target_of[v as usize] = INVALID;
+                }
+                let moved: Vec<u32> = selection
+                    .iter()
+                    .zip(&before)
+                    .zip(&outcome.positions)
+                    .filter(|((_, p), q)| p != q)
+                    .map(|((&(v, _), _), _)| v)
+                    .collect();
+                let mut moved_faces: Vec<u32> =
+                    moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
+                moved_faces.sort_unstable();
+                moved_faces.dedup();
+                max_edge = max_edge.max(longest_edge(mesh, Some(&moved_faces)));
+                times.collision += millis(started);
+
+                let started = Instant::now();
+                for &v in &moved {
+                    grid.move_to(v, mesh.positions()[v as usize]);
+                }
+                times.grid_update += millis(started);
+
+                report.steps += 1;
+                report.moves += moved.len();
+                report.clamped += outcome.clamped;
+                report.reverted += outcome.reverted;
+                for v in moved {
+                    if !touched[v as usize] {
+                        touched[v as usize] = true;
+                        touched_list.push(v);
+                    }
+                    moved_in_sample.push(v);
+                }
+            }
+
+            // Normals of the moved vertices and of their neighbours, whose faces also turned.
+            let started = Instant::now();
+            let mut refresh: Vec<u32> = moved_in_sample
+                .iter()
+                .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
+                .collect();
+            refresh.sort_unstable();
+            refresh.dedup();
+            mesh.recompute_normals_at(&refresh);
+            times.deformation += millis(started);
+        }
+
+        touched_list.sort_unstable();
+        report.touched = touched_list.len();
+        let mut grid_current = true;
+        if let Some(hook) = self.hook.as_mut() {
+            let started = Instant::now();
+            grid_current = hook.after_stroke(mesh, &touched_list, &mut grid)?;
+            times.remesh += millis(started);
+        }
+        if grid_current {
+            self.grid = Some(KeptGrid {
+                grid,
+                version: mesh.version(),
+            });
+        }
+        report.phases = times;
+        Ok(report)
+    }
+}

@@ -1,0 +1,138 @@
+//! The brush pipeline: sLayer's Algorithm 2 behind one interface that every backend implements.
+//!
+//! Per stroke the grid is rebuilt; per sample the brush's motion is split into steps of at most
+//! one edge length; per step vertices are selected through the grid, deformed, tested against
+//! nearby triangles and clamped where they would come closer than the collision distance; an
+//! exact backstop then undoes any move that would still make two triangles cross (edge–edge
+//! cases the vertex–triangle test cannot see). After the stroke a hook runs: remeshing plugs in
+//! there. Every backend reports the same phases: selection, deformation, grid update,
+//! collision, remesh.
+
+mod cpu;
+mod step;
+
+pub use cpu::{CpuPipeline, Search};
+
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::brush::Stroke;
+use crate::grid::{GridError, SpatialHash};
+use crate::mesh::Mesh;
+
+/// Tunables, in units of the mesh's edge length `L` where they are lengths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PipelineSettings {
+    /// Vertices stop this far (× L) from other surfaces. The paper uses one edge length.
+    pub collision_distance: f32,
+    /// Largest move of a vertex in one step (× L). Below twice the collision distance a vertex
+    /// cannot jump across a triangle between two proximity tests.
+    pub max_step: f32,
+    /// The edge length `L`; by default the mean edge length of the mesh at the first stroke,
+    /// then held constant (sLayer's edge length assumption).
+    pub edge_length: Option<f32>,
+    /// Rebuild the grid at every stroke, as Algorithm 2 does. Off by default: the grid is kept
+    /// exact by every edit and rebuilt only when the mesh changed behind the pipeline's back.
+    pub rebuild_grid_every_stroke: bool,
+}
+
+impl Default for PipelineSettings {
+    fn default() -> Self {
+        PipelineSettings {
+            collision_distance: 1.0,
+            max_step: 1.0,
+            edge_length: None,
+            rebuild_grid_every_stroke: false,
+        }
+    }
+}
+
+/// Milliseconds spent in each phase.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct PhaseTimes {
+    pub selection: f64,
+    pub deformation: f64,
+    pub grid_update: f64,
+    pub collision: f64,
+    pub remesh: f64,
+}
+
+impl PhaseTimes {
+    pub fn total(&self) -> f64 {
+        self.selection + self.deformation + self.grid_update + self.collision + self.remesh
+    }
+
+    pub fn add(&mut self, other: &PhaseTimes) {
+        self.selection += other.selection;
+        self.deformation += other.deformation;
+        self.grid_update += other.grid_update;
+        self.collision += other.collision;
+        self.remesh += other.remesh;
+    }
+
+    /// The phases as (name, milliseconds), in table order.
+    pub fn named(&self) -> [(&'static str, f64); 5] {
+        [
+            ("selection", self.selection),
+            ("deformation", self.deformation),
+            ("grid update", self.grid_update),
+            ("collision", self.collision),
+            ("remesh", self.remesh),
+        ]
+    }
+}
+
+/// What one stroke did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct StrokeReport {
+    /// Samples after resampling.
+    pub samples: usize,
+    /// Steps (a sample moving vertices more than `max_step` takes several).
+    pub steps: usize,
+    /// Vertex moves, summed over steps.
+    pub moves: usize,
+    /// Moves shortened by the proximity test.
+    pub clamped: usize,
+    /// Moves undone by the exact backstop.
+    pub reverted: usize,
+    /// Distinct vertices the stroke moved.
+    pub touched: usize,
+    pub phases: PhaseTimes,
+}
+
+#[derive(Debug, Error)]
+pub enum PipelineError {
+    #[error("the mesh has no edges to take a length from")]
+    NoEdges,
+    #[error("stroke names layer {layer}, but the mesh has {layer_count}")]
+    LayerOutOfRange { layer: u32, layer_count: usize },
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    #[error("after-stroke hook failed: {0}")]
+    Hook(String),
+}
+
+/// Runs after every stroke with the vertices it moved and the up-to-date grid; remeshing plugs
+/// in here.
+pub trait StrokeHook: Send {
+    /// The pipeline books the time spent here under "remesh". Returns whether `grid` still
+    /// matches the mesh (a hook that edits the mesh and maintains the grid returns true; one
+    /// that does not, false, and the grid is rebuilt before the next stroke).
+    fn after_stroke(
+        &mut self,
+        mesh: &mut Mesh,
+        touched: &[u32],
+        grid: &mut SpatialHash,
+    ) -> Result<bool, PipelineError>;
+}
+
+/// A sculpting backend: applies strokes to a mesh.
+pub trait SculptPipeline {
+    /// Name for reports ("cpu", "cpu-reference", "gpu").
+    fn name(&self) -> String;
+    fn apply_stroke(
+        &mut self,
+        mesh: &mut Mesh,
+        stroke: &Stroke,
+    ) -> Result<StrokeReport, PipelineError>;
+}
