@@ -32,6 +32,11 @@ fn euler_characteristic(mesh: &Mesh) -> i64 {
 fn every_kind_validates_and_has_consistent_adjacency() {
     for (name, mesh) in kinds() {
         mesh.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut edge_neighbours = vec![Vec::new(); mesh.vertex_count()];
+        for [a, b] in mesh.edges() {
+            edge_neighbours[a as usize].push(b);
+            edge_neighbours[b as usize].push(a);
+        }
         let csr = mesh.vertex_faces();
         for v in 0..mesh.vertex_count() as u32 {
             let mut from_fan: Vec<u32> = mesh.faces_around(v).collect();

@@ -5,7 +5,8 @@
 //! (altitude = twice the area over the longest edge). The faces incident to `v` cover a disk of
 //! radius `ρ` around it, and each further ring of faces widens the covered disk by at least `ρ`.
 //! So on a surface that is locally a sheet, a face with no vertex within graph distance `r` of
-//! `v` is at least `(r + 1)·ρ` away. Skipping the faces that touch the `r`-ring with
+//! `v` is at least `(r + 1)·ρ` away (near an open boundary the covered region is cut, and the
+//! far side of a narrow notch can be nearer: it is a different part of the sheet and collides). Skipping the faces that touch the `r`-ring with
 //! `(r + 1)·ρ ≥ d` therefore skips exactly the faces that are near only because they are
 //! neighbours, and nothing farther: a face of the same layer that comes within `d` from outside
 //! the ring is a genuine fold, and collides. `tests/collision.rs` checks both directions on
@@ -13,7 +14,7 @@
 
 use rayon::prelude::*;
 
-use crate::mesh::{INVALID, Mesh, next, prev};
+use crate::mesh::{Mesh, next, prev};
 
 /// Share of faces allowed to be thinner than the `ρ` used (slivers are few and local; letting one
 /// sliver set the ring for the whole mesh would blind collision everywhere).
@@ -65,16 +66,15 @@ pub fn ring_vertices(mesh: &Mesh, vertex: u32, ring: u32, out: &mut Vec<u32>) {
         let frontier_end = out.len();
         for i in frontier_start..frontier_end {
             let u = out[i];
-            let mut last = INVALID;
-            for c in mesh.adjacency().corners_around(u) {
-                let w = mesh.corner_vertex(next(c));
+            if mesh.is_boundary_vertex(u) {
+                let first = mesh.adjacency().vertex_corner[u as usize];
+                let w = mesh.corner_vertex(prev(first));
                 if !out.contains(&w) {
                     out.push(w);
                 }
-                last = c;
             }
-            if last != INVALID && mesh.adjacency().swing_right(last) == INVALID {
-                let w = mesh.corner_vertex(prev(last));
+            for c in mesh.adjacency().corners_around(u) {
+                let w = mesh.corner_vertex(next(c));
                 if !out.contains(&w) {
                     out.push(w);
                 }

@@ -286,16 +286,17 @@ impl Mesh {
         self.adjacency.corners_around(vertex).map(face_of)
     }
 
-    /// The one-ring of a vertex, in fan order (a boundary vertex's last neighbour included).
+    /// The one-ring of a vertex, in fan order. On a boundary it runs from one boundary
+    /// neighbour to the other.
     pub fn neighbours(&self, vertex: u32) -> Vec<u32> {
         let mut ring = Vec::with_capacity(8);
-        let mut last = INVALID;
+        if self.is_boundary_vertex(vertex) {
+            // The first corner's other edge is the boundary edge the fan starts from.
+            let first = self.adjacency.vertex_corner[vertex as usize];
+            ring.push(self.corner_vertex(prev(first)));
+        }
         for c in self.adjacency.corners_around(vertex) {
             ring.push(self.corner_vertex(next(c)));
-            last = c;
-        }
-        if last != INVALID && self.adjacency.swing_right(last) == INVALID {
-            ring.push(self.corner_vertex(prev(last)));
         }
         ring
     }

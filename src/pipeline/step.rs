@@ -364,14 +364,13 @@ pub fn collide(
                     continue;
                 }
                 // Distance along the move is convex: bisect for the last safe fraction.
-                let (mut lo, mut hi) = (0.0f32, 1.0f32.min(t));
+                // Always over the whole move, so the result for a face does not depend on
+                // the order faces are met in (the grid and the reference meet them differently).
+                let (mut lo, mut hi) = (0.0f32, 1.0f32);
                 let at = |s: f32| {
                     let x = p + (q - p) * s;
                     closest_point_on_triangle(x, a, b, c).distance(x)
                 };
-                if at(hi) >= threshold {
-                    continue;
-                }
                 for _ in 0..CLAMP_ROUNDS {
                     let mid = 0.5 * (lo + hi);
                     if at(mid) >= threshold {
