@@ -12,7 +12,7 @@ use crate::collide::LocalFaceGrid;
 use crate::collide::neighbourhood::ring_vertices;
 use crate::geom::{Aabb, closest_point_on_triangle, triangles_intersect};
 use crate::grid::SpatialHash;
-use crate::mesh::{INVALID, LayerId, Mesh, VertexFlags};
+use crate::mesh::{INVALID, Mesh, VertexFlags};
 
 /// Bisection rounds when clamping a move: 2⁻¹⁶ of a step.
 const CLAMP_ROUNDS: u32 = 16;
@@ -177,8 +177,9 @@ pub struct Region {
     grid: LocalFaceGrid,
     use_grid: bool,
     vertices: Vec<u32>,
-    /// Per mesh face: the generation that last put it in `faces`.
+    /// Per mesh face: the generation that last put it in `faces`, and its index there.
     face_stamp: Vec<u32>,
+    local_index: Vec<u32>,
     generation: u32,
 }
 
@@ -219,6 +220,7 @@ impl Region {
         // is a minimum or a sorted set.
         if self.face_stamp.len() < mesh.face_count() {
             self.face_stamp.resize(mesh.face_count(), 0);
+            self.local_index.resize(mesh.face_count(), 0);
         }
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
@@ -231,6 +233,7 @@ impl Region {
                 let stamp = &mut self.face_stamp[f as usize];
                 if *stamp != self.generation {
                     *stamp = self.generation;
+                    self.local_index[f as usize] = self.faces.len() as u32;
                     self.faces.push(f);
                 }
             }
@@ -253,6 +256,12 @@ impl Region {
             self.grid
                 .build(&self.boxes, region, LOCAL_CELL_EDGES * g.cell_size());
         }
+    }
+
+    /// Index of a mesh face in this region, if it is in it.
+    fn local(&self, face: u32) -> Option<usize> {
+        (self.face_stamp.get(face as usize) == Some(&self.generation))
+            .then(|| self.local_index[face as usize] as usize)
     }
 
     /// Local faces whose box overlaps `query`, each once.
@@ -286,6 +295,77 @@ fn triangle(mesh: &Mesh, f: u32) -> [Vec3; 3] {
     mesh.face_positions(f as usize)
 }
 
+/// Tests one moving vertex, now at its tentative position, against the faces near its move
+/// (only those in `changed`, if given). Returns the position it must be pulled back to, if any.
+fn pull_back(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    v: u32,
+    start: Vec3,
+    changed: Option<&[bool]>,
+    scratch: &mut Scratch,
+) -> Option<Vec3> {
+    let d = state.collision_distance;
+    let x = mesh.positions()[v as usize];
+    let query = Aabb::of_points(&[start, x]).expanded(d);
+    let own_layer = mesh.vertex_layers()[v as usize];
+    let layers = mesh.face_layers();
+    let mut ring_ready = false;
+    let mut ring = std::mem::take(&mut scratch.ring);
+    let mut nearby = std::mem::take(&mut scratch.nearby);
+    nearby.clear();
+    region.candidates(&query, scratch, |local| nearby.push(local as u32));
+    let mut t = 1.0f32;
+    for &local in &nearby {
+        if changed.is_some_and(|marks| !marks[local as usize]) {
+            continue;
+        }
+        let f = region.faces[local as usize];
+        let tri = mesh.faces()[f as usize];
+        if tri.contains(&v) || !region.boxes[local as usize].within(x, d) {
+            continue;
+        }
+        // The vertex's own neighbourhood is near by construction, not by collision.
+        if layers[f as usize] == own_layer {
+            if !ring_ready {
+                ring_vertices(mesh, v, state.ring, &mut ring);
+                ring_ready = true;
+            }
+            if tri.iter().any(|u| ring.contains(u)) {
+                continue;
+            }
+        }
+        let [a, b, c] = triangle(mesh, f);
+        let distance = |y: Vec3| closest_point_on_triangle(y, a, b, c).distance(y);
+        let here = distance(x);
+        if here >= d {
+            continue;
+        }
+        // Never closer than the collision distance, nor closer than it already was.
+        let threshold = d.min(distance(start));
+        if here >= threshold {
+            continue;
+        }
+        // Distance along the move is convex and safe at its start: bisect for the last safe
+        // fraction, always over the whole move so that the result does not depend on the
+        // order faces are met in.
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        for _ in 0..CLAMP_ROUNDS {
+            let mid = 0.5 * (lo + hi);
+            if distance(start + (x - start) * mid) >= threshold {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        t = t.min(lo);
+    }
+    scratch.ring = ring;
+    scratch.nearby = nearby;
+    (t < 1.0).then(|| start + (x - start) * t)
+}
+
 /// What the collision phase did.
 #[derive(Debug, Default)]
 pub struct CollisionOutcome {
@@ -295,8 +375,22 @@ pub struct CollisionOutcome {
     pub reverted: usize,
 }
 
-/// Proximity test and clamping of every move against the state before the step (sLayer's
-/// narrow phase), then the exact backstop. Leaves the final positions in `mesh`.
+/// Passes of the proximity test before giving up on converging (each pass only re-tests against
+/// faces that the previous one changed; two passes are the rule).
+const MAX_PASSES: usize = 8;
+
+/// Proximity test and clamping (sLayer's narrow phase and response), then the exact backstop.
+/// Leaves the final positions in `mesh`.
+///
+/// Every moving vertex is tested at its target against the faces at *their* targets — the state
+/// the step is heading for — not against where they were: a patch carried by grab or turned by
+/// twist then never collides with its own old position, and two active layers moving together
+/// keep their gap instead of colliding with each other's past. A vertex closer than the
+/// collision distance `d` to a face outside its neighbourhood is pulled back along its own move
+/// to the last point at distance `min(d, distance from its start)`. Pulling some vertices back
+/// moves their faces, so the test repeats against the faces that changed, all vertices of a
+/// pass deciding from the same state (Jacobi), which keeps the result independent of thread
+/// count and search order.
 pub fn collide(
     state: &StrokeState<'_>,
     region: &mut Region,
@@ -307,103 +401,78 @@ pub fn collide(
 ) -> CollisionOutcome {
     region.gather(state, mesh, selection, targets, target_of);
     let region: &Region = region;
-    let d = state.collision_distance;
-    let layers: &[LayerId] = mesh.face_layers();
     let before: Vec<Vec3> = selection
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
         .collect();
-
-    // Phase A: each vertex against the faces as they were before the step.
-    let mesh_view: &Mesh = mesh;
-    let clamped: Vec<(Vec3, bool)> = map_with_scratch(
-        state.parallel,
-        region.faces.len(),
-        &(0..selection.len()).collect::<Vec<_>>(),
-        |scratch, &i| {
-            let v = selection[i].0;
-            let (p, q) = (before[i], targets[i]);
-            if p == q {
-                return (q, false);
-            }
-            let query = Aabb::of_points(&[p, q]).expanded(d);
-            let own_layer = mesh_view.vertex_layers()[v as usize];
-            let mut ring_ready = false;
-            let mut ring = std::mem::take(&mut scratch.ring);
-            let mut t = 1.0f32;
-            let mut nearby = std::mem::take(&mut scratch.nearby);
-            nearby.clear();
-            region.candidates(&query, scratch, |local| nearby.push(local as u32));
-            for &local in &nearby {
-                let f = region.faces[local as usize];
-                let tri = mesh_view.faces()[f as usize];
-                if tri.contains(&v) {
-                    continue;
-                }
-                if !region.boxes[local as usize].within(q, d) {
-                    continue;
-                }
-                // The vertex's own neighbourhood is near by construction, not by collision.
-                if layers[f as usize] == own_layer {
-                    if !ring_ready {
-                        ring_vertices(mesh_view, v, state.ring, &mut ring);
-                        ring_ready = true;
-                    }
-                    if tri.iter().any(|u| ring.contains(u)) {
-                        continue;
-                    }
-                }
-                let [a, b, c] = triangle(mesh_view, f);
-                let dq = closest_point_on_triangle(q, a, b, c).distance(q);
-                if dq >= d {
-                    continue;
-                }
-                let dp = closest_point_on_triangle(p, a, b, c).distance(p);
-                let threshold = d.min(dp);
-                if dq >= threshold {
-                    continue;
-                }
-                // Distance along the move is convex: bisect for the last safe fraction.
-                // Always over the whole move, so the result for a face does not depend on
-                // the order faces are met in (the grid and the reference meet them differently).
-                let (mut lo, mut hi) = (0.0f32, 1.0f32);
-                let at = |s: f32| {
-                    let x = p + (q - p) * s;
-                    closest_point_on_triangle(x, a, b, c).distance(x)
-                };
-                for _ in 0..CLAMP_ROUNDS {
-                    let mid = 0.5 * (lo + hi);
-                    if at(mid) >= threshold {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                t = t.min(lo);
-            }
-            scratch.ring = ring;
-            scratch.nearby = nearby;
-            if t < 1.0 {
-                (p + (q - p) * t, true)
-            } else {
-                (q, false)
-            }
-        },
-    );
-    let clamped_count = clamped.iter().filter(|c| c.1).count();
     {
         let positions = mesh.positions_mut();
-        for (&(v, _), &(x, _)) in selection.iter().zip(&clamped) {
-            positions[v as usize] = x;
+        for (&(v, _), &q) in selection.iter().zip(targets) {
+            positions[v as usize] = q;
         }
     }
 
+    // Per local face: changed by the last pass (the first pass tests every face).
+    let mut changed: Option<Vec<bool>> = None;
+    for pass in 0..MAX_PASSES {
+        let moving: Vec<usize> = (0..selection.len())
+            .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
+            .collect();
+        let mesh_view: &Mesh = mesh;
+        let changed_view = changed.as_deref();
+        let pulled: Vec<Option<Vec3>> = map_with_scratch(
+            state.parallel,
+            region.faces.len(),
+            &moving,
+            |scratch, &i| {
+                pull_back(
+                    state,
+                    region,
+                    mesh_view,
+                    selection[i].0,
+                    before[i],
+                    changed_view,
+                    scratch,
+                )
+            },
+        );
+        let last_pass = pass + 1 == MAX_PASSES;
+        let mut moved_back = Vec::new();
+        {
+            let positions = mesh.positions_mut();
+            for (&i, x) in moving.iter().zip(pulled) {
+                let Some(x) = x else { continue };
+                let v = selection[i].0;
+                // Out of passes: what still collides goes back to where it was.
+                positions[v as usize] = if last_pass { before[i] } else { x };
+                moved_back.push(v);
+            }
+        }
+        if moved_back.is_empty() {
+            break;
+        }
+        let mut marks = vec![false; region.faces.len()];
+        for &v in &moved_back {
+            for f in mesh.faces_around(v) {
+                if let Some(local) = region.local(f) {
+                    marks[local] = true;
+                }
+            }
+        }
+        changed = Some(marks);
+    }
+    let clamped_count = selection
+        .iter()
+        .zip(targets)
+        .filter(|((v, _), q)| mesh.positions()[*v as usize] != **q)
+        .count();
+
     // Phase B: undo moves until no moved face crosses any face (edge–edge crossings and a
     // still vertex poking through a moving face are invisible to phase A).
-    let mut still_moved: Vec<bool> = clamped
+    let mut still_moved: Vec<bool> = selection
         .iter()
         .zip(&before)
-        .map(|(c, p)| c.0 != *p)
+        .map(|(&(v, _), p)| mesh.positions()[v as usize] != *p)
         .collect();
     let mut reverted = 0;
     loop {
