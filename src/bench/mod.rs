@@ -33,9 +33,13 @@ pub struct SceneResult {
     pub edge_band_fraction: f64,
     pub valid: bool,
     pub faces_after: usize,
+    /// One-time set-up before the first stroke (grid build, collision set-up), not in the
+    /// per-sample figures.
+    pub setup_ms: f64,
     /// Moves shortened by the proximity test, and undone by the exact backstop.
     pub collisions: usize,
     pub reverted: usize,
+    pub moves: usize,
     pub validation_error: Option<String>,
 }
 
@@ -45,6 +49,10 @@ pub struct ScalingRow {
     pub faces: usize,
     pub ms_per_sample: f64,
     pub ms_per_remesh: f64,
+    /// Work done, to check that every size did the same: samples, steps, vertex moves.
+    pub samples: usize,
+    pub steps: usize,
+    pub moves: usize,
 }
 
 /// Runs `strokes` on `mesh` and measures. `progress` is told after each stroke.
@@ -58,8 +66,11 @@ pub fn run_strokes(
 ) -> Result<SceneResult, PipelineError> {
     let (vertices, faces) = (mesh.live_vertex_count(), mesh.live_face_count());
     let mean_edge_length = mesh.edge_length_stats().mean;
+    let started = std::time::Instant::now();
+    pipeline.prepare(mesh)?;
+    let setup_ms = started.elapsed().as_secs_f64() * 1e3;
     let mut phases = PhaseTimes::default();
-    let (mut samples, mut steps, mut collisions, mut reverted) = (0, 0, 0, 0);
+    let (mut samples, mut steps, mut collisions, mut reverted, mut moves) = (0, 0, 0, 0, 0);
     for (i, stroke) in strokes.iter().enumerate() {
         let report = pipeline.apply_stroke(mesh, stroke)?;
         phases.add(&report.phases);
@@ -67,6 +78,7 @@ pub fn run_strokes(
         steps += report.steps;
         collisions += report.clamped;
         reverted += report.reverted;
+        moves += report.moves;
         progress(i + 1);
     }
     let sampling_ms = phases.total() - phases.remesh;
@@ -95,8 +107,10 @@ pub fn run_strokes(
         valid: validation.is_ok(),
         validation_error: validation.err().map(|e| e.to_string()),
         faces_after: mesh.live_face_count(),
+        setup_ms,
         collisions,
         reverted,
+        moves,
     })
 }
 

@@ -105,17 +105,20 @@ pub fn scaling_table(rows: &[ScalingRow]) -> String {
     let base = rows.first().map_or(1.0, |r| r.ms_per_sample.max(1e-9));
     let _ = writeln!(
         out,
-        "{:>10} {:>10} {:>10} {:>12}",
-        "faces", "ms/sample", "ms/remesh", "vs smallest"
+        "{:>10} {:>10} {:>10} {:>12} {:>8} {:>8} {:>9}",
+        "faces", "ms/sample", "ms/remesh", "vs smallest", "samples", "steps", "moves"
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "{:>10} {:>10.3} {:>10.1} {:>11.2}x",
+            "{:>10} {:>10.3} {:>10.1} {:>11.2}x {:>8} {:>8} {:>9}",
             r.faces,
             r.ms_per_sample,
             r.ms_per_remesh,
-            r.ms_per_sample / base
+            r.ms_per_sample / base,
+            r.samples,
+            r.steps,
+            r.moves
         );
     }
     out

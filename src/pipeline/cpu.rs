@@ -32,18 +32,32 @@ pub struct CpuPipeline {
     search: Search,
     parallel: bool,
     edge_length: Option<f32>,
-    /// Exclusion ring, cached per topology version.
-    ring: Option<(u64, u32)>,
     hook: Option<Box<dyn StrokeHook>>,
     region: Region,
-    grid: Option<KeptGrid>,
+    prepared: Option<Prepared>,
+    /// Per vertex scratch kept between strokes (reset where used).
+    target_of: Vec<u32>,
+    touched: Vec<bool>,
 }
 
-/// The grid between strokes, with the mesh version it matches.
-struct KeptGrid {
+/// What lasts between strokes: the grid and the collision set-up, with the mesh version they
+/// match. Nothing here is recomputed over the whole mesh per stroke.
+struct Prepared {
     grid: SpatialHash,
     version: MeshVersion,
+    /// Exclusion ring, and the face count it was derived at.
+    ring: u32,
+    ring_faces: usize,
+    /// A running upper bound on edge lengths, and the exact value it started from.
+    max_edge: f32,
+    exact_max_edge: f32,
 }
+
+/// The ring is re-derived when the face count has drifted this much since (remeshing keeps
+/// triangle quality, so the ring changes only with large changes of the mesh).
+const RING_REFRESH_DRIFT: f64 = 0.05;
+/// The edge bound is recomputed exactly when it has grown past this multiple of the exact value.
+const EDGE_BOUND_SLACK: f32 = 2.0;
 
 impl CpuPipeline {
     /// The fast backend: grids and all cores.
@@ -62,10 +76,11 @@ impl CpuPipeline {
             settings,
             search,
             parallel,
-            ring: None,
             hook: None,
             region: Region::default(),
-            grid: None,
+            prepared: None,
+            target_of: Vec::new(),
+            touched: Vec::new(),
         }
     }
 
@@ -77,6 +92,58 @@ impl CpuPipeline {
     /// The edge length `L` the pipeline works with (known after the first stroke).
     pub fn edge_length(&self) -> Option<f32> {
         self.edge_length
+    }
+
+    /// Brings the grid and the collision set-up up to date with `mesh`: nothing when the mesh
+    /// is as the last stroke left it, a rebuild when something else changed it.
+    fn prepare_state(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
+        let edge = match self.edge_length {
+            Some(l) => l,
+            None => {
+                let l = mesh.mean_edge_length();
+                if !(l.is_finite() && l > 0.0) {
+                    return Err(PipelineError::NoEdges);
+                }
+                self.edge_length = Some(l);
+                l
+            }
+        };
+        let version = mesh.version();
+        if let Some(prepared) = &mut self.prepared {
+            if prepared.version == version && !self.settings.rebuild_grid_every_stroke {
+                if prepared.max_edge > EDGE_BOUND_SLACK * prepared.exact_max_edge {
+                    prepared.exact_max_edge = longest_edge(mesh, None);
+                    prepared.max_edge = prepared.exact_max_edge;
+                }
+                return Ok(());
+            }
+        }
+        // Algorithm 2 rebuilds the grid per stroke. Ours is kept exact by every edit, so it is
+        // rebuilt only when something else changed the mesh (or when asked to, for comparison).
+        let grid = SpatialHash::build(mesh, edge)?;
+        let faces = mesh.face_count();
+        let (ring, ring_faces) = match &self.prepared {
+            Some(p)
+                if (faces as f64 - p.ring_faces as f64).abs()
+                    <= RING_REFRESH_DRIFT * p.ring_faces as f64 =>
+            {
+                (p.ring, p.ring_faces)
+            }
+            _ => (
+                exclusion_ring(mesh, self.settings.collision_distance * edge),
+                faces,
+            ),
+        };
+        let exact_max_edge = longest_edge(mesh, None);
+        self.prepared = Some(Prepared {
+            grid,
+            version,
+            ring,
+            ring_faces,
+            max_edge: exact_max_edge,
+            exact_max_edge,
+        });
+        Ok(())
     }
 }
 
@@ -138,6 +205,10 @@ fn frame_at(
 }
 
 impl SculptPipeline for CpuPipeline {
+    fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
+        self.prepare_state(mesh)
+    }
+
     fn name(&self) -> String {
         match (self.search, self.parallel) {
             (Search::Grid, true) => "cpu".into(),
@@ -162,58 +233,26 @@ impl SculptPipeline for CpuPipeline {
                 layer_count: mesh.layer_count(),
             });
         }
-        let edge = match self.edge_length {
-            Some(l) => l,
-            None => {
-                let l = mesh.mean_edge_length();
-                if !(l.is_finite() && l > 0.0) {
-                    return Err(PipelineError::NoEdges);
-                }
-                self.edge_length = Some(l);
-                l
-            }
+        let started = Instant::now();
+        self.prepare(mesh)?;
+        let mut times = PhaseTimes {
+            grid_update: millis(started),
+            ..PhaseTimes::default()
         };
-        let mut times = PhaseTimes::default();
         let mut report = StrokeReport::default();
-
-        // Algorithm 2 rebuilds the grid per stroke. Ours is kept exact by every edit, so it is
-        // rebuilt only when something else changed the mesh (or when asked to, for comparison).
-        let started = Instant::now();
-        let version = mesh.version();
-        let stale = match &self.grid {
-            Some(kept) => {
-                self.settings.rebuild_grid_every_stroke
-                    || kept.version != version
-                    || kept.grid.len() != mesh.live_vertex_count()
-                    || kept.grid.cell_size() != edge
-            }
-            None => true,
+        let edge = self.edge_length.unwrap_or(1.0);
+        let Some(Prepared {
+            mut grid,
+            ring,
+            mut max_edge,
+            exact_max_edge,
+            ring_faces,
+            ..
+        }) = self.prepared.take()
+        else {
+            return Err(PipelineError::NoEdges);
         };
-        if stale {
-            self.grid = Some(KeptGrid {
-                grid: SpatialHash::build(mesh, edge)?,
-                version,
-            });
-        }
-        let mut grid = match self.grid.take() {
-            Some(kept) => kept.grid,
-            None => SpatialHash::build(mesh, edge)?,
-        };
-        times.grid_update += millis(started);
-
-        let started = Instant::now();
         let distance = self.settings.collision_distance * edge;
-        let topology = mesh.version().topology;
-        let ring = match self.ring {
-            Some((version, ring)) if version == topology => ring,
-            _ => {
-                let ring = exclusion_ring(mesh, distance);
-                self.ring = Some((topology, ring));
-                ring
-            }
-        };
-        let mut max_edge = longest_edge(mesh, None);
-        times.collision += millis(started);
 
         let mut active = vec![false; mesh.layer_count()];
         for &l in &stroke.layers {
@@ -222,8 +261,10 @@ impl SculptPipeline for CpuPipeline {
         let step_limit = self.settings.max_step * edge;
         let samples = resample(&stroke.samples, stroke.spacing * stroke.brush.radius);
         report.samples = samples.len();
-        let mut target_of = vec![INVALID; mesh.vertex_count()];
-        let mut touched = vec![false; mesh.vertex_count()];
+        let mut target_of = std::mem::take(&mut self.target_of);
+        target_of.resize(mesh.vertex_count(), INVALID);
+        let mut touched = std::mem::take(&mut self.touched);
+        touched.resize(mesh.vertex_count(), false);
         let mut touched_list = Vec::new();
         let mut moved_in_sample = Vec::new();
         let mut previous: Option<Vec3> = None;
@@ -379,17 +420,33 @@ impl SculptPipeline for CpuPipeline {
         }
 
         touched_list.sort_unstable();
+        for &v in &touched_list {
+            touched[v as usize] = false;
+        }
+        self.target_of = target_of;
+        self.touched = touched;
         report.touched = touched_list.len();
         let mut grid_current = true;
         if let Some(hook) = self.hook.as_mut() {
             let started = Instant::now();
             grid_current = hook.after_stroke(mesh, &touched_list, &mut grid)?;
+            // The hook edits faces around the stroke only: their edges bound the change.
+            let around: Vec<u32> = touched_list
+                .iter()
+                .filter(|&&v| (v as usize) < mesh.vertex_count() && !mesh.is_vertex_dead(v))
+                .flat_map(|&v| mesh.faces_around(v))
+                .collect();
+            max_edge = max_edge.max(longest_edge(mesh, Some(&around)));
             times.remesh += millis(started);
         }
         if grid_current {
-            self.grid = Some(KeptGrid {
+            self.prepared = Some(Prepared {
                 grid,
                 version: mesh.version(),
+                ring,
+                ring_faces,
+                max_edge,
+                exact_max_edge,
             });
         }
         report.phases = times;

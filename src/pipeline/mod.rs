@@ -130,6 +130,9 @@ pub trait StrokeHook: Send {
 pub trait SculptPipeline {
     /// Name for reports ("cpu", "cpu-reference", "gpu").
     fn name(&self) -> String;
+    /// Builds what strokes need (grid, uploads) ahead of time; `apply_stroke` does it when
+    /// needed, so calling this only moves the one-time cost out of the first stroke.
+    fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError>;
     fn apply_stroke(
         &mut self,
         mesh: &mut Mesh,

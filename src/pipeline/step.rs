@@ -475,13 +475,17 @@ pub fn collide(
         .map(|(&(v, _), p)| mesh.positions()[v as usize] != *p)
         .collect();
     let mut reverted = 0;
+    // First every moved face; after an undo, only the faces around the vertices put back (the
+    // others have not moved since they were found clean).
+    let mut changed: Vec<u32> = selection
+        .iter()
+        .zip(&still_moved)
+        .filter(|(_, m)| **m)
+        .map(|(&(v, _), _)| v)
+        .collect();
     loop {
-        let mut moving_faces: Vec<u32> = selection
-            .iter()
-            .zip(&still_moved)
-            .filter(|(_, m)| **m)
-            .flat_map(|(&(v, _), _)| mesh.faces_around(v))
-            .collect();
+        let mut moving_faces: Vec<u32> =
+            changed.iter().flat_map(|&v| mesh.faces_around(v)).collect();
         moving_faces.sort_unstable();
         moving_faces.dedup();
         if moving_faces.is_empty() {
@@ -539,10 +543,11 @@ pub fn collide(
         }
         let undone = undo.len();
         let positions = mesh.positions_mut();
-        for v in undo {
+        for &v in &undo {
             positions[v as usize] = before[target_of[v as usize] as usize];
         }
         reverted += undone;
+        changed = undo;
         if undone == 0 {
             // Crossings that involve no moving vertex were there before the step.
             break;

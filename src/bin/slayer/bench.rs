@@ -89,6 +89,9 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 faces: r.faces,
                 ms_per_sample: r.ms_per_sample,
                 ms_per_remesh: r.ms_per_remesh,
+                samples: r.samples,
+                steps: r.steps,
+                moves: r.moves,
             });
         }
         println!("scaling: the same strokes (radius 12 L) on plaster of growing size");
