@@ -203,7 +203,183 @@ fn demo_writes_and_checks_the_default_material() {
         text(&out.stdout),
         text(&out.stderr)
     );
-    assert!(dir.join("plaster.ply").exists() && dir.join("plaster.obj").exists());
-    assert!(text(&out.stdout).contains("ok: no defects"));
+    for file in [
+        "plaster.ply",
+        "strokes.json",
+        "plaster-sculpted.ply",
+        "plaster-sculpted.obj",
+    ] {
+        assert!(dir.join(file).exists(), "{file}");
+    }
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("sLayer paper, Table 1"), "{stdout}");
+    assert!(stdout.contains("ok: no defects"), "{stdout}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn strokes_then_sculpt_round_trip_with_stats() {
+    let dir = scratch("sculpt");
+    let input = dir.join("in.ply");
+    let strokes = dir.join("s.json");
+    let output = dir.join("out.obj");
+    let stats = dir.join("stats.json");
+    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
+    assert!(
+        slayer(&["scene", "plaster", "--triangles", "20000", "-o", &p(&input)])
+            .status
+            .success()
+    );
+    let out = slayer(&[
+        "strokes",
+        "--scene",
+        "plaster",
+        "--triangles",
+        "20000",
+        "--count",
+        "3",
+        "-o",
+        &p(&strokes),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = slayer(&[
+        "sculpt",
+        "--input",
+        &p(&input),
+        "--strokes",
+        &p(&strokes),
+        "--output",
+        &p(&output),
+        "--stats",
+        &p(&stats),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let check = slayer(&["check", &p(&output), "--json"]);
+    assert!(check.status.success(), "{}", text(&check.stdout));
+    let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(stats["strokes"].as_array().unwrap().len(), 3);
+    assert!(
+        stats["strokes"][0]["phases"]["collision"]
+            .as_f64()
+            .is_some()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn sculpt_with_a_bad_stroke_file_fails_cleanly_and_touches_nothing() {
+    let dir = scratch("bad-strokes");
+    let input = dir.join("in.obj");
+    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
+    assert!(
+        slayer(&["scene", "plane", "--triangles", "2000", "-o", &p(&input)])
+            .status
+            .success()
+    );
+    let original = std::fs::read(&input).unwrap();
+    let modified = std::fs::metadata(&input).unwrap().modified().unwrap();
+    let cases = [
+        (
+            r#"{"strokes": [{"brush": "smudge", "radius": 0.1, "strength": 0.5, "layers": [0], "samples": [{"position": [0.5, 0.5, 0]}]}]}"#,
+            "unknown variant `smudge`",
+        ),
+        (
+            r#"{"strokes": [{"brush": "draw", "radius": -0.1, "strength": 0.5, "layers": [0], "samples": [{"position": [0.5, 0.5, 0]}]}]}"#,
+            "strokes[0].radius",
+        ),
+        (
+            r#"{"strokes": [{"brush": "draw", "radius": 0.1, "strength": 0.5, "layers": [3], "samples": [{"position": [0.5, 0.5, 0]}]}]}"#,
+            "layer 3 does not exist",
+        ),
+        (
+            r#"{"strokes": [{"brush": "draw", "radius": 0.1, "layers": [0], "samples": []}]}"#,
+            "missing field `strength`",
+        ),
+        ("not json", "s.json:1:"),
+    ];
+    for (content, expected) in cases {
+        let strokes = write(&dir, "s.json", content.as_bytes());
+        let output = dir.join("out.obj");
+        let out = slayer(&[
+            "sculpt",
+            "--input",
+            &p(&input),
+            "--strokes",
+            &strokes,
+            "--output",
+            &p(&output),
+        ]);
+        assert_one_line_error(&out, &[expected]);
+        assert!(!output.exists(), "no output is written");
+    }
+    assert!(
+        std::fs::read(&input).unwrap() == original,
+        "the input is untouched"
+    );
+    assert_eq!(
+        std::fs::metadata(&input).unwrap().modified().unwrap(),
+        modified
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bench_writes_the_fixed_json_fields() {
+    let dir = scratch("bench");
+    let json = dir.join("out.json");
+    let out = slayer(&[
+        "bench",
+        "--scene",
+        "metal",
+        "--triangles",
+        "20000",
+        "--strokes",
+        "3",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    assert!(text(&out.stdout).contains("sLayer paper, Table 1"));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    for field in ["backend", "adapter", "threads", "revision", "scenes"] {
+        assert!(report.get(field).is_some(), "missing {field}");
+    }
+    let scene = &report["scenes"][0];
+    for field in [
+        "name",
+        "layers",
+        "vertices",
+        "faces",
+        "mean_edge_length",
+        "strokes",
+        "samples",
+        "phase_ms",
+        "ms_per_sample",
+        "ms_per_stroke",
+        "ms_per_remesh",
+        "intersections",
+        "edge_band_fraction",
+        "valid",
+        "faces_after",
+    ] {
+        assert!(scene.get(field).is_some(), "missing scenes[0].{field}");
+    }
+    for phase in [
+        "selection",
+        "deformation",
+        "grid_update",
+        "collision",
+        "remesh",
+    ] {
+        assert!(scene["phase_ms"][phase].as_f64().is_some(), "phase {phase}");
+    }
+    assert_eq!(scene["intersections"], 0);
+    assert_eq!(scene["valid"], true);
+    assert_eq!(scene["strokes"], 3);
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -226,8 +226,8 @@ fn masked_vertices_and_inactive_layers_stay_still() {
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
     assert!(report.moves > 0);
-    for v in 0..mesh.vertex_count() {
-        let moved = mesh.positions()[v] != before[v];
+    for (v, old) in before.iter().enumerate() {
+        let moved = mesh.positions()[v] != *old;
         let layer = mesh.vertex_layers()[v];
         if layer == 1 || (layer == 2 && v % 2 == 0) {
             assert!(!moved, "vertex {v} on layer {layer} moved");

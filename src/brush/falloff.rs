@@ -29,7 +29,8 @@ impl Falloff {
     /// The weight at normalized distance `t = distance / radius`.
     #[inline]
     pub fn weight(&self, t: f32) -> f32 {
-        if !(t < 1.0) {
+        // NaN and everything past the rim weigh nothing.
+        if t.is_nan() || t >= 1.0 {
             return 0.0;
         }
         let t = t.max(0.0);

@@ -319,7 +319,7 @@ pub fn resample(samples: &[Sample], step: f32) -> Vec<Sample> {
     let Some(first) = samples.first() else {
         return Vec::new();
     };
-    if samples.len() == 1 || !(step > 0.0) {
+    if samples.len() == 1 || step.is_nan() || step <= 0.0 {
         return samples.to_vec();
     }
     let mut out = vec![*first];

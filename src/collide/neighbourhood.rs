@@ -25,7 +25,7 @@ pub const MAX_RING: u32 = 4;
 /// The graph distance `r` whose faces a vertex skips, for collision distance `distance`.
 pub fn exclusion_ring(mesh: &Mesh, distance: f32) -> u32 {
     let rho = altitude_bound(mesh);
-    if !(rho > 0.0) {
+    if rho.is_nan() || rho <= 0.0 {
         return MAX_RING;
     }
     let r = (distance as f64 / rho).ceil() - 1.0;

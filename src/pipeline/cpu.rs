@@ -109,14 +109,15 @@ impl CpuPipeline {
             }
         };
         let version = mesh.version();
-        if let Some(prepared) = &mut self.prepared {
-            if prepared.version == version && !self.settings.rebuild_grid_every_stroke {
-                if prepared.max_edge > EDGE_BOUND_SLACK * prepared.exact_max_edge {
-                    prepared.exact_max_edge = longest_edge(mesh, None);
-                    prepared.max_edge = prepared.exact_max_edge;
-                }
-                return Ok(());
+        if let Some(prepared) = &mut self.prepared
+            && prepared.version == version
+            && !self.settings.rebuild_grid_every_stroke
+        {
+            if prepared.max_edge > EDGE_BOUND_SLACK * prepared.exact_max_edge {
+                prepared.exact_max_edge = longest_edge(mesh, None);
+                prepared.max_edge = prepared.exact_max_edge;
             }
+            return Ok(());
         }
         // Algorithm 2 rebuilds the grid per stroke. Ours is kept exact by every edit, so it is
         // rebuilt only when something else changed the mesh (or when asked to, for comparison).

@@ -9,7 +9,7 @@
 //! collision, remesh.
 
 mod cpu;
-mod step;
+pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
 

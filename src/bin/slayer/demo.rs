@@ -3,11 +3,17 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
+use slayer::bench::{ScriptSpec, generate_script, paper_table, run_strokes};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
-use crate::progress::Steps;
+use crate::progress::{Bar, Steps};
 
-/// Generates the default material (peeling plaster), writes it and checks the written file.
+/// Strokes in the demo's script: enough to see every brush of the bench mix at work.
+const DEMO_STROKES: usize = 12;
+
+/// Generates the default material (peeling plaster), sculpts it with a short seeded stroke
+/// script, writes the material before and after, checks the result and prints the timings.
 pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let spec = SceneSpec {
@@ -21,23 +27,60 @@ pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
     let started = Instant::now();
     let steps = Steps::new("demo");
     steps.step("generating");
-    let mesh = generate(&spec)?;
-    let path = out.join("plaster.ply");
-    steps.step(&format!("writing {}", path.display()));
-    slayer::io::write_mesh(&mesh, &path)?;
-    let obj = out.join("plaster.obj");
-    steps.step(&format!("writing {}", obj.display()));
-    slayer::io::write_mesh(&mesh, &obj)?;
+    let mut mesh = generate(&spec)?;
+    let before = out.join("plaster.ply");
+    steps.step(&format!("writing {}", before.display()));
+    slayer::io::write_mesh(&mesh, &before)?;
+    let script = generate_script(
+        &mesh,
+        &ScriptSpec {
+            strokes: DEMO_STROKES,
+            ..ScriptSpec::default()
+        },
+    );
+    let strokes_path = out.join("strokes.json");
+    slayer::io::write_atomically(&strokes_path, script.to_json().as_bytes())?;
+    let strokes = script.resolve(&mesh, &strokes_path.display().to_string())?;
     steps.finish();
     println!(
-        "  generated {} layers, {} vertices, {} faces in {:.1} s",
+        "  generated {} layers, {} vertices, {} faces in {:.1} s -> {}",
         mesh.layer_count(),
         mesh.live_vertex_count(),
         mesh.live_face_count(),
-        started.elapsed().as_secs_f64()
+        started.elapsed().as_secs_f64(),
+        before.display()
     );
-    println!("  wrote {} and {}", path.display(), obj.display());
-    let report = crate::check::report(&path)?;
+
+    let mut pipeline = CpuPipeline::new(PipelineSettings::default());
+    println!(
+        "  sculpting {} strokes ({}) on the {} backend -> {}",
+        strokes.len(),
+        strokes
+            .iter()
+            .map(|s| s.brush.kind.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        pipeline.name(),
+        strokes_path.display()
+    );
+    let bar = Bar::new("sculpt", strokes.len() as u64);
+    let result = run_strokes(
+        "plaster",
+        &mut mesh,
+        &strokes,
+        &mut pipeline,
+        |_| bar.inc(),
+        true,
+    )?;
+    bar.finish();
+    println!("{}", paper_table(std::slice::from_ref(&result)));
+
+    let after = out.join("plaster-sculpted.ply");
+    let after_obj = out.join("plaster-sculpted.obj");
+    slayer::io::write_mesh(&mesh, &after)?;
+    slayer::io::write_mesh(&mesh, &after_obj)?;
+    println!("  wrote {} and {}", after.display(), after_obj.display());
+    let report = crate::check::report(&after)?;
     println!("{report}");
     Ok(if report.is_clean() {
         ExitCode::SUCCESS

@@ -1,0 +1,89 @@
+//! The brush pipeline's phases on their own (CPU): selection through the grid, deformation,
+//! and collision (proximity clamping plus the exact backstop) for one draw dab pressing the
+//! upper layers of a 200K-face plaster scene into the base.
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
+use slayer::collide::neighbourhood::exclusion_ring;
+use slayer::grid::SpatialHash;
+use slayer::mesh::INVALID;
+use slayer::pipeline::step::{Region, StrokeState, collide, deform, select};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+use std::hint::black_box;
+
+fn phases(c: &mut Criterion) {
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 200_000,
+        seed: 1,
+    })
+    .unwrap();
+    let edge = mesh.mean_edge_length();
+    let grid = SpatialHash::build(&mesh, edge).unwrap();
+    let active = vec![false, true, true];
+    let state = StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: true,
+        collision_distance: edge,
+        ring: exclusion_ring(&mesh, edge),
+        max_edge: mesh.edge_length_stats().max as f32,
+    };
+    // The middle of the paint layer, pushed down hard.
+    let (lo, hi) = mesh.bounds().unwrap();
+    let center = (lo + hi) * 0.5;
+    let top = (0..mesh.vertex_count())
+        .filter(|&v| mesh.vertex_layers()[v] == 1)
+        .min_by(|&a, &b| {
+            mesh.positions()[a]
+                .truncate()
+                .distance(center.truncate())
+                .total_cmp(&mesh.positions()[b].truncate().distance(center.truncate()))
+        })
+        .unwrap();
+    let dab = Dab {
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius: 12.0 * edge,
+            strength: 1.0,
+            falloff: Falloff::Blend { n: 3 },
+            invert: true,
+        },
+        frame: DabFrame {
+            center: mesh.positions()[top],
+            normal: Vec3::Z,
+            plane_point: mesh.positions()[top],
+            motion: Vec3::ZERO,
+        },
+        pressure: 1.0,
+        share: 1.0,
+    };
+    let selection = select(&state, &mesh, &dab);
+    let targets = deform(&state, &mesh, &dab, &selection);
+    let mut target_of = vec![INVALID; mesh.vertex_count()];
+    for (i, &(v, _)) in selection.iter().enumerate() {
+        target_of[v as usize] = i as u32;
+    }
+
+    let mut group = c.benchmark_group("pipeline");
+    group.sample_size(30);
+    group.bench_function(format!("select ({} vertices)", selection.len()), |b| {
+        b.iter(|| select(&state, black_box(&mesh), &dab).len())
+    });
+    group.bench_function("deform", |b| {
+        b.iter(|| deform(&state, black_box(&mesh), &dab, &selection).len())
+    });
+    let mut region = Region::default();
+    group.bench_function("collide", |b| {
+        b.iter_batched_ref(
+            || mesh.clone(),
+            |m| collide(&state, &mut region, m, &selection, &targets, &target_of).clamped,
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, phases);
+criterion_main!(benches);
