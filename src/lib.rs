@@ -18,4 +18,5 @@ pub mod io;
 pub mod material;
 pub mod mesh;
 pub mod pipeline;
+pub mod remesh;
 pub mod scene;

@@ -10,7 +10,7 @@ mod tri_tri;
 pub use closest_point::{closest_point_on_triangle, point_triangle_distance_squared};
 pub use ray::{Ray, ray_triangle};
 pub use separation::surely_disjoint;
-pub use tri_tri::triangles_intersect;
+pub use tri_tri::{neighbours_overlap, triangles_intersect};
 
 use glam::Vec3;
 

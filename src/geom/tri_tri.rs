@@ -175,3 +175,40 @@ fn segments_intersect_2d(p: Coord<f64>, q: Coord<f64>, r: Coord<f64>, s: Coord<f
         || (d3 == 0 && on_segment_2d(p, q, r))
         || (d4 == 0 && on_segment_2d(p, q, s))
 }
+
+/// True when two triangles that share one or two vertices (given by `ids`) meet anywhere
+/// beyond what they share: a fold that the pair test, which skips neighbours, cannot see.
+///
+/// Sharing one vertex `v`: both triangles contain `v`, so any further common point gives a
+/// common segment from `v`, which ends on the far edge of one of them inside the other; the
+/// far-edge tests are therefore complete. Sharing an edge: only coplanar triangles on the same
+/// side of it overlap.
+pub fn neighbours_overlap(a: [Vec3; 3], a_ids: [u32; 3], b: [Vec3; 3], b_ids: [u32; 3]) -> bool {
+    let shared: Vec<usize> = (0..3).filter(|&i| b_ids.contains(&a_ids[i])).collect();
+    let da = a.map(|p| p.as_dvec3());
+    let db = b.map(|p| p.as_dvec3());
+    match shared.len() {
+        1 => {
+            let i = shared[0];
+            let j = (0..3).find(|&j| b_ids[j] == a_ids[i]).unwrap_or(0);
+            let (a1, a2) = (da[(i + 1) % 3], da[(i + 2) % 3]);
+            let (b1, b2) = (db[(j + 1) % 3], db[(j + 2) % 3]);
+            (!is_degenerate(db) && segment_meets_triangle(a1, a2, db))
+                || (!is_degenerate(da) && segment_meets_triangle(b1, b2, da))
+        }
+        2 => {
+            let far_a = (0..3).find(|i| !shared.contains(i)).unwrap_or(0);
+            let far_b = (0..3).find(|&j| !a_ids.contains(&b_ids[j])).unwrap_or(0);
+            let (p, q) = (da[shared[0]], da[shared[1]]);
+            if orient(p, q, da[far_a], db[far_b]) != 0.0 || is_degenerate(da) {
+                return false;
+            }
+            let axis = projection_axis(da);
+            let side = |x: DVec3| {
+                orient_sign_2d(drop_axis(p, axis), drop_axis(q, axis), drop_axis(x, axis))
+            };
+            side(da[far_a]) * side(db[far_b]) > 0
+        }
+        _ => false,
+    }
+}

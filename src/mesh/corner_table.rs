@@ -165,7 +165,7 @@ impl CornerTable {
         loop {
             count += 1;
             c = self.swing_right(c);
-            if c == INVALID || c == start || count > self.opposite.len() as u32 {
+            if c == INVALID || c == start || count >= MAX_FAN {
                 return count;
             }
         }
@@ -178,6 +178,7 @@ impl CornerTable {
             table: self,
             start,
             current: start,
+            remaining: MAX_FAN,
         }
     }
 }
@@ -187,15 +188,21 @@ pub struct FanIter<'a> {
     table: &'a CornerTable,
     start: u32,
     current: u32,
+    /// A fan never has more corners than this; a corrupted table cannot loop forever.
+    remaining: u32,
 }
+
+/// Most corners a fan walk visits (a valence far beyond any real mesh).
+pub const MAX_FAN: u32 = 1 << 16;
 
 impl Iterator for FanIter<'_> {
     type Item = u32;
 
     fn next(&mut self) -> Option<u32> {
-        if self.current == INVALID {
+        if self.current == INVALID || self.remaining == 0 {
             return None;
         }
+        self.remaining -= 1;
         let c = self.current;
         let n = self.table.swing_right(c);
         self.current = if n == self.start { INVALID } else { n };

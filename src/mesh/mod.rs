@@ -8,6 +8,7 @@
 mod attributes;
 mod components;
 mod corner_table;
+mod edit;
 mod error;
 mod measure;
 mod validate;

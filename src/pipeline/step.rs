@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use crate::brush::{Dab, displacement};
 use crate::collide::LocalFaceGrid;
 use crate::collide::neighbourhood::ring_vertices;
-use crate::geom::{Aabb, closest_point_on_triangle, triangles_intersect};
+use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, VertexFlags};
 
@@ -291,6 +291,10 @@ impl Region {
 /// cells per axis and a proximity query a handful.
 const LOCAL_CELL_EDGES: f32 = 1.5;
 
+fn face_normal(t: [Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0])
+}
+
 fn triangle(mesh: &Mesh, f: u32) -> [Vec3; 3] {
     mesh.face_positions(f as usize)
 }
@@ -502,6 +506,35 @@ pub fn collide(
                 let box_f = Aabb::of_points(&tri_f);
                 let faces = mesh_view.faces();
                 let mut found = Vec::new();
+                // A face turned over onto its neighbours (a fold within a fan, which twist and
+                // pinch can make) shares vertices with everything it overlaps, so no pair test
+                // sees it; its normal reversing does.
+                let old = faces[f as usize].map(|w| {
+                    let slot = target_of[w as usize];
+                    if slot == INVALID {
+                        mesh_view.positions()[w as usize]
+                    } else {
+                        before[slot as usize]
+                    }
+                });
+                let (n_old, n_new) = (face_normal(old), face_normal(tri_f));
+                if n_old.dot(n_new) <= 0.0 && n_old != Vec3::ZERO {
+                    found.push((f, f));
+                }
+                // Nor may the step fold two faces around a shared vertex onto each other: they
+                // overlap while sharing a vertex, which the pair test skips.
+                let ids_f = faces[f as usize];
+                for w in ids_f {
+                    for g in mesh_view.faces_around(w) {
+                        if g == f || (g < f && is_moving(g)) {
+                            continue;
+                        }
+                        let tri_g = triangle(mesh_view, g);
+                        if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
+                            found.push((f.min(g), f.max(g)));
+                        }
+                    }
+                }
                 region.candidates(&box_f, scratch, |local| {
                     let g = region.faces[local];
                     if g == f || (g < f && is_moving(g)) {
@@ -531,6 +564,7 @@ pub fn collide(
         pairs.sort_unstable();
         let mut undo: Vec<u32> = Vec::new();
         for (f, g) in pairs {
+            // (f, f) marks a face that turned over.
             for face in [f, g] {
                 for v in mesh.faces()[face as usize] {
                     let slot = target_of[v as usize];

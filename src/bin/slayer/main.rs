@@ -4,6 +4,7 @@ mod bench;
 mod check;
 mod demo;
 mod progress;
+mod remesh;
 mod scene;
 mod sculpt;
 mod strokes;
@@ -68,6 +69,15 @@ enum Command {
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
+    },
+    /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax).
+    Remesh {
+        file: PathBuf,
+        /// Target edge length; the mesh's mean edge length by default.
+        #[arg(long)]
+        edge: Option<f32>,
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Write the bench's seeded stroke script for a scene.
     Strokes {
@@ -137,6 +147,7 @@ fn main() -> ExitCode {
             output,
             stats,
         } => sculpt::run(&input, &strokes, &output, stats.as_deref()),
+        Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
         Command::Strokes {
             scene,
             triangles,

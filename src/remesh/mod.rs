@@ -1,0 +1,637 @@
+//! Local adaptive isotropic remeshing after each stroke (Dunyach et al. 2013, in the loop of
+//! Botsch & Kobbelt 2004; DESIGN §4): within the faces around every vertex the stroke touched,
+//! plus a ring, split edges longer than 4/3·L, collapse edges shorter than 4/5·L, flip edges
+//! toward valence 6 (4 on boundaries), and relax vertices tangentially with projection back onto
+//! the surface as it was before remeshing. L stays constant: sLayer's edge length assumption.
+//!
+//! Remeshing never creates interpenetration: a vertex moved by a collapse or by relaxation may
+//! not come closer than the collision distance to another layer (or to a part of its own layer
+//! outside its neighbourhood) than it already was, and the triangles a flip or a collapse
+//! creates are tested exactly against the other layers' triangles nearby. Splits do not move
+//! the surface. The grid is kept up to date through every edit.
+
+mod reference;
+
+use std::time::Instant;
+
+use glam::Vec3;
+use serde::Serialize;
+
+use crate::collide::neighbourhood::ring_vertices;
+use crate::geom::{Aabb, closest_point_on_triangle, triangles_intersect};
+use crate::grid::SpatialHash;
+use crate::mesh::{INVALID, Mesh, next, prev};
+use crate::pipeline::{PipelineError, StrokeHook};
+use reference::ReferenceSurface;
+
+/// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
+pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
+pub const COLLAPSE_BELOW: f32 = 4.0 / 5.0;
+/// A collapse or flip may not turn a face's normal by more than this (cosine).
+const MIN_NORMAL_COSINE: f32 = 0.5;
+/// A flip may only replace a nearly flat pair of faces (cosine of the dihedral deviation), so
+/// the surface keeps its shape.
+const FLIP_FLATNESS_COSINE: f32 = 0.94;
+/// Faces thinner than this share of L² are not created.
+const MIN_AREA_SHARE: f32 = 0.01;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RemeshSettings {
+    /// Target edge length `L`.
+    pub target_edge: f32,
+    /// Split / collapse / flip / relax rounds.
+    pub iterations: usize,
+    /// Rings of vertices added around the touched ones.
+    pub region_rings: u32,
+    /// Collision distance (world units) and the neighbourhood ring a vertex skips.
+    pub collision_distance: f32,
+    pub exclusion_ring: u32,
+}
+
+impl RemeshSettings {
+    pub fn new(target_edge: f32) -> Self {
+        RemeshSettings {
+            target_edge,
+            iterations: 3,
+            region_rings: 2,
+            collision_distance: target_edge,
+            exclusion_ring: 1,
+        }
+    }
+}
+
+/// What a remesh did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RemeshReport {
+    pub region_vertices: usize,
+    pub splits: usize,
+    pub collapses: usize,
+    pub flips: usize,
+    pub relaxed: usize,
+    /// Moves and edits refused because they would have come too close to another surface.
+    pub refused: usize,
+    pub millis: f64,
+}
+
+/// Remeshes the region around `seeds` (the vertices a stroke moved), keeping `grid` exact.
+pub fn remesh_region(
+    mesh: &mut Mesh,
+    grid: &mut SpatialHash,
+    seeds: &[u32],
+    settings: &RemeshSettings,
+) -> RemeshReport {
+    let started = Instant::now();
+    let mut remesher = Remesher::new(mesh, grid, seeds, settings);
+    for _ in 0..settings.iterations {
+        remesher.split_long_edges();
+        remesher.collapse_short_edges();
+        remesher.flip_toward_regular_valence();
+        remesher.relax();
+    }
+    let mut report = remesher.finish();
+    report.millis = started.elapsed().as_secs_f64() * 1e3;
+    report
+}
+
+/// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`).
+pub fn remesh_all(
+    mesh: &mut Mesh,
+    settings: &RemeshSettings,
+) -> Result<RemeshReport, PipelineError> {
+    let mut grid = SpatialHash::build(mesh, settings.target_edge)?;
+    let seeds: Vec<u32> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| {
+            !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
+        })
+        .collect();
+    let report = remesh_region(
+        mesh,
+        &mut grid,
+        &seeds,
+        &RemeshSettings {
+            region_rings: 0,
+            ..*settings
+        },
+    );
+    mesh.compact();
+    Ok(report)
+}
+
+struct Remesher<'a> {
+    mesh: &'a mut Mesh,
+    grid: &'a mut SpatialHash,
+    settings: RemeshSettings,
+    /// Region vertices (grows with splits; dead ones are skipped).
+    region: Vec<u32>,
+    in_region: Vec<bool>,
+    surface: ReferenceSurface,
+    report: RemeshReport,
+    scratch: Vec<u32>,
+}
+
+impl<'a> Remesher<'a> {
+    fn new(
+        mesh: &'a mut Mesh,
+        grid: &'a mut SpatialHash,
+        seeds: &[u32],
+        settings: &RemeshSettings,
+    ) -> Self {
+        let mut in_region = vec![false; mesh.vertex_count()];
+        let mut region = Vec::new();
+        for &v in seeds {
+            if (v as usize) < mesh.vertex_count()
+                && !mesh.is_vertex_dead(v)
+                && !in_region[v as usize]
+            {
+                in_region[v as usize] = true;
+                region.push(v);
+            }
+        }
+        let mut frontier = region.clone();
+        for _ in 0..settings.region_rings {
+            let mut next_frontier = Vec::new();
+            for &v in &frontier {
+                for u in mesh.neighbours(v) {
+                    if !in_region[u as usize] {
+                        in_region[u as usize] = true;
+                        region.push(u);
+                        next_frontier.push(u);
+                    }
+                }
+            }
+            frontier = next_frontier;
+        }
+        region.sort_unstable();
+        let surface = ReferenceSurface::capture(mesh, grid, &region, settings);
+        Remesher {
+            report: RemeshReport {
+                region_vertices: region.len(),
+                ..RemeshReport::default()
+            },
+            mesh,
+            grid,
+            settings: *settings,
+            region,
+            in_region,
+            surface,
+            scratch: Vec::new(),
+        }
+    }
+
+    fn finish(self) -> RemeshReport {
+        let live: Vec<u32> = self
+            .region
+            .iter()
+            .copied()
+            .filter(|&v| !self.mesh.is_vertex_dead(v))
+            .collect();
+        let mut refresh: Vec<u32> = live
+            .iter()
+            .flat_map(|&v| {
+                self.mesh
+                    .faces_around(v)
+                    .flat_map(|f| self.mesh.faces()[f as usize])
+            })
+            .collect();
+        refresh.sort_unstable();
+        refresh.dedup();
+        self.mesh.recompute_normals_at(&refresh);
+        self.report
+    }
+
+    fn live(&self, v: u32) -> bool {
+        !self.mesh.is_vertex_dead(v) && self.mesh.adjacency().vertex_corner[v as usize] != INVALID
+    }
+
+    /// Edges with both ends in the region, each once, as corners. (Edges leaving the region
+    /// are left alone: the ring around the touched vertices is the margin.)
+    fn region_edges(&self) -> Vec<u32> {
+        let mut edges = Vec::new();
+        for &v in &self.region {
+            if self.live(v) {
+                self.push_edges_at(v, &mut edges);
+            }
+        }
+        edges
+    }
+
+    /// The region edges at `v` that `v` owns (the lower-numbered end), as corners.
+    fn push_edges_at(&self, v: u32, edges: &mut Vec<u32>) {
+        let owned = |u: u32| v < u && self.in_region.get(u as usize).copied().unwrap_or(false);
+        for c in self.mesh.adjacency().corners_around(v) {
+            // Around v, corner c's face holds edge (v, next), opposite prev(c).
+            if owned(self.mesh.corner_vertex(next(c))) {
+                edges.push(prev(c));
+            }
+        }
+        if self.mesh.is_boundary_vertex(v) {
+            // The boundary edge the fan starts from, (prev(first), v), opposite next(first).
+            let first = self.mesh.adjacency().vertex_corner[v as usize];
+            if owned(self.mesh.corner_vertex(prev(first))) {
+                edges.push(next(first));
+            }
+        }
+    }
+
+    fn length(&self, corner: u32) -> f32 {
+        let (a, b) = self.mesh.edge_vertices(corner);
+        self.mesh.positions()[a as usize].distance(self.mesh.positions()[b as usize])
+    }
+
+    fn add_to_region(&mut self, v: u32) {
+        if v as usize >= self.in_region.len() {
+            self.in_region.resize(v as usize + 1, false);
+        }
+        if !self.in_region[v as usize] {
+            self.in_region[v as usize] = true;
+            self.region.push(v);
+        }
+    }
+
+    /// Splits edges longer than 4/3·L at their midpoints, longest first: splitting the longest
+    /// edge of a stretched triangle first is what makes the process converge (splitting its
+    /// shorter edges first can create ever new edges toward the far corners).
+    fn split_long_edges(&mut self) {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        let limit = SPLIT_ABOVE * self.settings.target_edge;
+        let mut heap: BinaryHeap<(u32, Reverse<u32>)> = BinaryHeap::new();
+        let push = |heap: &mut BinaryHeap<(u32, Reverse<u32>)>, length: f32, corner: u32| {
+            if length > limit {
+                // Positive floats order like their bits.
+                heap.push((length.to_bits(), Reverse(corner)));
+            }
+        };
+        for c in self.region_edges() {
+            push(&mut heap, self.length(c), c);
+        }
+        // The number of splits needed follows the area; the cap (far above it) only guards
+        // against a pathological configuration.
+        let mut budget = 64 * self.region.len() + 1024;
+        while let Some((bits, Reverse(c))) = heap.pop() {
+            if self.mesh.is_face_dead((c / 3) as usize) {
+                continue;
+            }
+            let (a, b) = self.mesh.edge_vertices(c);
+            if !(self.in_region[a as usize] && self.in_region[b as usize]) {
+                continue;
+            }
+            let length = self.length(c);
+            if length <= limit {
+                continue;
+            }
+            if length.to_bits() != bits {
+                // The corner names another edge now; queue it at its own length.
+                push(&mut heap, length, c);
+                continue;
+            }
+            if budget == 0 {
+                break;
+            }
+            budget -= 1;
+            let (f, o) = (c / 3, self.mesh.adjacency().opposite[c as usize]);
+            let first_new = self.mesh.face_count() as u32;
+            let m = self.mesh.split_edge(c, 0.5);
+            self.surface.record_split(f, first_new);
+            if o != INVALID {
+                self.surface.record_split(o / 3, first_new + 1);
+            }
+            self.grid.insert(m, self.mesh.positions()[m as usize]);
+            self.add_to_region(m);
+            self.report.splits += 1;
+            // Every edge of the faces around m may have changed: the halves, the new edges at
+            // m, and the far edges of its faces.
+            let corners: Vec<u32> = self.mesh.adjacency().corners_around(m).collect();
+            for k in corners {
+                for e in [k, next(k), prev(k)] {
+                    push(&mut heap, self.length(e), e);
+                }
+            }
+        }
+    }
+
+    fn collapse_short_edges(&mut self) {
+        let short = COLLAPSE_BELOW * self.settings.target_edge;
+        let long = SPLIT_ABOVE * self.settings.target_edge;
+        for c in self.region_edges() {
+            if self.mesh.is_face_dead((c / 3) as usize) || self.length(c) >= short {
+                continue;
+            }
+            let (a, b) = self.mesh.edge_vertices(c);
+            if !(self.in_region[a as usize] && self.in_region[b as usize]) {
+                continue;
+            }
+            // Keep the boundary vertex where it is when only one end is on the boundary;
+            // otherwise meet in the middle.
+            let o = self.mesh.adjacency().opposite[c as usize];
+            let candidates = [(c, a, b), (o, b, a)];
+            let mut done = false;
+            for (corner, keep, remove) in candidates {
+                if corner == INVALID || done || !self.mesh.is_collapse_ok(corner) {
+                    continue;
+                }
+                let boundary_keep = self.mesh.is_boundary_vertex(keep);
+                let boundary_remove = self.mesh.is_boundary_vertex(remove);
+                let target = if boundary_keep && !boundary_remove {
+                    self.mesh.positions()[keep as usize]
+                } else {
+                    0.5 * (self.mesh.positions()[keep as usize]
+                        + self.mesh.positions()[remove as usize])
+                };
+                if !self.collapse_shape_ok(keep, remove, target, long) {
+                    continue;
+                }
+                if !self.move_is_safe(keep, target, Some(remove)) {
+                    self.report.refused += 1;
+                    continue;
+                }
+                self.grid.remove(remove);
+                let survivor = self.mesh.collapse_edge(corner, target);
+                self.grid.move_to(survivor, target);
+                self.report.collapses += 1;
+                done = true;
+            }
+        }
+    }
+
+    /// New edges at the survivor stay below the split limit, and no face around it flips or
+    /// degenerates.
+    fn collapse_shape_ok(&self, keep: u32, remove: u32, target: Vec3, long: f32) -> bool {
+        let positions = self.mesh.positions();
+        let min_area = MIN_AREA_SHARE * self.settings.target_edge * self.settings.target_edge;
+        for v in [keep, remove] {
+            for u in self.mesh.neighbours(v) {
+                if u != keep && u != remove && positions[u as usize].distance(target) > long {
+                    return false;
+                }
+            }
+            for f in self.mesh.faces_around(v) {
+                let tri = self.mesh.faces()[f as usize];
+                if tri.contains(&keep) && tri.contains(&remove) {
+                    continue;
+                }
+                let old = tri.map(|w| positions[w as usize]);
+                let new = tri.map(|w| {
+                    if w == keep || w == remove {
+                        target
+                    } else {
+                        positions[w as usize]
+                    }
+                });
+                let (n_old, n_new) = (normal(old), normal(new));
+                if n_new.length() * 0.5 < min_area
+                    || n_old.normalize_or_zero().dot(n_new.normalize_or_zero()) < MIN_NORMAL_COSINE
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    fn flip_toward_regular_valence(&mut self) {
+        for c in self.region_edges() {
+            if self.mesh.is_face_dead((c / 3) as usize) || !self.mesh.is_flip_ok(c) {
+                continue;
+            }
+            let o = self.mesh.adjacency().opposite[c as usize];
+            let (a, b) = self.mesh.edge_vertices(c);
+            let (x, y) = (self.mesh.corner_vertex(c), self.mesh.corner_vertex(o));
+            let ideal = |m: &Mesh, v: u32| if m.is_boundary_vertex(v) { 4 } else { 6 };
+            let deviation = |va: usize, vb: usize, vx: usize, vy: usize| {
+                let d = |v: usize, t: i64| (v as i64 - t).abs();
+                d(va, ideal(self.mesh, a))
+                    + d(vb, ideal(self.mesh, b))
+                    + d(vx, ideal(self.mesh, x))
+                    + d(vy, ideal(self.mesh, y))
+            };
+            let (va, vb, vx, vy) = (
+                self.mesh.valence(a),
+                self.mesh.valence(b),
+                self.mesh.valence(x),
+                self.mesh.valence(y),
+            );
+            if deviation(va - 1, vb - 1, vx + 1, vy + 1) >= deviation(va, vb, vx, vy) {
+                continue;
+            }
+            if !self.flip_shape_ok(c, o) {
+                continue;
+            }
+            let p = self.mesh.positions();
+            let new_faces = [
+                ([x, a, y], [p[x as usize], p[a as usize], p[y as usize]]),
+                ([y, b, x], [p[y as usize], p[b as usize], p[x as usize]]),
+            ];
+            if !self.faces_clear(&new_faces, &[]) {
+                self.report.refused += 1;
+                continue;
+            }
+            self.mesh.flip_edge(c);
+            self.report.flips += 1;
+        }
+    }
+
+    /// The two faces are nearly coplanar, the new ones keep their orientation, and the new
+    /// edge is no longer than the old one nor past the split limit (a flip must not undo
+    /// the splits).
+    fn flip_shape_ok(&self, c: u32, o: u32) -> bool {
+        let p = self.mesh.positions();
+        let (a, b) = self.mesh.edge_vertices(c);
+        let (x, y) = (self.mesh.corner_vertex(c), self.mesh.corner_vertex(o));
+        let [pa, pb, px, py] = [a, b, x, y].map(|v| p[v as usize]);
+        let new_length = px.distance(py);
+        if new_length > SPLIT_ABOVE * self.settings.target_edge
+            || new_length > pa.distance(pb) * 1.25
+        {
+            return false;
+        }
+        let (n1, n2) = (
+            normal([px, pa, pb]).normalize_or_zero(),
+            normal([py, pb, pa]).normalize_or_zero(),
+        );
+        if n1.dot(n2) < FLIP_FLATNESS_COSINE {
+            return false;
+        }
+        let (m1, m2) = (normal([px, pa, py]), normal([py, pb, px]));
+        let min_area = 2.0 * MIN_AREA_SHARE * self.settings.target_edge * self.settings.target_edge;
+        m1.length() > min_area
+            && m2.length() > min_area
+            && m1.normalize_or_zero().dot(n1) > MIN_NORMAL_COSINE
+            && m2.normalize_or_zero().dot(n1) > MIN_NORMAL_COSINE
+    }
+
+    /// Tangential relaxation toward the centroid of the one-ring, projected back onto the
+    /// surface as it was, for interior region vertices; boundaries stay in place.
+    fn relax(&mut self) {
+        let live: Vec<u32> = self
+            .region
+            .iter()
+            .copied()
+            .filter(|&v| self.live(v))
+            .collect();
+        let proposals: Vec<(u32, Vec3)> = live
+            .iter()
+            .filter(|&&v| !self.mesh.is_boundary_vertex(v))
+            .filter_map(|&v| {
+                let p = self.mesh.positions()[v as usize];
+                let ring = self.mesh.neighbours(v);
+                if ring.is_empty() {
+                    return None;
+                }
+                let centroid = ring
+                    .iter()
+                    .map(|&u| self.mesh.positions()[u as usize])
+                    .sum::<Vec3>()
+                    / ring.len() as f32;
+                let n = self.mesh.normals()[v as usize];
+                let tangential = (centroid - p) - n * n.dot(centroid - p);
+                let moved = p + tangential;
+                let layer = self.mesh.vertex_layers()[v as usize];
+                let projected = self.surface.project(moved, layer).unwrap_or(moved);
+                (projected.distance(p) > 1e-4 * self.settings.target_edge).then_some((v, projected))
+            })
+            .collect();
+        for (v, target) in proposals {
+            if !self.relax_shape_ok(v, target) {
+                continue;
+            }
+            if !self.move_is_safe(v, target, None) {
+                self.report.refused += 1;
+                continue;
+            }
+            self.mesh.positions_mut()[v as usize] = target;
+            self.grid.move_to(v, target);
+            self.report.relaxed += 1;
+        }
+    }
+
+    /// Moving `v` to `target` flips no face around it.
+    fn relax_shape_ok(&self, v: u32, target: Vec3) -> bool {
+        let p = self.mesh.positions();
+        self.mesh.faces_around(v).all(|f| {
+            let tri = self.mesh.faces()[f as usize];
+            let old = tri.map(|w| p[w as usize]);
+            let new = tri.map(|w| if w == v { target } else { p[w as usize] });
+            normal(old)
+                .normalize_or_zero()
+                .dot(normal(new).normalize_or_zero())
+                > MIN_NORMAL_COSINE
+        })
+    }
+
+    /// A vertex (with `merged`, when a collapse takes it along) may move to `target` only if no
+    /// face outside its neighbourhood gets closer than the collision distance (or than it
+    /// already was), and its faces at the new position cross no other layer.
+    fn move_is_safe(&mut self, v: u32, target: Vec3, merged: Option<u32>) -> bool {
+        let d = self.settings.collision_distance;
+        let from = self.mesh.positions()[v as usize];
+        let mut ring = std::mem::take(&mut self.scratch);
+        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
+        if let Some(m) = merged {
+            let mut more = Vec::new();
+            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
+            ring.extend(more);
+        }
+        let layer = self.mesh.vertex_layers()[v as usize];
+        let mut safe = true;
+        let query = Aabb::of_points(&[from, target]).expanded(d);
+        let positions = self.mesh.positions();
+        let faces = self.mesh.faces();
+        // Faces near the target, through the reference surface's grid of all nearby faces.
+        self.surface.for_each_near(&query, |face| {
+            if !safe {
+                return;
+            }
+            let tri = faces[face as usize];
+            // The neighbourhood skipped is the vertex's own, in its own layer.
+            if tri[0] == INVALID
+                || (self.mesh.face_layers()[face as usize] == layer
+                    && tri.iter().any(|w| ring.contains(w)))
+            {
+                return;
+            }
+            let [a, b, c] = tri.map(|w| positions[w as usize]);
+            let now = closest_point_on_triangle(target, a, b, c).distance(target);
+            if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
+                safe = false;
+            }
+        });
+        self.scratch = ring;
+        if !safe {
+            return false;
+        }
+        // The faces that will carry the vertex, against every nearby face, exactly.
+        let moved: Vec<([u32; 3], [Vec3; 3])> = [Some(v), merged]
+            .into_iter()
+            .flatten()
+            .flat_map(|w| self.mesh.faces_around(w).collect::<Vec<_>>())
+            .filter_map(|f| {
+                let tri = faces[f as usize];
+                if merged.is_some_and(|m| tri.contains(&m) && tri.contains(&v)) {
+                    return None;
+                }
+                let ids = tri.map(|w| if Some(w) == merged { v } else { w });
+                let at = ids.map(|w| {
+                    if w == v {
+                        target
+                    } else {
+                        positions[w as usize]
+                    }
+                });
+                Some((ids, at))
+            })
+            .collect();
+        let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
+        self.faces_clear(&moved, &involved)
+    }
+
+    /// No triangle in `triangles` (vertex ids and the positions they will have) crosses a nearby
+    /// face, of any layer. Faces that share a vertex with the triangle are its neighbours, and
+    /// faces around a `moving` vertex are being tested themselves.
+    fn faces_clear(&self, triangles: &[([u32; 3], [Vec3; 3])], moving: &[u32]) -> bool {
+        let positions = self.mesh.positions();
+        let faces = self.mesh.faces();
+        let mut clear = true;
+        for (ids, tri) in triangles {
+            let bounds = Aabb::of_points(tri);
+            self.surface.for_each_near(&bounds, |face| {
+                if !clear {
+                    return;
+                }
+                let other = faces[face as usize];
+                if other[0] == INVALID
+                    || other.iter().any(|w| ids.contains(w) || moving.contains(w))
+                {
+                    return;
+                }
+                let other = other.map(|w| positions[w as usize]);
+                if Aabb::of_points(&other).overlaps(&bounds) && triangles_intersect(*tri, other) {
+                    clear = false;
+                }
+            });
+        }
+        clear
+    }
+}
+
+fn normal(t: [Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0])
+}
+
+/// Remeshing as the pipeline's after-stroke hook.
+pub struct RemeshHook {
+    pub settings: RemeshSettings,
+    pub last: RemeshReport,
+}
+
+impl StrokeHook for RemeshHook {
+    fn after_stroke(
+        &mut self,
+        mesh: &mut Mesh,
+        touched: &[u32],
+        grid: &mut SpatialHash,
+    ) -> Result<bool, PipelineError> {
+        self.last = remesh_region(mesh, grid, touched, &self.settings);
+        Ok(true)
+    }
+}

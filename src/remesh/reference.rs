@@ -1,0 +1,152 @@
+//! The surface as it was before remeshing: where relaxed vertices are projected back to, and the
+//! index of every face near the region that collision checks read (at current positions).
+
+use glam::Vec3;
+use rustc_hash::FxHashMap;
+
+use super::RemeshSettings;
+use crate::collide::LocalFaceGrid;
+use crate::geom::{Aabb, closest_point_on_triangle};
+use crate::grid::SpatialHash;
+use crate::mesh::Mesh;
+
+pub struct ReferenceSurface {
+    /// Faces near the region when remeshing began, their triangles then, and their layers.
+    faces: Vec<u32>,
+    triangles: Vec<[Vec3; 3]>,
+    layers: Vec<u32>,
+    grid: LocalFaceGrid,
+    /// Faces split off during remeshing, by the captured face they descend from.
+    descendants: Vec<Vec<u32>>,
+    /// For a face created during remeshing: the captured face it descends from.
+    ancestor: FxHashMap<u32, u32>,
+    /// Local index of each captured face.
+    local: FxHashMap<u32, u32>,
+    search: f32,
+    stamp: std::cell::RefCell<(Vec<u32>, u32)>,
+}
+
+impl ReferenceSurface {
+    pub fn capture(
+        mesh: &Mesh,
+        grid: &SpatialHash,
+        region: &[u32],
+        settings: &RemeshSettings,
+    ) -> Self {
+        let l = settings.target_edge;
+        let bounds = region.iter().fold(Aabb::EMPTY, |b, &v| {
+            b.including(mesh.positions()[v as usize])
+        });
+        let reach = settings.collision_distance + 3.0 * l;
+        let area = bounds.expanded(reach);
+        let mut vertices = Vec::new();
+        if !bounds.is_empty() {
+            grid.for_each_in_box(area.min, area.max, |v| vertices.push(v));
+        }
+        let mut faces: Vec<u32> = vertices
+            .iter()
+            .flat_map(|&v| mesh.faces_around(v))
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        let triangles: Vec<[Vec3; 3]> = faces
+            .iter()
+            .map(|&f| mesh.face_positions(f as usize))
+            .collect();
+        let layers = faces
+            .iter()
+            .map(|&f| mesh.face_layers()[f as usize])
+            .collect();
+        // Boxes widened by two edge lengths: faces move and flip while remeshing and must stay
+        // inside the boxes they are filed under.
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| Aabb::of_points(t).expanded(2.0 * l))
+            .collect();
+        let mut local_grid = LocalFaceGrid::default();
+        if !faces.is_empty() {
+            local_grid.build(&boxes, area.expanded(l), 1.5 * l);
+        }
+        let local = faces
+            .iter()
+            .enumerate()
+            .map(|(i, &f)| (f, i as u32))
+            .collect();
+        ReferenceSurface {
+            descendants: vec![Vec::new(); faces.len()],
+            stamp: std::cell::RefCell::new((vec![0; faces.len()], 0)),
+            faces,
+            triangles,
+            layers,
+            grid: local_grid,
+            ancestor: FxHashMap::default(),
+            local,
+            search: l,
+        }
+    }
+
+    /// `child` was split off `parent` (geometrically inside it when made).
+    pub fn record_split(&mut self, parent: u32, child: u32) {
+        let root = match self.local.get(&parent) {
+            Some(&i) => Some(i),
+            None => self.ancestor.get(&parent).copied(),
+        };
+        if let Some(root) = root {
+            self.descendants[root as usize].push(child);
+            self.ancestor.insert(child, root);
+        }
+    }
+
+    /// Calls `f` with every face (by mesh index) filed near `query`, once each, and the faces
+    /// split off them since.
+    pub fn for_each_near(&self, query: &Aabb, mut f: impl FnMut(u32)) {
+        let mut guard = self.stamp.borrow_mut();
+        let (stamps, generation) = &mut *guard;
+        *generation = generation.wrapping_add(1);
+        if *generation == 0 {
+            stamps.fill(0);
+            *generation = 1;
+        }
+        let generation = *generation;
+        self.grid.for_each_candidate(query, |local| {
+            let slot = &mut stamps[local as usize];
+            if *slot == generation {
+                return;
+            }
+            *slot = generation;
+            f(self.faces[local as usize]);
+            for &child in &self.descendants[local as usize] {
+                f(child);
+            }
+        });
+    }
+
+    /// The closest point of the original surface of `layer` to `p`, within an edge length.
+    pub fn project(&self, p: Vec3, layer: u32) -> Option<Vec3> {
+        let query = Aabb { min: p, max: p }.expanded(self.search);
+        let mut best: Option<(f32, Vec3)> = None;
+        let mut guard = self.stamp.borrow_mut();
+        let (stamps, generation) = &mut *guard;
+        *generation = generation.wrapping_add(1);
+        if *generation == 0 {
+            stamps.fill(0);
+            *generation = 1;
+        }
+        let generation = *generation;
+        self.grid.for_each_candidate(&query, |local| {
+            let i = local as usize;
+            if stamps[i] == generation || self.layers[i] != layer {
+                return;
+            }
+            stamps[i] = generation;
+            let [a, b, c] = self.triangles[i];
+            let q = closest_point_on_triangle(p, a, b, c);
+            let d = q.distance_squared(p);
+            if best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, q));
+            }
+        });
+        best.filter(|(d, _)| *d <= self.search * self.search)
+            .map(|(_, q)| q)
+    }
+}
