@@ -47,15 +47,18 @@ fn bench_scene(
     let strokes = script.resolve(&mesh, "generated script")?;
     steps.finish();
     let mut pipeline = CpuPipeline::new(PipelineSettings::default());
-    let bar = Bar::new(kind.name(), strokes.len() as u64);
-    let result = run_strokes(
-        kind.name(),
-        &mut mesh,
-        &strokes,
-        &mut pipeline,
-        |_| bar.inc(),
-        true,
-    )?;
+    sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut pipeline)
+}
+
+/// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does.
+pub fn sculpt_with_progress(
+    name: &str,
+    mesh: &mut slayer::mesh::Mesh,
+    strokes: &[slayer::brush::Stroke],
+    pipeline: &mut dyn SculptPipeline,
+) -> anyhow::Result<SceneResult> {
+    let bar = Bar::new(name, strokes.len() as u64);
+    let result = run_strokes(name, mesh, strokes, pipeline, |_| bar.inc(), true)?;
     bar.finish();
     Ok(result)
 }

@@ -3,11 +3,11 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use slayer::bench::{ScriptSpec, generate_script, paper_table, run_strokes};
+use slayer::bench::{ScriptSpec, generate_script, paper_table};
 use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
-use crate::progress::{Bar, Steps};
+use crate::progress::Steps;
 
 /// Strokes in the demo's script: enough to see every brush of the bench mix at work.
 const DEMO_STROKES: usize = 12;
@@ -63,16 +63,7 @@ pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
         pipeline.name(),
         strokes_path.display()
     );
-    let bar = Bar::new("sculpt", strokes.len() as u64);
-    let result = run_strokes(
-        "plaster",
-        &mut mesh,
-        &strokes,
-        &mut pipeline,
-        |_| bar.inc(),
-        true,
-    )?;
-    bar.finish();
+    let result = crate::bench::sculpt_with_progress("plaster", &mut mesh, &strokes, &mut pipeline)?;
     println!("{}", paper_table(std::slice::from_ref(&result)));
 
     let after = out.join("plaster-sculpted.ply");
