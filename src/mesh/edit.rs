@@ -243,13 +243,8 @@ impl Mesh {
         // Stitch the faces across f's other two edges, and g's.
         let o1 = self.adjacency.opposite[c1 as usize];
         let o2 = self.adjacency.opposite[c2 as usize];
+        // (`link` with a boundary on one side leaves the other side a boundary.)
         self.link(o1, o2);
-        if o1 == INVALID {
-            self.adjacency.opposite[o2 as usize] = INVALID;
-        }
-        if o2 == INVALID && o1 != INVALID {
-            self.adjacency.opposite[o1 as usize] = INVALID;
-        }
         let mut y = INVALID;
         let (mut p1, mut p2) = (INVALID, INVALID);
         if o != INVALID {
@@ -258,12 +253,6 @@ impl Mesh {
             p1 = self.adjacency.opposite[e1 as usize];
             p2 = self.adjacency.opposite[e2 as usize];
             self.link(p1, p2);
-            if p1 == INVALID && p2 != INVALID {
-                self.adjacency.opposite[p2 as usize] = INVALID;
-            }
-            if p2 == INVALID && p1 != INVALID {
-                self.adjacency.opposite[p1 as usize] = INVALID;
-            }
         }
         // b's other faces now use a.
         for &c in &fan_b {

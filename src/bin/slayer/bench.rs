@@ -7,6 +7,7 @@ use slayer::bench::{
     scaling_table,
 };
 use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
+use slayer::remesh::{RemeshHook, RemeshSettings};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 use crate::progress::{Bar, Steps};
@@ -20,6 +21,8 @@ pub struct Options {
     pub scaling: bool,
     pub scaling_sizes: Vec<usize>,
     pub backend: String,
+    /// Remesh after every stroke (issue 4, in progress: off by default).
+    pub remesh: bool,
 }
 
 fn bench_scene(
@@ -27,6 +30,7 @@ fn bench_scene(
     triangles: usize,
     strokes: usize,
     seed: u64,
+    remesh: bool,
 ) -> anyhow::Result<SceneResult> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
@@ -47,6 +51,15 @@ fn bench_scene(
     let strokes = script.resolve(&mesh, "generated script")?;
     steps.finish();
     let mut pipeline = CpuPipeline::new(PipelineSettings::default());
+    if remesh {
+        let edge = mesh.mean_edge_length();
+        let mut settings = RemeshSettings::new(edge);
+        settings.exclusion_ring = slayer::collide::neighbourhood::exclusion_ring(&mesh, edge);
+        pipeline.set_hook(Box::new(RemeshHook {
+            settings,
+            last: Default::default(),
+        }));
+    }
     sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut pipeline)
 }
 
@@ -74,7 +87,13 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
     let mut scenes = Vec::new();
     for &kind in &options.scenes {
         let triangles = options.triangles.unwrap_or(kind.default_triangles());
-        scenes.push(bench_scene(kind, triangles, options.strokes, options.seed)?);
+        scenes.push(bench_scene(
+            kind,
+            triangles,
+            options.strokes,
+            options.seed,
+            options.remesh,
+        )?);
     }
     if !scenes.is_empty() {
         println!("{}", paper_table(&scenes));
@@ -87,6 +106,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 faces,
                 options.strokes.min(8),
                 options.seed,
+                options.remesh,
             )?;
             scaling.push(ScalingRow {
                 faces: r.faces,

@@ -121,6 +121,9 @@ enum Command {
         scaling_sizes: Vec<usize>,
         #[arg(long, default_value = "cpu")]
         backend: String,
+        /// Remesh after every stroke (work in progress; see issue 4).
+        #[arg(long)]
+        remesh: bool,
     },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
@@ -165,6 +168,7 @@ fn main() -> ExitCode {
             scaling,
             scaling_sizes,
             backend,
+            remesh,
         } => {
             let scenes = if scene == "all" {
                 vec![
@@ -192,6 +196,7 @@ fn main() -> ExitCode {
                 scaling,
                 scaling_sizes,
                 backend,
+                remesh,
             })
         }
     };
