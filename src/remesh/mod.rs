@@ -533,34 +533,9 @@ impl<'a> Remesher<'a> {
             ring.extend(more);
         }
         let layer = self.mesh.vertex_layers()[v as usize];
-        let mut safe = true;
-        let query = Aabb::of_points(&[from, target]).expanded(d);
         let positions = self.mesh.positions();
         let faces = self.mesh.faces();
-        // Faces near the target, through the reference surface's grid of all nearby faces.
-        self.surface.for_each_near(&query, |face| {
-            if !safe {
-                return;
-            }
-            let tri = faces[face as usize];
-            // The neighbourhood skipped is the vertex's own, in its own layer.
-            if tri[0] == INVALID
-                || (self.mesh.face_layers()[face as usize] == layer
-                    && tri.iter().any(|w| ring.contains(w)))
-            {
-                return;
-            }
-            let [a, b, c] = tri.map(|w| positions[w as usize]);
-            let now = closest_point_on_triangle(target, a, b, c).distance(target);
-            if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
-                safe = false;
-            }
-        });
-        self.scratch = ring;
-        if !safe {
-            return false;
-        }
-        // The faces that will carry the vertex, against every nearby face, exactly.
+        // The faces that will carry the vertex, at their new positions.
         let moved: Vec<([u32; 3], [Vec3; 3])> = [Some(v), merged]
             .into_iter()
             .flatten()
@@ -581,6 +556,41 @@ impl<'a> Remesher<'a> {
                 Some((ids, at))
             })
             .collect();
+        // How far those faces reach from the target: the proximity scan covers that too.
+        let reach = moved
+            .iter()
+            .flat_map(|(_, t)| t.iter())
+            .map(|p| p.distance(target))
+            .fold(0.0f32, f32::max);
+        let mut safe = true;
+        let query = Aabb::of_points(&[from, target]).expanded(d.max(reach));
+        // Faces near the target, through the reference surface's grid of all nearby faces.
+        self.surface.for_each_near(&query, |face| {
+            if !safe {
+                return;
+            }
+            let tri = faces[face as usize];
+            // The neighbourhood skipped is the vertex's own, in its own layer.
+            if tri[0] == INVALID
+                || (self.mesh.face_layers()[face as usize] == layer
+                    && tri.iter().any(|w| ring.contains(w)))
+            {
+                return;
+            }
+            let [a, b, c] = tri.map(|w| positions[w as usize]);
+            // Faces beyond both the collision distance and the reach do not matter.
+            if !Aabb::of_points(&[a, b, c]).within(target, d.max(reach)) {
+                return;
+            }
+            let now = closest_point_on_triangle(target, a, b, c).distance(target);
+            if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
+                safe = false;
+            }
+        });
+        self.scratch = ring;
+        if !safe {
+            return false;
+        }
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
         self.faces_clear(&moved, &involved)
     }

@@ -10,6 +10,10 @@ use crate::geom::{Aabb, closest_point_on_triangle};
 use crate::grid::SpatialHash;
 use crate::mesh::Mesh;
 
+/// How far (× L) a face may drift from where it was filed while remeshing. Relaxation moves a
+/// vertex a fraction of an edge per round and flips stay within the quad they replace.
+const MOVE_MARGIN: f32 = 1.0;
+
 pub struct ReferenceSurface {
     /// Faces near the region when remeshing began, their triangles then, and their layers.
     faces: Vec<u32>,
@@ -57,11 +61,11 @@ impl ReferenceSurface {
             .iter()
             .map(|&f| mesh.face_layers()[f as usize])
             .collect();
-        // Boxes widened by two edge lengths: faces move and flip while remeshing and must stay
-        // inside the boxes they are filed under.
+        // Boxes widened: faces move and flip while remeshing and must stay inside the boxes
+        // they are filed under.
         let boxes: Vec<Aabb> = triangles
             .iter()
-            .map(|t| Aabb::of_points(t).expanded(2.0 * l))
+            .map(|t| Aabb::of_points(t).expanded(MOVE_MARGIN * l))
             .collect();
         let mut local_grid = LocalFaceGrid::default();
         if !faces.is_empty() {
