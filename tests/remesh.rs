@@ -166,7 +166,7 @@ fn remeshing_an_irregular_sheet_makes_edges_uniform() {
 }
 
 #[test]
-#[ignore = "issue 4 in progress: after 40 torture strokes with remeshing on plaster one within-layer crossing remains; see the session note"]
+#[ignore = "issue 4 in progress: no crossings any more, but after 40 torture strokes the share of edges in band is 0.65 (< 0.9) and the run takes over a minute; see the session note"]
 fn remeshing_after_strokes_keeps_layers_apart() {
     use slayer::bench::{BrushMix, ScriptSpec, generate_script};
     use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};

@@ -18,7 +18,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use crate::collide::neighbourhood::ring_vertices;
-use crate::geom::{Aabb, closest_point_on_triangle, triangles_intersect};
+use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, next, prev};
 use crate::pipeline::{PipelineError, StrokeHook};
@@ -422,7 +422,7 @@ impl<'a> Remesher<'a> {
                 ([x, a, y], [p[x as usize], p[a as usize], p[y as usize]]),
                 ([y, b, x], [p[y as usize], p[b as usize], p[x as usize]]),
             ];
-            if !self.faces_clear(&new_faces, &[]) {
+            if !self.faces_clear(&new_faces, &[], &[c / 3, o / 3]) {
                 self.report.refused += 1;
                 continue;
             }
@@ -592,15 +592,33 @@ impl<'a> Remesher<'a> {
             return false;
         }
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
-        self.faces_clear(&moved, &involved)
+        self.faces_clear(&moved, &involved, &[])
     }
 
     /// No triangle in `triangles` (vertex ids and the positions they will have) crosses a nearby
-    /// face, of any layer. Faces that share a vertex with the triangle are its neighbours, and
-    /// faces around a `moving` vertex are being tested themselves.
-    fn faces_clear(&self, triangles: &[([u32; 3], [Vec3; 3])], moving: &[u32]) -> bool {
+    /// face, of any layer, nor overlaps a neighbour beyond the vertices they share (a fold, which
+    /// pair tests skip and a later split would turn into a crossing). Faces around a `moving`
+    /// vertex are being tested themselves, among each other; `replaced` faces are on their way
+    /// out.
+    fn faces_clear(
+        &self,
+        triangles: &[([u32; 3], [Vec3; 3])],
+        moving: &[u32],
+        replaced: &[u32],
+    ) -> bool {
         let positions = self.mesh.positions();
         let faces = self.mesh.faces();
+        for (i, (ids, tri)) in triangles.iter().enumerate() {
+            for (other_ids, other) in &triangles[i + 1..] {
+                let shared = ids.iter().filter(|w| other_ids.contains(w)).count();
+                if shared == 3
+                    || (shared > 0 && neighbours_overlap(*tri, *ids, *other, *other_ids))
+                    || (shared == 0 && triangles_intersect(*tri, *other))
+                {
+                    return false;
+                }
+            }
+        }
         let mut clear = true;
         for (ids, tri) in triangles {
             let bounds = Aabb::of_points(tri);
@@ -608,14 +626,27 @@ impl<'a> Remesher<'a> {
                 if !clear {
                     return;
                 }
-                let other = faces[face as usize];
-                if other[0] == INVALID
-                    || other.iter().any(|w| ids.contains(w) || moving.contains(w))
+                let other_ids = faces[face as usize];
+                if other_ids[0] == INVALID
+                    || replaced.contains(&face)
+                    || other_ids.iter().any(|w| moving.contains(w))
                 {
                     return;
                 }
-                let other = other.map(|w| positions[w as usize]);
-                if Aabb::of_points(&other).overlaps(&bounds) && triangles_intersect(*tri, other) {
+                let shared = other_ids.iter().filter(|w| ids.contains(w)).count();
+                if shared == 3 {
+                    return;
+                }
+                let other = other_ids.map(|w| positions[w as usize]);
+                if !Aabb::of_points(&other).overlaps(&bounds) {
+                    return;
+                }
+                let crossing = if shared == 0 {
+                    triangles_intersect(*tri, other)
+                } else {
+                    neighbours_overlap(*tri, *ids, other, other_ids)
+                };
+                if crossing {
                     clear = false;
                 }
             });
