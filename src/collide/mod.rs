@@ -6,6 +6,8 @@
 mod intersections;
 mod local_grid;
 pub mod neighbourhood;
+mod stamps;
 
 pub use intersections::{IntersectingPair, IntersectionReport, find_intersections};
 pub use local_grid::LocalFaceGrid;
+pub use stamps::Stamps;

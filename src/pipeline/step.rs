@@ -8,8 +8,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::brush::{Dab, displacement};
-use crate::collide::LocalFaceGrid;
 use crate::collide::neighbourhood::ring_vertices;
+use crate::collide::{LocalFaceGrid, Stamps};
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, VertexFlags};
@@ -30,51 +30,27 @@ pub struct StrokeState<'a> {
     pub max_edge: f32,
 }
 
-/// Per-thread scratch: a stamp per face for de-duplication.
+/// Per-thread scratch: the faces a query has met, a ring, a candidate list.
+#[derive(Default)]
 pub struct Scratch {
-    stamp: Vec<u32>,
-    generation: u32,
+    seen: Stamps,
     ring: Vec<u32>,
     nearby: Vec<u32>,
-}
-
-impl Scratch {
-    pub fn new(faces: usize) -> Scratch {
-        Scratch {
-            stamp: vec![0; faces],
-            generation: 0,
-            ring: Vec::new(),
-            nearby: Vec::new(),
-        }
-    }
-
-    fn next_generation(&mut self, faces: usize) -> u32 {
-        if self.stamp.len() < faces {
-            self.stamp.resize(faces, 0);
-        }
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            self.stamp.fill(0);
-            self.generation = 1;
-        }
-        self.generation
-    }
 }
 
 /// Maps `f` over `items`, in parallel or not, with per-thread scratch.
 fn map_with_scratch<T: Send, I: Sync>(
     parallel: bool,
-    faces: usize,
     items: &[I],
     f: impl Fn(&mut Scratch, &I) -> T + Sync + Send,
 ) -> Vec<T> {
     if parallel {
         items
             .par_iter()
-            .map_init(|| Scratch::new(faces), |s, item| f(s, item))
+            .map_init(Scratch::default, |s, item| f(s, item))
             .collect()
     } else {
-        let mut scratch = Scratch::new(faces);
+        let mut scratch = Scratch::default();
         items.iter().map(|item| f(&mut scratch, item)).collect()
     }
 }
@@ -177,10 +153,9 @@ pub struct Region {
     grid: LocalFaceGrid,
     use_grid: bool,
     vertices: Vec<u32>,
-    /// Per mesh face: the generation that last put it in `faces`, and its index there.
-    face_stamp: Vec<u32>,
+    /// Mesh faces already in `faces`, and their index there.
+    gathered: Stamps,
     local_index: Vec<u32>,
-    generation: u32,
 }
 
 impl Region {
@@ -218,21 +193,13 @@ impl Region {
         }
         // Faces of those vertices, each once. Their order does not matter: every result below
         // is a minimum or a sorted set.
-        if self.face_stamp.len() < mesh.face_count() {
-            self.face_stamp.resize(mesh.face_count(), 0);
-            self.local_index.resize(mesh.face_count(), 0);
-        }
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            self.face_stamp.fill(0);
-            self.generation = 1;
-        }
+        self.gathered.start(mesh.face_count());
+        self.local_index
+            .resize(mesh.face_count().max(self.local_index.len()), 0);
         self.faces.clear();
         for &v in &self.vertices {
             for f in mesh.faces_around(v) {
-                let stamp = &mut self.face_stamp[f as usize];
-                if *stamp != self.generation {
-                    *stamp = self.generation;
+                if self.gathered.insert(f as usize) {
                     self.local_index[f as usize] = self.faces.len() as u32;
                     self.faces.push(f);
                 }
@@ -260,21 +227,19 @@ impl Region {
 
     /// Index of a mesh face in this region, if it is in it.
     fn local(&self, face: u32) -> Option<usize> {
-        (self.face_stamp.get(face as usize) == Some(&self.generation))
+        self.gathered
+            .contains(face as usize)
             .then(|| self.local_index[face as usize] as usize)
     }
 
     /// Local faces whose box overlaps `query`, each once.
     fn candidates(&self, query: &Aabb, scratch: &mut Scratch, mut f: impl FnMut(usize)) {
         if self.use_grid {
-            let generation = scratch.next_generation(self.faces.len());
+            scratch.seen.start(self.faces.len());
             self.grid.for_each_candidate(query, |local| {
-                let slot = &mut scratch.stamp[local as usize];
-                if *slot != generation {
-                    *slot = generation;
-                    if self.boxes[local as usize].overlaps(query) {
-                        f(local as usize);
-                    }
+                if scratch.seen.insert(local as usize) && self.boxes[local as usize].overlaps(query)
+                {
+                    f(local as usize);
                 }
             });
         } else {
@@ -424,22 +389,17 @@ pub fn collide(
             .collect();
         let mesh_view: &Mesh = mesh;
         let changed_view = changed.as_deref();
-        let pulled: Vec<Option<Vec3>> = map_with_scratch(
-            state.parallel,
-            region.faces.len(),
-            &moving,
-            |scratch, &i| {
-                pull_back(
-                    state,
-                    region,
-                    mesh_view,
-                    selection[i].0,
-                    before[i],
-                    changed_view,
-                    scratch,
-                )
-            },
-        );
+        let pulled: Vec<Option<Vec3>> = map_with_scratch(state.parallel, &moving, |scratch, &i| {
+            pull_back(
+                state,
+                region,
+                mesh_view,
+                selection[i].0,
+                before[i],
+                changed_view,
+                scratch,
+            )
+        });
         let last_pass = pass + 1 == MAX_PASSES;
         let mut moved_back = Vec::new();
         {
@@ -497,11 +457,8 @@ pub fn collide(
         }
         let is_moving = |f: u32| moving_faces.binary_search(&f).is_ok();
         let mesh_view: &Mesh = mesh;
-        let crossings: Vec<Vec<(u32, u32)>> = map_with_scratch(
-            state.parallel,
-            region.faces.len(),
-            &moving_faces,
-            |scratch, &f| {
+        let crossings: Vec<Vec<(u32, u32)>> =
+            map_with_scratch(state.parallel, &moving_faces, |scratch, &f| {
                 let tri_f = triangle(mesh_view, f);
                 let box_f = Aabb::of_points(&tri_f);
                 let faces = mesh_view.faces();
@@ -555,8 +512,7 @@ pub fn collide(
                     }
                 });
                 found
-            },
-        );
+            });
         let mut pairs: Vec<(u32, u32)> = crossings.into_iter().flatten().collect();
         if pairs.is_empty() {
             break;

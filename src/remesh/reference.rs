@@ -5,7 +5,7 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use super::RemeshSettings;
-use crate::collide::LocalFaceGrid;
+use crate::collide::{LocalFaceGrid, Stamps};
 use crate::geom::{Aabb, closest_point_on_triangle};
 use crate::grid::SpatialHash;
 use crate::mesh::Mesh;
@@ -27,7 +27,7 @@ pub struct ReferenceSurface {
     /// Local index of each captured face.
     local: FxHashMap<u32, u32>,
     search: f32,
-    stamp: std::cell::RefCell<(Vec<u32>, u32)>,
+    seen: std::cell::RefCell<Stamps>,
 }
 
 impl ReferenceSurface {
@@ -78,7 +78,7 @@ impl ReferenceSurface {
             .collect();
         ReferenceSurface {
             descendants: vec![Vec::new(); faces.len()],
-            stamp: std::cell::RefCell::new((vec![0; faces.len()], 0)),
+            seen: std::cell::RefCell::new(Stamps::default()),
             faces,
             triangles,
             layers,
@@ -104,20 +104,12 @@ impl ReferenceSurface {
     /// Calls `f` with every face (by mesh index) filed near `query`, once each, and the faces
     /// split off them since.
     pub fn for_each_near(&self, query: &Aabb, mut f: impl FnMut(u32)) {
-        let mut guard = self.stamp.borrow_mut();
-        let (stamps, generation) = &mut *guard;
-        *generation = generation.wrapping_add(1);
-        if *generation == 0 {
-            stamps.fill(0);
-            *generation = 1;
-        }
-        let generation = *generation;
+        let mut seen = self.seen.borrow_mut();
+        seen.start(self.faces.len());
         self.grid.for_each_candidate(query, |local| {
-            let slot = &mut stamps[local as usize];
-            if *slot == generation {
+            if !seen.insert(local as usize) {
                 return;
             }
-            *slot = generation;
             f(self.faces[local as usize]);
             for &child in &self.descendants[local as usize] {
                 f(child);
@@ -129,20 +121,13 @@ impl ReferenceSurface {
     pub fn project(&self, p: Vec3, layer: u32) -> Option<Vec3> {
         let query = Aabb { min: p, max: p }.expanded(self.search);
         let mut best: Option<(f32, Vec3)> = None;
-        let mut guard = self.stamp.borrow_mut();
-        let (stamps, generation) = &mut *guard;
-        *generation = generation.wrapping_add(1);
-        if *generation == 0 {
-            stamps.fill(0);
-            *generation = 1;
-        }
-        let generation = *generation;
+        let mut seen = self.seen.borrow_mut();
+        seen.start(self.faces.len());
         self.grid.for_each_candidate(&query, |local| {
             let i = local as usize;
-            if stamps[i] == generation || self.layers[i] != layer {
+            if self.layers[i] != layer || !seen.insert(i) {
                 return;
             }
-            stamps[i] = generation;
             let [a, b, c] = self.triangles[i];
             let q = closest_point_on_triangle(p, a, b, c);
             let d = q.distance_squared(p);

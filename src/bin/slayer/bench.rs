@@ -25,6 +25,15 @@ pub struct Options {
     pub remesh: bool,
 }
 
+/// `--scene`: one scene name, `all` (the paper's three materials) or `none` (scaling only).
+pub fn parse_scenes(scene: &str) -> Result<Vec<SceneKind>, slayer::scene::SceneError> {
+    Ok(match scene {
+        "all" => vec![SceneKind::Plaster, SceneKind::Bark, SceneKind::Metal],
+        "none" => Vec::new(),
+        name => vec![name.parse()?],
+    })
+}
+
 fn bench_scene(
     kind: SceneKind,
     triangles: usize,

@@ -170,21 +170,11 @@ fn main() -> ExitCode {
             backend,
             remesh,
         } => {
-            let scenes = if scene == "all" {
-                vec![
-                    slayer::scene::SceneKind::Plaster,
-                    slayer::scene::SceneKind::Bark,
-                    slayer::scene::SceneKind::Metal,
-                ]
-            } else if scene == "none" {
-                Vec::new()
-            } else {
-                match scene.parse() {
-                    Ok(kind) => vec![kind],
-                    Err(e) => {
-                        eprintln!("error: {e}");
-                        return ExitCode::FAILURE;
-                    }
+            let scenes = match bench::parse_scenes(&scene) {
+                Ok(scenes) => scenes,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::FAILURE;
                 }
             };
             bench::run(&bench::Options {
