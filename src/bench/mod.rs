@@ -13,6 +13,57 @@ use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
 use crate::pipeline::{PhaseTimes, PipelineError, SculptPipeline};
+use crate::remesh::RemeshReport;
+
+/// The distribution of the smallest angle of a set of faces, in degrees.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct AngleSummary {
+    pub faces: usize,
+    pub p1: f64,
+    pub p5: f64,
+    pub median: f64,
+    /// Share of faces whose smallest angle is below 20° and below 30°.
+    pub below_20: f64,
+    pub below_30: f64,
+}
+
+impl AngleSummary {
+    pub fn of(triangles: impl Iterator<Item = [glam::Vec3; 3]>) -> AngleSummary {
+        let mut angles: Vec<f64> = triangles.map(smallest_angle_degrees).collect();
+        if angles.is_empty() {
+            return AngleSummary::default();
+        }
+        angles.sort_unstable_by(f64::total_cmp);
+        let n = angles.len();
+        let at = |q: f64| angles[((n - 1) as f64 * q).round() as usize];
+        let share = |limit: f64| angles.partition_point(|&a| a < limit) as f64 / n as f64;
+        AngleSummary {
+            faces: n,
+            p1: at(0.01),
+            p5: at(0.05),
+            median: at(0.5),
+            below_20: share(20.0),
+            below_30: share(30.0),
+        }
+    }
+}
+
+/// Smallest interior angle of a triangle, in degrees (0 for a degenerate one).
+pub fn smallest_angle_degrees([a, b, c]: [glam::Vec3; 3]) -> f64 {
+    let angle = |p: glam::Vec3, q: glam::Vec3, r: glam::Vec3| {
+        let (u, v) = ((q - p).as_dvec3(), (r - p).as_dvec3());
+        let denominator = u.length() * v.length();
+        if denominator == 0.0 {
+            0.0
+        } else {
+            (u.dot(v) / denominator)
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees()
+        }
+    };
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
 
 /// Figures for one scene; field names are the fixed JSON interface of BENCHMARK.md.
 #[derive(Debug, Clone, Serialize)]
@@ -30,9 +81,16 @@ pub struct SceneResult {
     pub ms_per_stroke: f64,
     pub ms_per_remesh: f64,
     pub intersections: usize,
+    /// Share of the edges at vertices the strokes moved or made (the remeshed regions) with
+    /// length in [4/5·L, 4/3·L].
     pub edge_band_fraction: f64,
     pub valid: bool,
     pub faces_after: usize,
+    /// What remeshing did over the run.
+    pub remesh: RemeshReport,
+    /// Smallest angle of the faces in the worked region, before the strokes and after.
+    pub min_angle_before: AngleSummary,
+    pub min_angle_after: AngleSummary,
     /// One-time set-up before the first stroke (grid build, collision set-up), not in the
     /// per-sample figures.
     pub setup_ms: f64,
@@ -65,11 +123,15 @@ pub fn run_strokes(
     check_intersections: bool,
 ) -> Result<SceneResult, PipelineError> {
     let (vertices, faces) = (mesh.live_vertex_count(), mesh.live_face_count());
+    // Where the strokes went: vertices that moved or were made; the edge band is measured there.
+    let start_positions = mesh.positions().to_vec();
+    let start_faces = mesh.faces().to_vec();
     let mean_edge_length = mesh.edge_length_stats().mean;
     let started = std::time::Instant::now();
     pipeline.prepare(mesh)?;
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
     let mut phases = PhaseTimes::default();
+    let mut remesh = RemeshReport::default();
     let (mut samples, mut steps, mut collisions, mut reverted, mut moves) = (0, 0, 0, 0, 0);
     for (i, stroke) in strokes.iter().enumerate() {
         let report = pipeline.apply_stroke(mesh, stroke)?;
@@ -79,6 +141,7 @@ pub fn run_strokes(
         collisions += report.clamped;
         reverted += report.reverted;
         moves += report.moves;
+        remesh.add(&report.remesh);
         progress(i + 1);
     }
     let sampling_ms = phases.total() - phases.remesh;
@@ -88,7 +151,23 @@ pub fn run_strokes(
     } else {
         0
     };
-    let band = edge_band_fraction(mesh, mean_edge_length);
+    let worked = |v: u32| {
+        start_positions
+            .get(v as usize)
+            .is_none_or(|&p| p != mesh.positions()[v as usize])
+    };
+    let band = edge_band_fraction_where(mesh, mean_edge_length, |a, b| worked(a) || worked(b));
+    let min_angle_before = AngleSummary::of(
+        start_faces
+            .iter()
+            .filter(|f| f[0] != crate::mesh::INVALID && f.iter().any(|&v| worked(v)))
+            .map(|f| f.map(|v| start_positions[v as usize])),
+    );
+    let min_angle_after = AngleSummary::of(
+        (0..mesh.face_count())
+            .filter(|&f| !mesh.is_face_dead(f) && mesh.faces()[f].iter().any(|&v| worked(v)))
+            .map(|f| mesh.face_positions(f)),
+    );
     Ok(SceneResult {
         name: name.to_string(),
         layers: mesh.layer_count(),
@@ -107,6 +186,9 @@ pub fn run_strokes(
         valid: validation.is_ok(),
         validation_error: validation.err().map(|e| e.to_string()),
         faces_after: mesh.live_face_count(),
+        remesh,
+        min_angle_before,
+        min_angle_after,
         setup_ms,
         collisions,
         reverted,
@@ -116,17 +198,29 @@ pub fn run_strokes(
 
 /// Share of edges with length in [4/5·L, 4/3·L] (the remesher's band).
 pub fn edge_band_fraction(mesh: &Mesh, edge: f64) -> f64 {
+    edge_band_fraction_where(mesh, edge, |_, _| true)
+}
+
+/// Share of the edges `(a, b)` picked by `counts` with length in [4/5·L, 4/3·L]; 1 when none is
+/// picked.
+pub fn edge_band_fraction_where(mesh: &Mesh, edge: f64, counts: impl Fn(u32, u32) -> bool) -> f64 {
     let (lo, hi) = (0.8 * edge, 4.0 / 3.0 * edge);
     let mut inside = 0usize;
     let mut total = 0usize;
     mesh.for_each_edge(|a, b| {
+        if !counts(a, b) {
+            return;
+        }
         let l = mesh.positions()[a as usize].distance(mesh.positions()[b as usize]) as f64;
         total += 1;
         if (lo..=hi).contains(&l) {
             inside += 1;
         }
     });
-    inside as f64 / total.max(1) as f64
+    if total == 0 {
+        return 1.0;
+    }
+    inside as f64 / total as f64
 }
 
 /// The short git revision of the working copy, if git can tell.

@@ -48,3 +48,54 @@ fn project(t: &[DVec3; 3], axis: DVec3) -> (f64, f64) {
     let d = t.map(|p| p.dot(axis));
     (d[0].min(d[1]).min(d[2]), d[0].max(d[1]).max(d[2]))
 }
+
+/// True only when two triangles that share the vertex `p` — the others being `(a1, a2)` and
+/// `(b1, b2)` — surely meet nowhere else: seen along a direction both face, their wedges at `p`
+/// lie on either side of a line through `p`, by more than rounding could hide.
+///
+/// Why that suffices: if the projections meet only at `p`, a common point projects onto `p`, so
+/// it lies on the line through `p` along the view direction; a triangle whose projection has area
+/// meets that line only at `p`. This settles the fans of a smooth surface (every pair of faces
+/// around a vertex) without the exact predicates, which near-coplanar fans send down their slow
+/// path.
+pub fn surely_apart_at_shared_vertex(p: Vec3, a: [Vec3; 2], b: [Vec3; 2]) -> bool {
+    let p = p.as_dvec3();
+    let [a1, a2] = a.map(|x| x.as_dvec3() - p);
+    let [b1, b2] = b.map(|x| x.as_dvec3() - p);
+    let (na, nb) = (a1.cross(a2), b1.cross(b2));
+    let (la, lb) = (na.length(), nb.length());
+    if la == 0.0 || lb == 0.0 {
+        return false;
+    }
+    let (na, nb) = (na / la, nb / lb);
+    // A view both triangles face (folded-back pairs are left to the exact test).
+    if na.dot(nb) < -0.5 {
+        return false;
+    }
+    let view = (na + nb).normalize();
+    let e1 = view.any_orthonormal_vector();
+    let e2 = view.cross(e1);
+    let flat = |x: DVec3| (x.dot(e1), x.dot(e2));
+    let [u1, u2, w1, w2] = [a1, a2, b1, b2].map(flat);
+    let cross = |r: (f64, f64), x: (f64, f64)| r.0 * x.1 - r.1 * x.0;
+    let scale = [a1, a2, b1, b2]
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.length()));
+    let margin = 1e-9 * scale * scale;
+    // Both projections have area: each triangle meets the view line through p only at p.
+    if cross(u1, u2).abs() <= margin || cross(w1, w2).abs() <= margin {
+        return false;
+    }
+    // Two convex wedges with a common apex are apart exactly when a line along one of their
+    // four sides separates them.
+    let separates = |r: (f64, f64), same: [(f64, f64); 2], other: [(f64, f64); 2]| {
+        let s = same.map(|x| cross(r, x));
+        let o = other.map(|x| cross(r, x));
+        (s.iter().all(|&v| v >= -margin) && o.iter().all(|&v| v < -margin))
+            || (s.iter().all(|&v| v <= margin) && o.iter().all(|&v| v > margin))
+    };
+    separates(u1, [u1, u2], [w1, w2])
+        || separates(u2, [u1, u2], [w1, w2])
+        || separates(w1, [w1, w2], [u1, u2])
+        || separates(w2, [w1, w2], [u1, u2])
+}

@@ -184,19 +184,29 @@ fn segments_intersect_2d(p: Coord<f64>, q: Coord<f64>, r: Coord<f64>, s: Coord<f
 /// far-edge tests are therefore complete. Sharing an edge: only coplanar triangles on the same
 /// side of it overlap.
 pub fn neighbours_overlap(a: [Vec3; 3], a_ids: [u32; 3], b: [Vec3; 3], b_ids: [u32; 3]) -> bool {
-    let shared: Vec<usize> = (0..3).filter(|&i| b_ids.contains(&a_ids[i])).collect();
-    let da = a.map(|p| p.as_dvec3());
-    let db = b.map(|p| p.as_dvec3());
-    match shared.len() {
+    let mut shared = [0usize; 3];
+    let mut count = 0;
+    for i in 0..3 {
+        if b_ids.contains(&a_ids[i]) {
+            shared[count] = i;
+            count += 1;
+        }
+    }
+    match count {
         1 => {
             let i = shared[0];
             let j = (0..3).find(|&j| b_ids[j] == a_ids[i]).unwrap_or(0);
-            let (a1, a2) = (da[(i + 1) % 3], da[(i + 2) % 3]);
-            let (b1, b2) = (db[(j + 1) % 3], db[(j + 2) % 3]);
-            (!is_degenerate(db) && segment_meets_triangle(a1, a2, db))
-                || (!is_degenerate(da) && segment_meets_triangle(b1, b2, da))
+            let (a_far, b_far) = (
+                [a[(i + 1) % 3], a[(i + 2) % 3]],
+                [b[(j + 1) % 3], b[(j + 2) % 3]],
+            );
+            !super::separation::surely_apart_at_shared_vertex(a[i], a_far, b_far)
+                && overlap_beyond_vertex(a, i, b, j)
         }
         2 => {
+            let shared = &shared[..2];
+            let da = a.map(|p| p.as_dvec3());
+            let db = b.map(|p| p.as_dvec3());
             let far_a = (0..3).find(|i| !shared.contains(i)).unwrap_or(0);
             let far_b = (0..3).find(|&j| !a_ids.contains(&b_ids[j])).unwrap_or(0);
             let (p, q) = (da[shared[0]], da[shared[1]]);
@@ -210,5 +220,75 @@ pub fn neighbours_overlap(a: [Vec3; 3], a_ids: [u32; 3], b: [Vec3; 3], b_ids: [u
             side(da[far_a]) * side(db[far_b]) > 0
         }
         _ => false,
+    }
+}
+
+/// Exact test for triangles sharing only the vertex `a[i]` = `b[j]`: does either far edge meet
+/// the other triangle?
+fn overlap_beyond_vertex(a: [Vec3; 3], i: usize, b: [Vec3; 3], j: usize) -> bool {
+    let da = a.map(|p| p.as_dvec3());
+    let db = b.map(|p| p.as_dvec3());
+    let (a1, a2) = (da[(i + 1) % 3], da[(i + 2) % 3]);
+    let (b1, b2) = (db[(j + 1) % 3], db[(j + 2) % 3]);
+    (!is_degenerate(db) && segment_meets_triangle(a1, a2, db))
+        || (!is_degenerate(da) && segment_meets_triangle(b1, b2, da))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::separation::surely_apart_at_shared_vertex;
+    use super::*;
+    use proptest::prelude::*;
+
+    fn point() -> impl Strategy<Value = Vec3> {
+        (-1.0f32..1.0, -1.0f32..1.0, -0.3f32..0.3).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(4000))]
+        /// The fast filter never hides an overlap the exact test finds: random pairs of faces
+        /// around a shared vertex, flat-ish (fans of a surface) and folded.
+        #[test]
+        fn shared_vertex_filter_is_conservative(
+            p in point(), a1 in point(), a2 in point(), b1 in point(), b2 in point(),
+            flatten in prop::bool::ANY,
+        ) {
+            let squash = |v: Vec3| if flatten { Vec3::new(v.x, v.y, v.z * 1e-3) } else { v };
+            let (p, a1, a2, b1, b2) = (squash(p), squash(a1), squash(a2), squash(b1), squash(b2));
+            let (a, b) = ([p, a1, a2], [p, b1, b2]);
+            if surely_apart_at_shared_vertex(p, [a1, a2], [b1, b2]) {
+                prop_assert!(!overlap_beyond_vertex(a, 0, b, 0));
+            }
+            prop_assert_eq!(
+                neighbours_overlap(a, [0, 1, 2], b, [0, 3, 4]),
+                overlap_beyond_vertex(a, 0, b, 0)
+            );
+        }
+    }
+
+    /// A fan of six faces around a vertex on a flat sheet: the filter settles every pair that
+    /// shares only the centre.
+    #[test]
+    fn flat_fan_pairs_are_settled_by_the_filter() {
+        let ring: Vec<Vec3> = (0..6)
+            .map(|k| {
+                let t = k as f32 * std::f32::consts::TAU / 6.0;
+                Vec3::new(t.cos(), t.sin(), 0.0)
+            })
+            .collect();
+        for i in 0..6 {
+            for k in 2..5 {
+                let j = (i + k) % 6;
+                let a = [ring[i], ring[(i + 1) % 6]];
+                let b = [ring[j], ring[(j + 1) % 6]];
+                assert!(surely_apart_at_shared_vertex(Vec3::ZERO, a, b));
+                assert!(!overlap_beyond_vertex(
+                    [Vec3::ZERO, a[0], a[1]],
+                    0,
+                    [Vec3::ZERO, b[0], b[1]],
+                    0
+                ));
+            }
+        }
     }
 }

@@ -8,12 +8,14 @@ use rayon::prelude::*;
 
 use super::step::{Region, StrokeState, collide, deform, select};
 use super::{
-    PhaseTimes, PipelineError, PipelineSettings, SculptPipeline, StrokeHook, StrokeReport,
+    PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
+    StrokeReport,
 };
 use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, MeshVersion};
+use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
 
 /// How nearby elements are found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -146,6 +148,22 @@ impl CpuPipeline {
         });
         Ok(())
     }
+}
+
+/// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring,
+/// keeping `grid` exact.
+fn remesh_touched(
+    mesh: &mut Mesh,
+    grid: &mut SpatialHash,
+    seeds: &[u32],
+    (edge, distance, ring): (f32, f32, u32),
+) -> RemeshReport {
+    let settings = RemeshSettings {
+        collision_distance: distance,
+        exclusion_ring: ring,
+        ..RemeshSettings::new(edge)
+    };
+    remesh_region(mesh, grid, seeds, &settings)
 }
 
 /// Longest edge of the given faces (all live faces when `faces` is `None`).
@@ -418,6 +436,19 @@ impl SculptPipeline for CpuPipeline {
             refresh.dedup();
             mesh.recompute_normals_at(&refresh);
             times.deformation += millis(started);
+
+            // A grab keeps moving the vertices it caught at its first sample, so its region is
+            // remeshed once, after the stroke.
+            if self.settings.remeshing == Remeshing::AfterSample && !is_grab {
+                let started = Instant::now();
+                let pass =
+                    remesh_touched(mesh, &mut grid, &moved_in_sample, (edge, distance, ring));
+                max_edge = max_edge.max(pass.longest_edge);
+                report.remesh.add(&pass);
+                target_of.resize(mesh.vertex_count(), INVALID);
+                touched.resize(mesh.vertex_count(), false);
+                times.remesh += millis(started);
+            }
         }
 
         touched_list.sort_unstable();
@@ -427,6 +458,18 @@ impl SculptPipeline for CpuPipeline {
         self.target_of = target_of;
         self.touched = touched;
         report.touched = touched_list.len();
+        let remesh_now = match self.settings.remeshing {
+            Remeshing::Off => false,
+            Remeshing::AfterStroke => true,
+            Remeshing::AfterSample => is_grab,
+        };
+        if remesh_now {
+            let started = Instant::now();
+            let pass = remesh_touched(mesh, &mut grid, &touched_list, (edge, distance, ring));
+            max_edge = max_edge.max(pass.longest_edge);
+            report.remesh.add(&pass);
+            times.remesh += millis(started);
+        }
         let mut grid_current = true;
         if let Some(hook) = self.hook.as_mut() {
             let started = Instant::now();

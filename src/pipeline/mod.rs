@@ -19,6 +19,7 @@ use thiserror::Error;
 use crate::brush::Stroke;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::Mesh;
+use crate::remesh::RemeshReport;
 
 /// Tunables, in units of the mesh's edge length `L` where they are lengths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +35,35 @@ pub struct PipelineSettings {
     /// Rebuild the grid at every stroke, as Algorithm 2 does. Off by default: the grid is kept
     /// exact by every edit and rebuilt only when the mesh changed behind the pipeline's back.
     pub rebuild_grid_every_stroke: bool,
+    /// When the touched region is remeshed back to edge length `L`.
+    pub remeshing: Remeshing,
+}
+
+/// When the pipeline remeshes what the brush touched (sLayer discusses both; DESIGN §3–4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Remeshing {
+    /// Never: edges stretch and shrink with the brush.
+    Off,
+    /// Once per stroke, over every vertex the stroke moved (the paper's choice, and ours).
+    #[default]
+    AfterStroke,
+    /// After every stroke sample, over the vertices that sample moved: strong grabs keep their
+    /// detail while they stretch, at the price of more remeshing passes.
+    AfterSample,
+}
+
+impl std::str::FromStr for Remeshing {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "off" => Ok(Remeshing::Off),
+            "stroke" => Ok(Remeshing::AfterStroke),
+            "sample" => Ok(Remeshing::AfterSample),
+            other => Err(format!(
+                "unknown remeshing `{other}` (expected off, stroke or sample)"
+            )),
+        }
+    }
 }
 
 impl Default for PipelineSettings {
@@ -43,6 +73,7 @@ impl Default for PipelineSettings {
             max_step: 1.0,
             edge_length: None,
             rebuild_grid_every_stroke: false,
+            remeshing: Remeshing::AfterStroke,
         }
     }
 }
@@ -97,6 +128,8 @@ pub struct StrokeReport {
     pub reverted: usize,
     /// Distinct vertices the stroke moved.
     pub touched: usize,
+    /// What remeshing did, summed over the stroke's remeshing passes.
+    pub remesh: RemeshReport,
     pub phases: PhaseTimes,
 }
 

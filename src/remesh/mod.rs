@@ -21,7 +21,7 @@ use crate::collide::neighbourhood::ring_vertices;
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, next, prev};
-use crate::pipeline::{PipelineError, StrokeHook};
+use crate::pipeline::PipelineError;
 use reference::ReferenceSurface;
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
@@ -32,6 +32,8 @@ const MIN_NORMAL_COSINE: f32 = 0.5;
 /// A flip may only replace a nearly flat pair of faces (cosine of the dihedral deviation), so
 /// the surface keeps its shape.
 const FLIP_FLATNESS_COSINE: f32 = 0.94;
+/// Relaxation moves shorter than this share of L are not worth their collision checks.
+const RELAX_MIN_MOVE: f32 = 0.05;
 /// Faces thinner than this share of L² are not created.
 const MIN_AREA_SHARE: f32 = 0.01;
 
@@ -63,6 +65,8 @@ impl RemeshSettings {
 /// What a remesh did.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct RemeshReport {
+    /// Remeshing passes summed here (one per stroke or per sample).
+    pub passes: usize,
     pub region_vertices: usize,
     pub splits: usize,
     pub collapses: usize,
@@ -70,7 +74,24 @@ pub struct RemeshReport {
     pub relaxed: usize,
     /// Moves and edits refused because they would have come too close to another surface.
     pub refused: usize,
+    /// Longest edge among the faces around the region afterwards (the pipeline's running
+    /// bound on edge lengths).
+    pub longest_edge: f32,
     pub millis: f64,
+}
+
+impl RemeshReport {
+    pub fn add(&mut self, other: &RemeshReport) {
+        self.passes += other.passes;
+        self.region_vertices += other.region_vertices;
+        self.splits += other.splits;
+        self.collapses += other.collapses;
+        self.flips += other.flips;
+        self.relaxed += other.relaxed;
+        self.refused += other.refused;
+        self.longest_edge = self.longest_edge.max(other.longest_edge);
+        self.millis += other.millis;
+    }
 }
 
 /// Remeshes the region around `seeds` (the vertices a stroke moved), keeping `grid` exact.
@@ -80,15 +101,41 @@ pub fn remesh_region(
     seeds: &[u32],
     settings: &RemeshSettings,
 ) -> RemeshReport {
+    remesh(mesh, grid, seeds, settings, Start::OutOfBand)
+}
+
+/// Where remeshing starts: after a stroke, at the vertices with an edge outside the band (the
+/// rest of the stroke's footprint is already as the remesher would leave it, and is left
+/// alone); for a whole-mesh remesh, everywhere.
+#[derive(Clone, Copy, PartialEq)]
+enum Start {
+    OutOfBand,
+    Everywhere,
+}
+
+fn remesh(
+    mesh: &mut Mesh,
+    grid: &mut SpatialHash,
+    seeds: &[u32],
+    settings: &RemeshSettings,
+    start: Start,
+) -> RemeshReport {
     let started = Instant::now();
-    let mut remesher = Remesher::new(mesh, grid, seeds, settings);
-    for _ in 0..settings.iterations {
+    let mut remesher = Remesher::new(mesh, grid, seeds, settings, start);
+    for round in 0..settings.iterations {
+        let edits = remesher.edit_count();
         remesher.split_long_edges();
         remesher.collapse_short_edges();
         remesher.flip_toward_regular_valence();
+        // Relaxation follows edits: a round that changed nothing (after the first, which
+        // relaxes what the stroke left out of band) has converged.
+        if round > 0 && remesher.edit_count() == edits {
+            break;
+        }
         remesher.relax();
     }
     let mut report = remesher.finish();
+    report.passes = 1;
     report.millis = started.elapsed().as_secs_f64() * 1e3;
     report
 }
@@ -104,7 +151,7 @@ pub fn remesh_all(
             !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
         })
         .collect();
-    let report = remesh_region(
+    let report = remesh(
         mesh,
         &mut grid,
         &seeds,
@@ -112,6 +159,7 @@ pub fn remesh_all(
             region_rings: 0,
             ..*settings
         },
+        Start::Everywhere,
     );
     mesh.compact();
     Ok(report)
@@ -124,6 +172,13 @@ struct Remesher<'a> {
     /// Region vertices (grows with splits; dead ones are skipped).
     region: Vec<u32>,
     in_region: Vec<bool>,
+    /// Vertices whose neighbourhood an edit changed (or that started out of band): flips look
+    /// at their edges and relaxation moves them and their neighbours.
+    dirty: Vec<bool>,
+    dirty_list: Vec<u32>,
+    /// Collapses refused for coming too close to another surface, by vertex pair: what stopped
+    /// them does not go away by remeshing, so later rounds do not retry them.
+    refused_collapses: rustc_hash::FxHashSet<(u32, u32)>,
     surface: ReferenceSurface,
     report: RemeshReport,
     scratch: Vec<u32>,
@@ -135,18 +190,34 @@ impl<'a> Remesher<'a> {
         grid: &'a mut SpatialHash,
         seeds: &[u32],
         settings: &RemeshSettings,
+        start: Start,
     ) -> Self {
+        let live = |v: u32| (v as usize) < mesh.vertex_count() && !mesh.is_vertex_dead(v);
+        let (short, long) = (
+            COLLAPSE_BELOW * settings.target_edge,
+            SPLIT_ABOVE * settings.target_edge,
+        );
+        let out_of_band = |v: u32| {
+            let p = mesh.positions()[v as usize];
+            mesh.neighbours(v).into_iter().any(|u| {
+                let length = p.distance(mesh.positions()[u as usize]);
+                !(short..=long).contains(&length)
+            })
+        };
+        // The region grows from the vertices that need work, not from everything the stroke
+        // touched: most of a stroke's footprint keeps its edges in band.
         let mut in_region = vec![false; mesh.vertex_count()];
         let mut region = Vec::new();
         for &v in seeds {
-            if (v as usize) < mesh.vertex_count()
-                && !mesh.is_vertex_dead(v)
+            if live(v)
                 && !in_region[v as usize]
+                && (start == Start::Everywhere || out_of_band(v))
             {
                 in_region[v as usize] = true;
                 region.push(v);
             }
         }
+        let starting = region.clone();
         let mut frontier = region.clone();
         for _ in 0..settings.region_rings {
             let mut next_frontier = Vec::new();
@@ -163,7 +234,8 @@ impl<'a> Remesher<'a> {
         }
         region.sort_unstable();
         let surface = ReferenceSurface::capture(mesh, grid, &region, settings);
-        Remesher {
+        let dirty = vec![false; in_region.len()];
+        let mut remesher = Remesher {
             report: RemeshReport {
                 region_vertices: region.len(),
                 ..RemeshReport::default()
@@ -173,9 +245,43 @@ impl<'a> Remesher<'a> {
             settings: *settings,
             region,
             in_region,
+            dirty,
+            dirty_list: Vec::new(),
+            refused_collapses: Default::default(),
             surface,
             scratch: Vec::new(),
+        };
+        for v in starting {
+            remesher.mark_dirty(v);
         }
+        remesher
+    }
+
+    fn edit_count(&self) -> usize {
+        self.report.splits + self.report.collapses + self.report.flips
+    }
+
+    fn mark_dirty(&mut self, v: u32) {
+        let i = v as usize;
+        if i >= self.dirty.len() {
+            self.dirty.resize(i + 1, false);
+        }
+        if !self.dirty[i] {
+            self.dirty[i] = true;
+            self.dirty_list.push(v);
+        }
+    }
+
+    /// Marks `v` and its neighbours dirty: an edit at `v` changed all their one-rings.
+    fn mark_dirty_around(&mut self, v: u32) {
+        self.mark_dirty(v);
+        for u in self.mesh.neighbours(v) {
+            self.mark_dirty(u);
+        }
+    }
+
+    fn is_dirty(&self, v: u32) -> bool {
+        self.dirty.get(v as usize).copied().unwrap_or(false)
     }
 
     fn finish(self) -> RemeshReport {
@@ -196,7 +302,16 @@ impl<'a> Remesher<'a> {
         refresh.sort_unstable();
         refresh.dedup();
         self.mesh.recompute_normals_at(&refresh);
-        self.report
+        let mut report = self.report;
+        report.longest_edge = live
+            .iter()
+            .flat_map(|&v| self.mesh.faces_around(v))
+            .map(|f| {
+                let [a, b, c] = self.mesh.face_positions(f as usize);
+                a.distance(b).max(b.distance(c)).max(c.distance(a))
+            })
+            .fold(0.0, f32::max);
+        report
     }
 
     fn live(&self, v: u32) -> bool {
@@ -298,6 +413,7 @@ impl<'a> Remesher<'a> {
             }
             self.grid.insert(m, self.mesh.positions()[m as usize]);
             self.add_to_region(m);
+            self.mark_dirty_around(m);
             self.report.splits += 1;
             // Every edge of the faces around m may have changed: the halves, the new edges at
             // m, and the far edges of its faces.
@@ -321,35 +437,56 @@ impl<'a> Remesher<'a> {
             if !(self.in_region[a as usize] && self.in_region[b as usize]) {
                 continue;
             }
-            // Keep the boundary vertex where it is when only one end is on the boundary;
-            // otherwise meet in the middle.
+            let pair = (a.min(b), a.max(b));
+            if self.refused_collapses.contains(&pair) {
+                continue;
+            }
+            // Meet in the middle; where that comes too close to another surface, stay at
+            // either end (a shorter move). A boundary vertex stays where it is when only one end
+            // is on the boundary.
             let o = self.mesh.adjacency().opposite[c as usize];
-            let candidates = [(c, a, b), (o, b, a)];
+            let positions = self.mesh.positions();
+            let middle = 0.5 * (positions[a as usize] + positions[b as usize]);
+            let choices = [
+                (c, a, b, Some(middle)),
+                (o, b, a, Some(middle)),
+                (c, a, b, None),
+                (o, b, a, None),
+            ];
             let mut done = false;
-            for (corner, keep, remove) in candidates {
+            let mut refused = false;
+            for (corner, keep, remove, to) in choices {
                 if corner == INVALID || done || !self.mesh.is_collapse_ok(corner) {
                     continue;
                 }
                 let boundary_keep = self.mesh.is_boundary_vertex(keep);
                 let boundary_remove = self.mesh.is_boundary_vertex(remove);
-                let target = if boundary_keep && !boundary_remove {
-                    self.mesh.positions()[keep as usize]
-                } else {
-                    0.5 * (self.mesh.positions()[keep as usize]
-                        + self.mesh.positions()[remove as usize])
+                let at_keep = self.mesh.positions()[keep as usize];
+                let target = match to {
+                    _ if boundary_keep && !boundary_remove => at_keep,
+                    Some(middle) => middle,
+                    None => at_keep,
                 };
+                if to.is_none() && target == middle {
+                    continue;
+                }
                 if !self.collapse_shape_ok(keep, remove, target, long) {
                     continue;
                 }
                 if !self.move_is_safe(keep, target, Some(remove)) {
-                    self.report.refused += 1;
+                    refused = true;
                     continue;
                 }
                 self.grid.remove(remove);
                 let survivor = self.mesh.collapse_edge(corner, target);
                 self.grid.move_to(survivor, target);
+                self.mark_dirty_around(survivor);
                 self.report.collapses += 1;
                 done = true;
+            }
+            if refused && !done {
+                self.report.refused += 1;
+                self.refused_collapses.insert(pair);
             }
         }
     }
@@ -391,11 +528,14 @@ impl<'a> Remesher<'a> {
 
     fn flip_toward_regular_valence(&mut self) {
         for c in self.region_edges() {
-            if self.mesh.is_face_dead((c / 3) as usize) || !self.mesh.is_flip_ok(c) {
+            if self.mesh.is_face_dead((c / 3) as usize) {
+                continue;
+            }
+            let (a, b) = self.mesh.edge_vertices(c);
+            if !(self.is_dirty(a) || self.is_dirty(b)) || !self.mesh.is_flip_ok(c) {
                 continue;
             }
             let o = self.mesh.adjacency().opposite[c as usize];
-            let (a, b) = self.mesh.edge_vertices(c);
             let (x, y) = (self.mesh.corner_vertex(c), self.mesh.corner_vertex(o));
             let ideal = |m: &Mesh, v: u32| if m.is_boundary_vertex(v) { 4 } else { 6 };
             let deviation = |va: usize, vb: usize, vx: usize, vy: usize| {
@@ -427,6 +567,9 @@ impl<'a> Remesher<'a> {
                 continue;
             }
             self.mesh.flip_edge(c);
+            for w in [a, b, x, y] {
+                self.mark_dirty(w);
+            }
             self.report.flips += 1;
         }
     }
@@ -463,12 +606,19 @@ impl<'a> Remesher<'a> {
     /// Tangential relaxation toward the centroid of the one-ring, projected back onto the
     /// surface as it was, for interior region vertices; boundaries stay in place.
     fn relax(&mut self) {
-        let live: Vec<u32> = self
-            .region
-            .iter()
-            .copied()
-            .filter(|&v| self.live(v))
-            .collect();
+        let mut movable = vec![false; self.mesh.vertex_count()];
+        let mut live: Vec<u32> = Vec::new();
+        for &v in &self.dirty_list {
+            if !self.live(v) {
+                continue;
+            }
+            for u in std::iter::once(v).chain(self.mesh.neighbours(v)) {
+                if self.in_region[u as usize] && !movable[u as usize] {
+                    movable[u as usize] = true;
+                    live.push(u);
+                }
+            }
+        }
         let proposals: Vec<(u32, Vec3)> = live
             .iter()
             .filter(|&&v| !self.mesh.is_boundary_vertex(v))
@@ -488,7 +638,8 @@ impl<'a> Remesher<'a> {
                 let moved = p + tangential;
                 let layer = self.mesh.vertex_layers()[v as usize];
                 let projected = self.surface.project(moved, layer).unwrap_or(moved);
-                (projected.distance(p) > 1e-4 * self.settings.target_edge).then_some((v, projected))
+                (projected.distance(p) > RELAX_MIN_MOVE * self.settings.target_edge)
+                    .then_some((v, projected))
             })
             .collect();
         for (v, target) in proposals {
@@ -556,14 +707,8 @@ impl<'a> Remesher<'a> {
                 Some((ids, at))
             })
             .collect();
-        // How far those faces reach from the target: the proximity scan covers that too.
-        let reach = moved
-            .iter()
-            .flat_map(|(_, t)| t.iter())
-            .map(|p| p.distance(target))
-            .fold(0.0f32, f32::max);
         let mut safe = true;
-        let query = Aabb::of_points(&[from, target]).expanded(d.max(reach));
+        let query = Aabb::of_points(&[from, target]).expanded(d);
         // Faces near the target, through the reference surface's grid of all nearby faces.
         self.surface.for_each_near(&query, |face| {
             if !safe {
@@ -578,8 +723,8 @@ impl<'a> Remesher<'a> {
                 return;
             }
             let [a, b, c] = tri.map(|w| positions[w as usize]);
-            // Faces beyond both the collision distance and the reach do not matter.
-            if !Aabb::of_points(&[a, b, c]).within(target, d.max(reach)) {
+            // Faces beyond the collision distance do not matter.
+            if !Aabb::of_points(&[a, b, c]).within(target, d) {
                 return;
             }
             let now = closest_point_on_triangle(target, a, b, c).distance(target);
@@ -657,22 +802,4 @@ impl<'a> Remesher<'a> {
 
 fn normal(t: [Vec3; 3]) -> Vec3 {
     (t[1] - t[0]).cross(t[2] - t[0])
-}
-
-/// Remeshing as the pipeline's after-stroke hook.
-pub struct RemeshHook {
-    pub settings: RemeshSettings,
-    pub last: RemeshReport,
-}
-
-impl StrokeHook for RemeshHook {
-    fn after_stroke(
-        &mut self,
-        mesh: &mut Mesh,
-        touched: &[u32],
-        grid: &mut SpatialHash,
-    ) -> Result<bool, PipelineError> {
-        self.last = remesh_region(mesh, grid, touched, &self.settings);
-        Ok(true)
-    }
 }

@@ -6,8 +6,7 @@ use slayer::bench::{
     ScalingRow, SceneResult, ScriptSpec, generate_script, paper_table, run_strokes, scaling_svg,
     scaling_table,
 };
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
-use slayer::remesh::{RemeshHook, RemeshSettings};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 use crate::progress::{Bar, Steps};
@@ -21,8 +20,8 @@ pub struct Options {
     pub scaling: bool,
     pub scaling_sizes: Vec<usize>,
     pub backend: String,
-    /// Remesh after every stroke (issue 4, in progress: off by default).
-    pub remesh: bool,
+    /// When the touched region is remeshed.
+    pub remeshing: Remeshing,
 }
 
 /// `--scene`: one scene name, `all` (the paper's three materials) or `none` (scaling only).
@@ -39,7 +38,7 @@ fn bench_scene(
     triangles: usize,
     strokes: usize,
     seed: u64,
-    remesh: bool,
+    remeshing: Remeshing,
 ) -> anyhow::Result<SceneResult> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
@@ -59,16 +58,10 @@ fn bench_scene(
     );
     let strokes = script.resolve(&mesh, "generated script")?;
     steps.finish();
-    let mut pipeline = CpuPipeline::new(PipelineSettings::default());
-    if remesh {
-        let edge = mesh.mean_edge_length();
-        let mut settings = RemeshSettings::new(edge);
-        settings.exclusion_ring = slayer::collide::neighbourhood::exclusion_ring(&mesh, edge);
-        pipeline.set_hook(Box::new(RemeshHook {
-            settings,
-            last: Default::default(),
-        }));
-    }
+    let mut pipeline = CpuPipeline::new(PipelineSettings {
+        remeshing,
+        ..PipelineSettings::default()
+    });
     sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut pipeline)
 }
 
@@ -101,7 +94,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
             triangles,
             options.strokes,
             options.seed,
-            options.remesh,
+            options.remeshing,
         )?);
     }
     if !scenes.is_empty() {
@@ -115,7 +108,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 faces,
                 options.strokes.min(8),
                 options.seed,
-                options.remesh,
+                options.remeshing,
             )?;
             scaling.push(ScalingRow {
                 faces: r.faces,

@@ -69,6 +69,9 @@ enum Command {
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
+        /// Remesh the touched region: after every stroke, after every stroke sample, or off.
+        #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
+        remesh: slayer::pipeline::Remeshing,
     },
     /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax).
     Remesh {
@@ -121,9 +124,9 @@ enum Command {
         scaling_sizes: Vec<usize>,
         #[arg(long, default_value = "cpu")]
         backend: String,
-        /// Remesh after every stroke (work in progress; see issue 4).
-        #[arg(long)]
-        remesh: bool,
+        /// Remesh the touched region: after every stroke, after every stroke sample, or off.
+        #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
+        remesh: slayer::pipeline::Remeshing,
     },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
@@ -149,7 +152,8 @@ fn main() -> ExitCode {
             strokes,
             output,
             stats,
-        } => sculpt::run(&input, &strokes, &output, stats.as_deref()),
+            remesh,
+        } => sculpt::run(&input, &strokes, &output, stats.as_deref(), remesh),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
         Command::Strokes {
             scene,
@@ -186,7 +190,7 @@ fn main() -> ExitCode {
                 scaling,
                 scaling_sizes,
                 backend,
-                remesh,
+                remeshing: remesh,
             })
         }
     };

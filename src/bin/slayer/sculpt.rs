@@ -3,7 +3,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use slayer::brush::StrokeFile;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline, StrokeReport};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline, StrokeReport};
 
 use crate::progress::Bar;
 
@@ -13,6 +13,7 @@ pub fn run(
     strokes: &Path,
     output: &Path,
     stats: Option<&Path>,
+    remeshing: Remeshing,
 ) -> anyhow::Result<ExitCode> {
     slayer::io::Format::of_path(output)?;
     let mut mesh = slayer::io::read_mesh(input)?;
@@ -21,7 +22,10 @@ pub fn run(
     let name = strokes.display().to_string();
     let file = StrokeFile::parse(&text, &name)?;
     let strokes = file.resolve(&mesh, &name)?;
-    let mut pipeline = CpuPipeline::new(PipelineSettings::default());
+    let mut pipeline = CpuPipeline::new(PipelineSettings {
+        remeshing,
+        ..PipelineSettings::default()
+    });
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
     for stroke in &strokes {
