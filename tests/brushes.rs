@@ -4,7 +4,7 @@
 use glam::Vec3;
 use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke, StrokeFile, resample};
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
 use slayer::scene::shapes;
 
 #[test]
@@ -95,10 +95,14 @@ fn stroke(kind: BrushKind, invert: bool, points: &[Vec3]) -> Stroke {
     }
 }
 
+/// Applies a stroke without remeshing: these tests follow vertices by index.
 fn apply(mesh: &mut Mesh, stroke: &Stroke) {
-    CpuPipeline::new(PipelineSettings::default())
-        .apply_stroke(mesh, stroke)
-        .unwrap();
+    CpuPipeline::new(PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    })
+    .apply_stroke(mesh, stroke)
+    .unwrap();
     mesh.validate().unwrap();
 }
 

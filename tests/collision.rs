@@ -12,8 +12,17 @@ use slayer::collide::neighbourhood::{exclusion_ring, ring_vertices};
 use slayer::geom::point_triangle_distance_squared;
 use slayer::grid::SpatialHash;
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate, shapes};
+
+/// The brush pipeline without remeshing: these tests are about collisions (and compare vertex
+/// by vertex); `tests/remesh.rs` runs torture strokes with remeshing on.
+fn sculpt_only() -> PipelineSettings {
+    PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    }
+}
 
 fn scene(kind: SceneKind, triangles: usize, seed: u64) -> Mesh {
     generate(&SceneSpec {
@@ -99,7 +108,7 @@ fn three_hundred_random_strokes_leave_no_intersection() {
         for _ in 0..12 {
             strokes.push(push_down(&mesh, &mut rng, edge));
         }
-        let mut pipeline = CpuPipeline::new(PipelineSettings::default());
+        let mut pipeline = CpuPipeline::new(sculpt_only());
         let mut collisions = 0;
         for (i, stroke) in strokes.iter().enumerate() {
             let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
@@ -124,7 +133,7 @@ fn three_hundred_random_strokes_leave_no_intersection() {
 #[test]
 fn a_layer_pushed_down_stops_one_collision_distance_above_the_next() {
     let mut mesh = shapes::stacked_sheets(2, 30, 30, 1.0, 2.5);
-    let settings = PipelineSettings::default();
+    let settings = sculpt_only();
     let mut pipeline = CpuPipeline::new(settings);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let edge = mesh.mean_edge_length();
@@ -175,8 +184,8 @@ fn grid_backend_agrees_with_the_brute_force_reference_bit_for_bit() {
     );
     let strokes = script.resolve(&base, "script").unwrap();
     let (mut fast, mut reference) = (base.clone(), base.clone());
-    let mut fast_pipeline = CpuPipeline::new(PipelineSettings::default());
-    let mut reference_pipeline = CpuPipeline::reference(PipelineSettings::default());
+    let mut fast_pipeline = CpuPipeline::new(sculpt_only());
+    let mut reference_pipeline = CpuPipeline::reference(sculpt_only());
     assert_eq!(reference_pipeline.name(), "cpu-reference");
     for (i, stroke) in strokes.iter().enumerate() {
         let a = fast_pipeline.apply_stroke(&mut fast, stroke).unwrap();
@@ -222,7 +231,7 @@ fn masked_vertices_and_inactive_layers_stay_still() {
             normal: Some(Vec3::Z),
         }],
     };
-    let report = CpuPipeline::new(PipelineSettings::default())
+    let report = CpuPipeline::new(sculpt_only())
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
     assert!(report.moves > 0);
@@ -349,7 +358,7 @@ fn a_fold_within_one_layer_still_collides() {
             })
             .collect(),
     };
-    let report = CpuPipeline::new(PipelineSettings::default())
+    let report = CpuPipeline::new(sculpt_only())
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
     assert!(report.clamped > 0, "the fold collided with itself");

@@ -209,10 +209,7 @@ impl<'a> Remesher<'a> {
         let mut in_region = vec![false; mesh.vertex_count()];
         let mut region = Vec::new();
         for &v in seeds {
-            if live(v)
-                && !in_region[v as usize]
-                && (start == Start::Everywhere || out_of_band(v))
-            {
+            if live(v) && !in_region[v as usize] && (start == Start::Everywhere || out_of_band(v)) {
                 in_region[v as usize] = true;
                 region.push(v);
             }
