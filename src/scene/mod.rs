@@ -6,11 +6,13 @@
 //! size), upper layers have holes and disconnected patches, and the same name, size and seed
 //! always give the same mesh, bit for bit.
 
+mod jitter;
 mod noise;
 pub mod shapes;
 mod sheet;
 mod sphere;
 
+pub use jitter::{MAX_JITTER, jitter};
 pub use noise::WaveNoise;
 pub use sheet::{Lattice, SheetLayer, build_sheets, kept_face_count, kept_faces};
 pub use sphere::{frequency_for, geodesic_sphere};

@@ -46,6 +46,10 @@ enum Command {
         /// Random seed: the same arguments always give a byte-identical file.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Displace interior vertices along the surface by up to this many edge lengths (0 to
+        /// 0.4): a deliberately irregular mesh, e.g. to try `slayer remesh` on.
+        #[arg(long, default_value_t = 0.0)]
+        jitter: f32,
         /// Output file (.obj or .ply).
         #[arg(short, long)]
         output: PathBuf,
@@ -143,8 +147,9 @@ fn main() -> ExitCode {
             name,
             triangles,
             seed,
+            jitter,
             output,
-        } => scene::run(&name, triangles, seed, &output),
+        } => scene::run(&name, triangles, seed, jitter, &output),
         Command::Check { file, json } => check::run(&file, json),
         Command::Adapters { json } => adapters(json),
         Command::Sculpt {

@@ -10,6 +10,7 @@ pub fn run(
     name: &str,
     triangles: Option<usize>,
     seed: u64,
+    jitter: f32,
     output: &Path,
 ) -> anyhow::Result<ExitCode> {
     let kind: SceneKind = name.parse()?;
@@ -19,9 +20,19 @@ pub fn run(
         seed,
     };
     slayer::io::Format::of_path(output)?;
+    if !(0.0..=slayer::scene::MAX_JITTER).contains(&jitter) {
+        anyhow::bail!(
+            "--jitter {jitter} is out of range (0 to {} edge lengths)",
+            slayer::scene::MAX_JITTER
+        );
+    }
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {} triangles", spec.triangles));
-    let mesh = generate(&spec)?;
+    let mut mesh = generate(&spec)?;
+    if jitter > 0.0 {
+        steps.step(&format!("jittering vertices by up to {jitter} L"));
+        slayer::scene::jitter(&mut mesh, jitter, seed).map_err(anyhow::Error::msg)?;
+    }
     steps.step(&format!("writing {}", output.display()));
     slayer::io::write_mesh(&mesh, output).context("writing the scene")?;
     let seconds = steps.finish();
