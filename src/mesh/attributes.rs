@@ -47,6 +47,27 @@ impl Brdf {
     pub fn is_finite(&self) -> bool {
         self.as_array().iter().all(|v| v.is_finite())
     }
+
+    /// `self + (other − self)·t`, field by field. The parametrization is linear, so this is the
+    /// in-between material: painting, remeshing and the renderer's interpolation all use it.
+    /// For `t` in [0, 1] every field stays between the two inputs' values.
+    pub fn lerp(&self, other: &Brdf, t: f32) -> Brdf {
+        let (a, b) = (self.as_array(), other.as_array());
+        Brdf::from_array(std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t))
+    }
+
+    /// Every field clamped into its range ([0, 1] for all of them); NaN becomes 0.
+    pub fn clamped(&self) -> Brdf {
+        Brdf::from_array(
+            self.as_array()
+                .map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }),
+        )
+    }
+
+    /// Whether every field lies in [0, 1].
+    pub fn in_range(&self) -> bool {
+        self.as_array().iter().all(|v| (0.0..=1.0).contains(v))
+    }
 }
 
 impl Default for Brdf {

@@ -1,0 +1,130 @@
+//! The preview's reflectance model, on the CPU: the reference that `wgsl/render/preview.wgsl`
+//! mirrors line for line (sLayer, "Reflectance Editing": a microfacet BRDF with the Phong
+//! distribution over a linear parametrization).
+//!
+//! A vertex's [`Brdf`] holds diffuse albedo `kd`, specular albedo `ks` (the Fresnel reflectance
+//! at normal incidence) and a linearized roughness `r`. The model is Cook–Torrance:
+//!
+//! ```text
+//! f(l, v) = kd/π + D(h)·G(l, v, h)·F(v·h) / (4 (n·l)(n·v))
+//! ```
+//!
+//! with the normalized Blinn–Phong distribution `D`, Schlick's Fresnel `F` toward white at
+//! grazing angles, and Cook and Torrance's V-cavity shadowing/masking term `G`.
+
+use glam::Vec3;
+
+use crate::mesh::Brdf;
+
+/// Smallest microfacet slope `α` the preview renders. A perfect mirror (`α = 0`) would need an
+/// infinite exponent; at 0.03 the highlight is already far smaller than a pixel's worth of
+/// normal variation on our meshes.
+pub const MIN_SLOPE: f32 = 0.03;
+
+/// The Blinn–Phong exponent of linearized roughness `roughness` in [0, 1].
+///
+/// The mapping is chosen so that equal steps of `r` look like equal steps of blur, which is what
+/// makes a weighted sum of two BRDFs an in-between material (AppIm's requirement, Di Renzo et
+/// al. 2014): the exponent itself is far from linear (a 50/50 mix of exponents 10 and 1000 is
+/// a near-mirror, not a half-rough surface). We take the RMS microfacet slope `α = r²`, which
+/// Burley (Disney, 2012) found to be perceptually linear, and turn it into the Blinn exponent
+/// with Walter et al.'s (2007) match between Beckmann and Blinn–Phong, `e = 2/α² − 2`.
+/// `r = 1` gives `e = 0`, a uniform distribution of microfacets; `r = 0` is clamped at
+/// [`MIN_SLOPE`] (`e ≈ 2221`). Values outside [0, 1] are clamped.
+pub fn blinn_exponent(roughness: f32) -> f32 {
+    let r = if roughness.is_nan() {
+        1.0
+    } else {
+        roughness.clamp(0.0, 1.0)
+    };
+    let alpha = (r * r).max(MIN_SLOPE);
+    2.0 / (alpha * alpha) - 2.0
+}
+
+/// The normalized Blinn–Phong distribution: `(e + 2)/(2π) · (n·h)^e`, integrating to one over
+/// the projected hemisphere.
+pub fn blinn_distribution(n_dot_h: f32, exponent: f32) -> f32 {
+    (exponent + 2.0) / std::f32::consts::TAU * n_dot_h.max(0.0).powf(exponent)
+}
+
+/// Schlick's approximation of Fresnel reflectance from `f0` at normal incidence.
+pub fn schlick_fresnel(f0: Vec3, v_dot_h: f32) -> Vec3 {
+    let m = (1.0 - v_dot_h.clamp(0.0, 1.0)).powi(5);
+    f0 + (Vec3::ONE - f0) * m
+}
+
+/// Cook and Torrance's shadowing and masking of V-shaped microfacet grooves.
+pub fn shadowing(n_dot_l: f32, n_dot_v: f32, n_dot_h: f32, v_dot_h: f32) -> f32 {
+    let v_dot_h = v_dot_h.max(1e-4);
+    let g = 2.0 * n_dot_h / v_dot_h;
+    (g * n_dot_v).min(g * n_dot_l).min(1.0)
+}
+
+/// A directional light: unit direction toward the light, and its irradiance on a surface
+/// facing it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    pub direction: Vec3,
+    pub irradiance: Vec3,
+}
+
+/// The preview's lighting in a frame where `+z` is up from the mesh and the camera looks from
+/// `toward_camera`: a warm key light from the upper left of the view and a cool, weaker fill
+/// from the right, plus a little ambient light so that nothing is black.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lighting {
+    pub key: Light,
+    pub fill: Light,
+    pub ambient: Vec3,
+}
+
+impl Lighting {
+    /// Lights placed relative to the view: `right` and `up` are the camera's axes, `toward` is
+    /// the unit direction from the target to the camera.
+    pub fn for_view(right: Vec3, up: Vec3, toward: Vec3) -> Lighting {
+        let key = (toward * 0.8 + up * 0.9 - right * 0.6).normalize();
+        let fill = (toward * 0.7 + right * 0.9 - up * 0.1).normalize();
+        Lighting {
+            key: Light {
+                direction: key,
+                irradiance: Vec3::new(2.6, 2.45, 2.25),
+            },
+            fill: Light {
+                direction: fill,
+                irradiance: Vec3::new(0.55, 0.62, 0.75),
+            },
+            ambient: Vec3::new(0.10, 0.10, 0.11),
+        }
+    }
+}
+
+/// Reflected radiance for unit irradiance from `l`: `f(l, v)·(n·l)`. All vectors are unit
+/// length; `n` faces the viewer. Zero when the light is below the surface.
+pub fn reflect(brdf: &Brdf, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
+    let n_dot_l = n.dot(l);
+    if n_dot_l <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let n_dot_v = n.dot(v).max(1e-4);
+    let h = (l + v).normalize_or(n);
+    let n_dot_h = n.dot(h).max(0.0);
+    let v_dot_h = v.dot(h).max(0.0);
+    let kd = Vec3::from_array(brdf.diffuse);
+    let ks = Vec3::from_array(brdf.specular);
+    let d = blinn_distribution(n_dot_h, blinn_exponent(brdf.roughness));
+    let g = shadowing(n_dot_l, n_dot_v, n_dot_h, v_dot_h);
+    let f = schlick_fresnel(ks, v_dot_h);
+    let specular = f * (d * g / (4.0 * n_dot_l * n_dot_v));
+    (kd / std::f32::consts::PI + specular) * n_dot_l
+}
+
+/// Radiance leaving a point toward the viewer under `lighting`, clamped to the displayable
+/// range (the render target applies the sRGB curve).
+pub fn shade(brdf: &Brdf, n: Vec3, v: Vec3, lighting: &Lighting) -> Vec3 {
+    let n = if n.dot(v) < 0.0 { -n } else { n };
+    let kd = Vec3::from_array(brdf.diffuse);
+    let radiance = reflect(brdf, n, lighting.key.direction, v) * lighting.key.irradiance
+        + reflect(brdf, n, lighting.fill.direction, v) * lighting.fill.irradiance
+        + kd * lighting.ambient;
+    radiance.clamp(Vec3::ZERO, Vec3::ONE)
+}
