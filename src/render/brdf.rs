@@ -10,7 +10,8 @@
 //! ```
 //!
 //! with the normalized Blinn–Phong distribution `D`, Schlick's Fresnel `F` toward white at
-//! grazing angles, and Cook and Torrance's V-cavity shadowing/masking term `G`.
+//! grazing angles, and Cook and Torrance's V-cavity shadowing/masking term `G`, lit by two
+//! directional lights and a sky-over-ground environment ([`Lighting`]).
 
 use glam::Vec3;
 
@@ -68,33 +69,49 @@ pub struct Light {
     pub irradiance: Vec3,
 }
 
-/// The preview's lighting in a frame where `+z` is up from the mesh and the camera looks from
-/// `toward_camera`: a warm key light from the upper left of the view and a cool, weaker fill
-/// from the right, plus a little ambient light so that nothing is black.
+/// The preview's lighting: a warm key light from the left of the view, about 40° above the
+/// xy plane (raking enough to model sculpted relief), a cool, weaker fill from the right, and a
+/// sky-over-ground environment (`+z` up) that lights diffuse surfaces softly and that glossy
+/// ones reflect, so that bare metal looks like metal rather than black.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lighting {
     pub key: Light,
     pub fill: Light,
-    pub ambient: Vec3,
+    /// Radiance of the environment straight up and straight down.
+    pub sky: Vec3,
+    pub ground: Vec3,
 }
 
+/// Share of the environment's radiance that reaches diffuse surfaces (it stands for the
+/// occlusion a preview does not compute).
+pub const AMBIENT_DIFFUSE: f32 = 0.3;
+
 impl Lighting {
-    /// Lights placed relative to the view: `right` and `up` are the camera's axes, `toward` is
-    /// the unit direction from the target to the camera.
+    /// Lights placed for a camera with image axes `right` and `up` looking from `toward` (unit
+    /// direction from the target to the camera).
     pub fn for_view(right: Vec3, up: Vec3, toward: Vec3) -> Lighting {
-        let key = (toward * 0.8 + up * 0.9 - right * 0.6).normalize();
-        let fill = (toward * 0.7 + right * 0.9 - up * 0.1).normalize();
+        // The camera's side of the scene, on the ground plane.
+        let front = Vec3::new(toward.x, toward.y, 0.0).normalize_or(-up);
+        let key = (-right * 0.75 + front * 0.35 + Vec3::Z * 0.7).normalize();
+        let fill = (right * 0.6 + front * 0.5 + Vec3::Z * 0.6).normalize();
         Lighting {
             key: Light {
                 direction: key,
-                irradiance: Vec3::new(2.6, 2.45, 2.25),
+                irradiance: Vec3::new(2.7, 2.55, 2.35),
             },
             fill: Light {
                 direction: fill,
-                irradiance: Vec3::new(0.55, 0.62, 0.75),
+                irradiance: Vec3::new(0.5, 0.58, 0.72),
             },
-            ambient: Vec3::new(0.10, 0.10, 0.11),
+            sky: Vec3::new(0.55, 0.62, 0.75),
+            ground: Vec3::new(0.13, 0.12, 0.11),
         }
+    }
+
+    /// Environment radiance in direction `d`, blurred toward its mean as `blur` goes to 1.
+    pub fn environment(&self, d: Vec3, blur: f32) -> Vec3 {
+        let sharp = self.ground.lerp(self.sky, 0.5 + 0.5 * d.z.clamp(-1.0, 1.0));
+        sharp.lerp(0.5 * (self.ground + self.sky), blur.clamp(0.0, 1.0))
     }
 }
 
@@ -118,13 +135,30 @@ pub fn reflect(brdf: &Brdf, n: Vec3, l: Vec3, v: Vec3) -> Vec3 {
     (kd / std::f32::consts::PI + specular) * n_dot_l
 }
 
+/// Light from the environment: diffuse from the hemisphere around `n`, specular reflected
+/// about it, with Fresnel's rise at grazing angles damped for rough surfaces (which do not
+/// mirror their surroundings even there).
+pub fn environment_light(brdf: &Brdf, n: Vec3, v: Vec3, lighting: &Lighting) -> Vec3 {
+    let kd = Vec3::from_array(brdf.diffuse);
+    let ks = Vec3::from_array(brdf.specular);
+    let r = brdf.roughness.clamp(0.0, 1.0);
+    let n_dot_v = n.dot(v).clamp(0.0, 1.0);
+    let mirrored = n * (2.0 * n.dot(v)) - v;
+    let grazing = (1.0 - n_dot_v).powi(5);
+    let fresnel = ks + (Vec3::splat(1.0 - r).max(ks) - ks) * grazing;
+    // Diffuse light from the hemisphere is the environment fully blurred about the normal.
+    let hemisphere = lighting
+        .ground
+        .lerp(lighting.sky, 0.5 + 0.5 * n.z.clamp(-1.0, 1.0));
+    kd * hemisphere * AMBIENT_DIFFUSE + fresnel * lighting.environment(mirrored, r)
+}
+
 /// Radiance leaving a point toward the viewer under `lighting`, clamped to the displayable
 /// range (the render target applies the sRGB curve).
 pub fn shade(brdf: &Brdf, n: Vec3, v: Vec3, lighting: &Lighting) -> Vec3 {
     let n = if n.dot(v) < 0.0 { -n } else { n };
-    let kd = Vec3::from_array(brdf.diffuse);
     let radiance = reflect(brdf, n, lighting.key.direction, v) * lighting.key.irradiance
         + reflect(brdf, n, lighting.fill.direction, v) * lighting.fill.irradiance
-        + kd * lighting.ambient;
+        + environment_light(brdf, n, v, lighting);
     radiance.clamp(Vec3::ZERO, Vec3::ONE)
 }

@@ -28,7 +28,8 @@ struct PreviewUniforms {
     key_irradiance: vec4<f32>,
     fill_direction: vec4<f32>,
     fill_irradiance: vec4<f32>,
-    ambient: vec4<f32>,
+    sky: vec4<f32>,
+    ground: vec4<f32>,
     // 1 to draw edges.
     wireframe: u32,
     // 1 to replace every layer's diffuse albedo by its palette colour.
@@ -92,7 +93,8 @@ fn fs_main(in: Varyings) -> @location(0) vec4<f32> {
     n = normalize(n);
     let key = Light(view.key_direction.xyz, view.key_irradiance.xyz);
     let fill = Light(view.fill_direction.xyz, view.fill_irradiance.xyz);
-    var colour = shade(brdf, n, v, key, fill, view.ambient.xyz);
+    let env = Environment(view.sky.xyz, view.ground.xyz);
+    var colour = shade(brdf, n, v, key, fill, env);
     if view.wireframe != 0u {
         let distance_in_pixels = in.barycentric / max(edge_width, vec3<f32>(1e-6));
         let nearest = min(min(distance_in_pixels.x, distance_in_pixels.y), distance_in_pixels.z);

@@ -63,14 +63,38 @@ fn reflect_light(brdf: Brdf, n: vec3<f32>, l: vec3<f32>, v: vec3<f32>) -> vec3<f
     return (brdf.diffuse / PI + specular) * n_dot_l;
 }
 
-// Radiance toward the viewer under a key light, a fill light and ambient light, clamped.
-fn shade(brdf: Brdf, normal: vec3<f32>, v: vec3<f32>, key: Light, fill: Light, ambient: vec3<f32>) -> vec3<f32> {
+// The environment, +z up: sky over ground, blurred toward its mean as `blur` goes to 1.
+struct Environment {
+    sky: vec3<f32>,
+    ground: vec3<f32>,
+}
+
+// Share of the environment reaching diffuse surfaces (`AMBIENT_DIFFUSE`).
+const AMBIENT_DIFFUSE: f32 = 0.3;
+
+fn environment(env: Environment, d: vec3<f32>, blur: f32) -> vec3<f32> {
+    let sharp = mix(env.ground, env.sky, 0.5 + 0.5 * clamp(d.z, -1.0, 1.0));
+    return mix(sharp, 0.5 * (env.ground + env.sky), clamp(blur, 0.0, 1.0));
+}
+
+fn environment_light(brdf: Brdf, n: vec3<f32>, v: vec3<f32>, env: Environment) -> vec3<f32> {
+    let r = clamp(brdf.roughness, 0.0, 1.0);
+    let n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+    let mirrored = n * (2.0 * dot(n, v)) - v;
+    let grazing = pow(1.0 - n_dot_v, 5.0);
+    let fresnel = brdf.specular + (max(vec3<f32>(1.0 - r), brdf.specular) - brdf.specular) * grazing;
+    let hemisphere = mix(env.ground, env.sky, 0.5 + 0.5 * clamp(n.z, -1.0, 1.0));
+    return brdf.diffuse * hemisphere * AMBIENT_DIFFUSE + fresnel * environment(env, mirrored, r);
+}
+
+// Radiance toward the viewer under a key light, a fill light and the environment, clamped.
+fn shade(brdf: Brdf, normal: vec3<f32>, v: vec3<f32>, key: Light, fill: Light, env: Environment) -> vec3<f32> {
     var n = normal;
     if dot(n, v) < 0.0 {
         n = -n;
     }
     let radiance = reflect_light(brdf, n, key.direction, v) * key.irradiance
         + reflect_light(brdf, n, fill.direction, v) * fill.irradiance
-        + brdf.diffuse * ambient;
+        + environment_light(brdf, n, v, env);
     return clamp(radiance, vec3<f32>(0.0), vec3<f32>(1.0));
 }

@@ -253,7 +253,7 @@ fn main() -> ExitCode {
 }
 
 /// An error and its causes on one line.
-fn one_line(error: &anyhow::Error) -> String {
+pub fn one_line(error: &anyhow::Error) -> String {
     format!("{error:#}").replace('\n', " ")
 }
 
