@@ -72,9 +72,21 @@ fn scene_then_check_reports_clean_layers_as_json() {
 #[test]
 fn same_scene_arguments_write_identical_files() {
     let dir = scratch("determinism");
-    for ext in ["obj", "ply"] {
-        let a = dir.join(format!("a.{ext}"));
-        let b = dir.join(format!("b.{ext}"));
+    // Same file names in two folders: an OBJ names its material library by file name.
+    for side in ["a", "b"] {
+        std::fs::create_dir_all(dir.join(side)).unwrap();
+    }
+    for ext in ["obj", "mtl", "ply"] {
+        let a = dir.join(format!("a/m.{ext}"));
+        let b = dir.join(format!("b/m.{ext}"));
+        if ext == "mtl" {
+            // Written beside the OBJ.
+            assert!(
+                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+                "{ext}"
+            );
+            continue;
+        }
         for path in [&a, &b] {
             let out = slayer(&[
                 "scene",
