@@ -136,7 +136,12 @@ pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
     let after_obj = out.join("plaster-sculpted.obj");
     slayer::io::write_mesh(&mesh, &after)?;
     slayer::io::write_mesh(&mesh, &after_obj)?;
-    println!("  wrote {} and {}", after.display(), after_obj.display());
+    println!(
+        "  wrote {}, {} and {}",
+        after.display(),
+        after_obj.display(),
+        after_obj.with_extension("mtl").display()
+    );
     if let (Some(gpu), Some(before_image)) = (&gpu, before_image) {
         let after_image = render_to(gpu, &mesh, &out.join("plaster-after.png"))?;
         let both = out.join("plaster-before-after.png");
