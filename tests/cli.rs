@@ -220,6 +220,10 @@ fn demo_writes_and_checks_the_default_material() {
         "strokes.json",
         "plaster-sculpted.ply",
         "plaster-sculpted.obj",
+        "plaster-sculpted.mtl",
+        "plaster-before.png",
+        "plaster-after.png",
+        "plaster-before-after.png",
     ] {
         assert!(dir.join(file).exists(), "{file}");
     }
