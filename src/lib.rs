@@ -19,4 +19,5 @@ pub mod material;
 pub mod mesh;
 pub mod pipeline;
 pub mod remesh;
+pub mod render;
 pub mod scene;

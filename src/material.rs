@@ -27,6 +27,7 @@ pub const CLAY: Material = Material {
 };
 pub const PLASTER: Material = material("plaster", [0.86, 0.84, 0.78], 0.03, 0.85);
 pub const PAINT: Material = material("paint", [0.24, 0.47, 0.58], 0.08, 0.35);
+pub const RED_PAINT: Material = material("red-paint", [0.50, 0.07, 0.05], 0.08, 0.3);
 pub const PEELING_PAINT: Material = material("peeling-paint", [0.78, 0.66, 0.42], 0.06, 0.45);
 pub const WOOD: Material = material("wood", [0.74, 0.56, 0.36], 0.04, 0.7);
 pub const INNER_BARK: Material = material("inner-bark", [0.46, 0.29, 0.17], 0.03, 0.8);
@@ -44,6 +45,7 @@ pub const PRESETS: &[Material] = &[
     CLAY,
     PLASTER,
     PAINT,
+    RED_PAINT,
     PEELING_PAINT,
     WOOD,
     INNER_BARK,

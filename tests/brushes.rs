@@ -75,6 +75,7 @@ fn sheet() -> Mesh {
 
 fn stroke(kind: BrushKind, invert: bool, points: &[Vec3]) -> Stroke {
     Stroke {
+        paint: None,
         brush: Brush {
             kind,
             radius: 6.0,

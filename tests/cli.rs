@@ -72,9 +72,21 @@ fn scene_then_check_reports_clean_layers_as_json() {
 #[test]
 fn same_scene_arguments_write_identical_files() {
     let dir = scratch("determinism");
-    for ext in ["obj", "ply"] {
-        let a = dir.join(format!("a.{ext}"));
-        let b = dir.join(format!("b.{ext}"));
+    // Same file names in two folders: an OBJ names its material library by file name.
+    for side in ["a", "b"] {
+        std::fs::create_dir_all(dir.join(side)).unwrap();
+    }
+    for ext in ["obj", "mtl", "ply"] {
+        let a = dir.join(format!("a/m.{ext}"));
+        let b = dir.join(format!("b/m.{ext}"));
+        if ext == "mtl" {
+            // Written beside the OBJ.
+            assert!(
+                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+                "{ext}"
+            );
+            continue;
+        }
         for path in [&a, &b] {
             let out = slayer(&[
                 "scene",
@@ -208,6 +220,10 @@ fn demo_writes_and_checks_the_default_material() {
         "strokes.json",
         "plaster-sculpted.ply",
         "plaster-sculpted.obj",
+        "plaster-sculpted.mtl",
+        "plaster-before.png",
+        "plaster-after.png",
+        "plaster-before-after.png",
     ] {
         assert!(dir.join(file).exists(), "{file}");
     }
@@ -382,4 +398,116 @@ fn bench_writes_the_fixed_json_fields() {
     assert_eq!(scene["valid"], true);
     assert_eq!(scene["strokes"], 3);
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Runs the binary with a private runtime folder, so that Mesa's window-system probing stays
+/// quiet on headless machines and stderr holds only our own lines.
+fn slayer_headless(args: &[&str]) -> Output {
+    let runtime = scratch("xdg-runtime");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    Command::new(env!("CARGO_BIN_EXE_slayer"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn render_writes_a_png_of_the_requested_size() {
+    let dir = scratch("render");
+    let ply = dir.join("p.ply");
+    let png = dir.join("p.png");
+    let out = slayer(&[
+        "scene",
+        "plaster",
+        "--triangles",
+        "2000",
+        "-o",
+        ply.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = slayer_headless(&[
+        "render",
+        ply.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "120×80",
+        "--camera",
+        "-20,60,0.8",
+        "--layers",
+        "0,flakes",
+        "--wireframe",
+        "--false-colour",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("ms"), "{}", text(&out.stdout));
+    let image = slayer::render::Image::read_png(&png).unwrap();
+    assert_eq!((image.width, image.height), (120, 80));
+}
+
+#[test]
+fn render_of_an_empty_mesh_file_is_a_clear_error() {
+    // The readers refuse a mesh with no faces; the library renders such a mesh as a blank
+    // image (tests/render.rs), which `render` would announce with a warning.
+    let dir = scratch("render-empty");
+    let ply = dir.join("empty.ply");
+    let png = dir.join("empty.png");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n\
+         property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+    )
+    .unwrap();
+    let out = slayer_headless(&["render", ply.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    assert_one_line_error(&out, &["empty.ply", "no faces"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn render_mistakes_are_one_line_errors() {
+    let dir = scratch("render-errors");
+    let ply = dir.join("p.ply");
+    let out = slayer(&[
+        "scene",
+        "plane",
+        "--triangles",
+        "200",
+        "-o",
+        ply.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let png = dir.join("x.png");
+    let (ply, png) = (ply.to_str().unwrap(), png.to_str().unwrap());
+    let missing = dir.join("missing.ply");
+    assert_one_line_error(
+        &slayer_headless(&["render", missing.to_str().unwrap(), "-o", png]),
+        &["missing.ply"],
+    );
+    assert_one_line_error(
+        &slayer_headless(&["render", ply, "-o", png, "--size", "99999x10"]),
+        &["too large"],
+    );
+    assert_one_line_error(
+        &slayer_headless(&["render", ply, "-o", png, "--layers", "7"]),
+        &["--layers", "no layer `7`"],
+    );
+    assert_one_line_error(
+        &slayer_headless(&["render", ply, "-o", dir.join("x.jpg").to_str().unwrap()]),
+        &[".png"],
+    );
+    // Clap rejects malformed values before anything runs.
+    for (flag, value) in [
+        ("--size", "0x10"),
+        ("--size", "wide"),
+        ("--camera", "1,2,3,4"),
+    ] {
+        let out = slayer_headless(&["render", ply, "-o", png, flag, value]);
+        assert!(!out.status.success(), "{flag} {value}");
+        assert!(text(&out.stderr).contains(value), "{}", text(&out.stderr));
+    }
 }

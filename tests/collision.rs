@@ -69,6 +69,7 @@ fn push_down(mesh: &Mesh, rng: &mut ChaCha8Rng, edge: f32) -> Stroke {
         })
         .collect();
     Stroke {
+        paint: None,
         brush: Brush {
             kind: BrushKind::Draw,
             radius: 10.0 * edge,
@@ -216,6 +217,7 @@ fn masked_vertices_and_inactive_layers_stay_still() {
         }
     }
     let stroke = Stroke {
+        paint: None,
         brush: Brush {
             kind: BrushKind::Draw,
             radius: 6.0,
@@ -340,6 +342,7 @@ fn a_fold_within_one_layer_still_collides() {
     let mut mesh = Mesh::new(positions, faces, layers, vec!["sheet".into()]).unwrap();
     assert_eq!(find_intersections(&mesh).total(), 0);
     let stroke = Stroke {
+        paint: None,
         brush: Brush {
             kind: BrushKind::Draw,
             radius: 3.0,

@@ -308,3 +308,42 @@ fn writing_is_atomic_and_reports_unwritable_paths() {
     std::fs::remove_dir_all(&dir).unwrap();
     let _ = Vec3::ZERO;
 }
+
+#[test]
+fn obj_files_come_with_a_material_library_per_layer_and_still_read_back() {
+    let dir = std::env::temp_dir().join(format!("slayer-io-mtl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = slayer::scene::generate(&slayer::scene::SceneSpec {
+        triangles: 2000,
+        ..slayer::scene::SceneSpec::new(slayer::scene::SceneKind::Plaster)
+    })
+    .unwrap();
+    let path = dir.join("plaster.obj");
+    slayer::io::write_mesh(&mesh, &path).unwrap();
+    let obj = std::fs::read_to_string(&path).unwrap();
+    assert!(obj.contains("mtllib plaster.mtl\n"), "{}", &obj[..200]);
+    assert_eq!(obj.matches("usemtl ").count(), 3);
+    let mtl = std::fs::read_to_string(dir.join("plaster.mtl")).unwrap();
+    assert_eq!(mtl.matches("newmtl ").count(), 3);
+    for (name, preset) in [
+        ("plaster", slayer::material::PLASTER),
+        ("paint", slayer::material::PAINT),
+        ("flakes", slayer::material::PEELING_PAINT),
+    ] {
+        let block = mtl.split(&format!("newmtl {name}\n")).nth(1).unwrap();
+        let [r, g, b] = preset.brdf.diffuse;
+        assert!(
+            block.contains(&format!("# preset {}", preset.name)),
+            "{block}"
+        );
+        assert!(block.contains(&format!("Kd {r} {g} {b}\n")), "{block}");
+        let ns = slayer::mesh::blinn_exponent(preset.brdf.roughness);
+        assert!(block.contains(&format!("Ns {ns}\n")), "{block}");
+    }
+    // Our reader (tobj underneath) keeps one layer per object and ignores the library.
+    let back = slayer::io::read_mesh(&path).unwrap();
+    assert_eq!(back.layer_names(), mesh.layer_names());
+    assert_eq!(back.positions(), mesh.positions());
+    assert_eq!(back.faces(), mesh.faces());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -3,7 +3,12 @@
 
 use std::path::Path;
 
-use slayer::gpu::shaders::{KERNELS, SHARED, expand_imports, kernel_source, validate};
+use slayer::gpu::CellKeyParams;
+use slayer::gpu::shaders::{
+    FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
+    render_source, validate,
+};
+use slayer::render::{PreviewUniforms, RenderVertex};
 
 fn wgsl_files(folder: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(folder)
@@ -43,6 +48,39 @@ fn every_kernel_file_is_registered_and_validates() {
 }
 
 #[test]
+fn every_render_shader_is_registered_and_has_vertex_and_fragment_stages() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("wgsl/render");
+    let files = wgsl_files(&root);
+    assert!(!files.is_empty());
+    for name in &files {
+        assert!(
+            RENDER_SHADERS.iter().any(|(k, _)| k == name),
+            "wgsl/render/{name}.wgsl is not registered in gpu::shaders::RENDER_SHADERS"
+        );
+        let on_disk = std::fs::read_to_string(root.join(format!("{name}.wgsl"))).unwrap();
+        let source = expand_imports(name, &on_disk).expect("imports expand");
+        let (module, _) = validate(name, &source).unwrap_or_else(|e| panic!("{e}"));
+        for (entry, stage) in [
+            (VERTEX_ENTRY, naga::ShaderStage::Vertex),
+            (FRAGMENT_ENTRY, naga::ShaderStage::Fragment),
+        ] {
+            assert!(
+                module
+                    .entry_points
+                    .iter()
+                    .any(|e| e.name == entry && e.stage == stage),
+                "wgsl/render/{name}.wgsl has no {stage:?} entry point `{entry}`"
+            );
+        }
+    }
+    assert_eq!(
+        RENDER_SHADERS.len(),
+        files.len(),
+        "RENDER_SHADERS names a file that does not exist"
+    );
+}
+
+#[test]
 fn every_shared_file_is_registered() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("wgsl/shared");
     for name in wgsl_files(&root) {
@@ -60,9 +98,13 @@ fn unknown_imports_are_reported() {
     assert!(error.to_string().contains("shared/nope"));
 }
 
-/// Size and member offsets of a named struct in a kernel, per naga.
-fn naga_struct(kernel: &str, name: &str) -> (u32, Vec<(String, u32)>) {
-    let source = kernel_source(kernel).unwrap();
+/// Size and member offsets of a named struct in a kernel or render shader, per naga.
+fn naga_struct(shader: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let source = match shader.strip_prefix("render/") {
+        Some(render) => render_source(render).unwrap(),
+        None => kernel_source(shader).unwrap(),
+    };
+    let kernel = shader;
     let (module, _) = validate(kernel, &source).unwrap();
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).unwrap();
@@ -81,12 +123,13 @@ fn naga_struct(kernel: &str, name: &str) -> (u32, Vec<(String, u32)>) {
     (layouter[handle].size, offsets)
 }
 
+/// Checks a host struct (in scope by its bare name) against the WGSL struct of the same name.
 macro_rules! assert_layout {
-    ($kernel:expr, $ty:ident { $($field:ident),* $(,)? }) => {{
-        let (size, offsets) = naga_struct($kernel, stringify!($ty));
-        assert_eq!(size as usize, std::mem::size_of::<slayer::gpu::$ty>(), "size of {}", stringify!($ty));
+    ($shader:expr, $ty:ident { $($field:ident),* $(,)? }) => {{
+        let (size, offsets) = naga_struct($shader, stringify!($ty));
+        assert_eq!(size as usize, std::mem::size_of::<$ty>(), "size of {}", stringify!($ty));
         let host: Vec<(String, u32)> = vec![
-            $((stringify!($field).to_string(), std::mem::offset_of!(slayer::gpu::$ty, $field) as u32)),*
+            $((stringify!($field).to_string(), std::mem::offset_of!($ty, $field) as u32)),*
         ];
         assert_eq!(offsets, host, "field offsets of {}", stringify!($ty));
     }};
@@ -101,6 +144,41 @@ fn host_structs_match_naga_layout() {
             table_mask,
             inv_cell_size,
             _pad
+        }
+    );
+}
+
+#[test]
+fn render_host_structs_match_naga_layout() {
+    assert_layout!(
+        "render/preview",
+        RenderVertex {
+            position,
+            layer,
+            normal,
+            roughness,
+            diffuse,
+            _pad0,
+            specular,
+            _pad1
+        }
+    );
+    assert_layout!(
+        "render/preview",
+        PreviewUniforms {
+            view_proj,
+            eye,
+            key_direction,
+            key_irradiance,
+            fill_direction,
+            fill_irradiance,
+            sky,
+            ground,
+            wireframe,
+            false_colour,
+            line_width,
+            _pad,
+            palette
         }
     );
 }

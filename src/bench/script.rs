@@ -154,6 +154,7 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
             falloff: Falloff::Blend { n: 3 },
             invert,
             layers: active.into_iter().map(LayerRef::Index).collect(),
+            paint: None,
             spacing: spec.spacing,
             samples: points,
         });
@@ -175,8 +176,7 @@ fn pick_brush(rng: &mut ChaCha8Rng, mix: BrushMix) -> (BrushKind, bool, f32) {
             _ => (BrushKind::Flatten, false, rng.random_range(0.3..0.7)),
         },
         BrushMix::Torture => {
-            let kind = crate::brush::BrushKind::ALL
-                [rng.random_range(0..crate::brush::BrushKind::ALL.len())];
+            let kind = BrushKind::DEFORMING[rng.random_range(0..BrushKind::DEFORMING.len())];
             let invert = kind == BrushKind::Draw || rng.random_bool(0.3);
             (kind, invert, rng.random_range(0.5..1.0))
         }

@@ -3,13 +3,17 @@
 
 mod falloff;
 mod field;
+mod paint;
+mod stencil;
 mod stroke;
 
 pub use falloff::Falloff;
 pub use field::{Dab, DabFrame, displacement};
+pub use paint::{Paint, paint_share};
+pub use stencil::{Pattern, Stencil};
 pub use stroke::{
-    LayerRef, MAX_RADIUS_OVER_EXTENT, Sample, SampleSpec, Stroke, StrokeError, StrokeFile,
-    StrokeSpec, resample,
+    LayerRef, MAX_RADIUS_OVER_EXTENT, PaintSpec, Sample, SampleSpec, StencilSpec, Stroke,
+    StrokeError, StrokeFile, StrokeSpec, resample,
 };
 
 use serde::{Deserialize, Serialize};
@@ -37,10 +41,27 @@ pub enum BrushKind {
     Crease,
     /// Turn about the brush normal through the centre.
     Twist,
+    /// Move nothing; only paint the stroke's material (every brush can paint as it deforms).
+    Paint,
 }
 
 impl BrushKind {
-    pub const ALL: [BrushKind; 9] = [
+    /// Every brush.
+    pub const ALL: [BrushKind; 10] = [
+        BrushKind::Draw,
+        BrushKind::Inflate,
+        BrushKind::Deflate,
+        BrushKind::Grab,
+        BrushKind::Smooth,
+        BrushKind::Flatten,
+        BrushKind::Pinch,
+        BrushKind::Crease,
+        BrushKind::Twist,
+        BrushKind::Paint,
+    ];
+
+    /// The brushes that move vertices.
+    pub const DEFORMING: [BrushKind; 9] = [
         BrushKind::Draw,
         BrushKind::Inflate,
         BrushKind::Deflate,
@@ -63,7 +84,13 @@ impl BrushKind {
             BrushKind::Pinch => "pinch",
             BrushKind::Crease => "crease",
             BrushKind::Twist => "twist",
+            BrushKind::Paint => "paint",
         }
+    }
+
+    /// Whether the brush moves vertices (all but `paint`).
+    pub fn deforms(self) -> bool {
+        self != BrushKind::Paint
     }
 }
 

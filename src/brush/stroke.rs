@@ -13,21 +13,43 @@
 //!     "invert": false,
 //!     "layers": [1, "flakes"],    // active layers, by index or name; the others stay still but collide
 //!     "spacing": 0.25,            // resampling step, as a share of the radius
+//!     "paint": {"material": "rust"},          // optional: paint while deforming (see below)
 //!     "samples": [{"position": [0.5, 0.5, 0.01], "pressure": 1.0, "normal": [0, 0, 1]}]
 //!   }]
 //! }
 //! ```
 //!
-//! `falloff`, `invert`, `spacing`, `pressure` and `normal` may be left out (blend n=3, false,
-//! 0.25, 1, the surface normal under the brush). Every problem is reported with the stroke and
-//! sample it is in.
+//! `falloff`, `invert`, `spacing`, `paint`, `pressure` and `normal` may be left out (blend n=3,
+//! false, 0.25, no paint, 1, the surface normal under the brush). Every problem is reported with
+//! the stroke and sample it is in.
+//!
+//! `paint` makes any brush paint as it deforms; the `paint` brush only paints and needs it. At
+//! each dab a vertex's BRDF becomes `old + (brush − old)·w·pressure·opacity`, `w` its falloff
+//! weight (for the `paint` brush, `strength` multiplies the opacity too):
+//!
+//! ```json
+//! "paint": {"material": "rust"}                                   // a preset (crate::material)
+//! "paint": {"diffuse": [0.5, 0.2, 0.1], "specular": [0.04, 0.04, 0.04], "roughness": 0.7}
+//! "paint": {"material": "paint", "roughness": 0.2, "opacity": 0.5} // a preset, overridden
+//! "paint": {"material": "rust", "stencil": {"pattern": "spots", "with": "bare-metal", "tile": 0.05}}
+//! "paint": {"material": "rust", "stencil": {"png": "moss.png", "tile": 0.1}}
+//! ```
+//!
+//! A stencil replaces the material texel by texel, tiled every `tile` world units and projected
+//! along the brush normal ([`super::Stencil::at`]). Patterns (`checker`, `stripes`, `spots`)
+//! mix `material` and `with` (default `clay`); a PNG (path relative to the working directory)
+//! gives diffuse albedo from its RGB, roughness from its alpha and the material's specular
+//! albedo.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::{Brush, BrushKind, Falloff};
-use crate::mesh::{LayerId, MAX_COORDINATE, Mesh};
+use std::sync::Arc;
+
+use super::{Brush, BrushKind, Falloff, Paint, Pattern, Stencil};
+use crate::material;
+use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
 
 /// A radius beyond this many times the mesh's bounding-box diagonal is rejected as absurd.
 pub const MAX_RADIUS_OVER_EXTENT: f32 = 10.0;
@@ -83,6 +105,50 @@ pub struct SampleSpec {
     pub normal: Option<[f32; 3]>,
 }
 
+/// The `paint` of a stroke as written in the file.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaintSpec {
+    /// A preset's name; the fields below override its values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diffuse: Option<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular: Option<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opacity: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stencil: Option<StencilSpec>,
+}
+
+impl PaintSpec {
+    /// A preset, as is.
+    pub fn material(name: &str) -> PaintSpec {
+        PaintSpec {
+            material: Some(name.to_string()),
+            ..PaintSpec::default()
+        }
+    }
+}
+
+/// A stencil as written in the file: a generated `pattern` or a `png`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StencilSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub png: Option<String>,
+    /// The pattern's second material (a preset name).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub with: Option<String>,
+    /// World size of one repeat.
+    pub tile: f32,
+}
+
 /// One stroke as written in the file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -95,6 +161,8 @@ pub struct StrokeSpec {
     #[serde(default)]
     pub invert: bool,
     pub layers: Vec<LayerRef>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paint: Option<PaintSpec>,
     #[serde(default = "default_spacing")]
     pub spacing: f32,
     pub samples: Vec<SampleSpec>,
@@ -121,6 +189,8 @@ pub struct Sample {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stroke {
     pub brush: Brush,
+    /// What the stroke paints, if anything.
+    pub paint: Option<Paint>,
     /// Active layers, sorted.
     pub layers: Vec<LayerId>,
     /// Resampling step as a share of the radius.
@@ -299,7 +369,25 @@ fn resolve_stroke(
             normal,
         });
     }
+    let paint = match (&spec.paint, spec.brush) {
+        (Some(paint), kind) => {
+            let mut paint = resolve_paint(paint)
+                .map_err(|(field, message)| (format!(".paint{field}"), message))?;
+            if kind == BrushKind::Paint {
+                paint.opacity *= spec.strength;
+            }
+            Some(paint)
+        }
+        (None, BrushKind::Paint) => {
+            return fail(
+                ".paint",
+                "the paint brush needs a `paint` (e.g. {\"material\": \"rust\"})".into(),
+            );
+        }
+        (None, _) => None,
+    };
     Ok(Stroke {
+        paint,
         brush: Brush {
             kind: spec.brush,
             radius: spec.radius,
@@ -311,6 +399,105 @@ fn resolve_stroke(
         spacing: spec.spacing,
         samples,
     })
+}
+
+fn preset(name: &str) -> Result<Brdf, String> {
+    material::preset(name).map(|m| m.brdf).ok_or_else(|| {
+        let names: Vec<&str> = material::PRESETS.iter().map(|m| m.name).collect();
+        format!("no material named `{name}` (presets: {})", names.join(", "))
+    })
+}
+
+/// A paint spec checked and turned into a [`Paint`]; errors name the field under `.paint`.
+fn resolve_paint(spec: &PaintSpec) -> Result<Paint, (String, String)> {
+    let fail = |field: &str, message: String| Err((field.to_string(), message));
+    let unit = |field: &str, values: &[f32]| -> Result<(), (String, String)> {
+        match values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+            Some(v) => Err((field.to_string(), format!("{v} is outside [0, 1]"))),
+            None => Ok(()),
+        }
+    };
+    let mut brdf = match &spec.material {
+        Some(name) => match preset(name) {
+            Ok(brdf) => brdf,
+            Err(message) => return fail(".material", message),
+        },
+        None => {
+            let missing = [
+                ("diffuse", spec.diffuse.is_none()),
+                ("specular", spec.specular.is_none()),
+                ("roughness", spec.roughness.is_none()),
+            ];
+            if let Some((field, _)) = missing.iter().find(|(_, absent)| *absent) {
+                return fail(
+                    &format!(".{field}"),
+                    "missing: give a `material`, or all of `diffuse`, `specular` and `roughness`"
+                        .into(),
+                );
+            }
+            Brdf::CLAY
+        }
+    };
+    if let Some(diffuse) = spec.diffuse {
+        unit(".diffuse", &diffuse)?;
+        brdf.diffuse = diffuse;
+    }
+    if let Some(specular) = spec.specular {
+        unit(".specular", &specular)?;
+        brdf.specular = specular;
+    }
+    if let Some(roughness) = spec.roughness {
+        unit(".roughness", &[roughness])?;
+        brdf.roughness = roughness;
+    }
+    let opacity = spec.opacity.unwrap_or(1.0);
+    unit(".opacity", &[opacity])?;
+    let stencil = match &spec.stencil {
+        None => None,
+        Some(stencil) => Some(Arc::new(
+            resolve_stencil(stencil, brdf)
+                .map_err(|(field, message)| (format!(".stencil{field}"), message))?,
+        )),
+    };
+    Ok(Paint {
+        brdf,
+        stencil,
+        opacity,
+    })
+}
+
+fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, String)> {
+    let fail = |field: &str, message: String| Err((field.to_string(), message));
+    if !(spec.tile.is_finite() && spec.tile > 0.0) {
+        return fail(".tile", format!("{} is not a positive length", spec.tile));
+    }
+    match (&spec.pattern, &spec.png) {
+        (Some(name), None) => {
+            let Some(pattern) = Pattern::from_name(name) else {
+                let names: Vec<&str> = Pattern::ALL.iter().map(|p| p.name()).collect();
+                return fail(
+                    ".pattern",
+                    format!("no pattern named `{name}` (patterns: {})", names.join(", ")),
+                );
+            };
+            let second = match &spec.with {
+                Some(name) => preset(name).map_err(|m| (".with".to_string(), m))?,
+                None => Brdf::CLAY,
+            };
+            Ok(Stencil::pattern(pattern, brdf, second, spec.tile))
+        }
+        (None, Some(path)) => {
+            if spec.with.is_some() {
+                return fail(".with", "only patterns mix two materials".into());
+            }
+            let bytes = std::fs::read(path)
+                .map_err(|e| (".png".to_string(), format!("cannot read `{path}`: {e}")))?;
+            Stencil::from_png(&bytes, brdf.specular, spec.tile)
+                .map_err(|e| (".png".to_string(), format!("`{path}`: {e}")))
+        }
+        (Some(_), Some(_)) => fail("", "give either `pattern` or `png`, not both".into()),
+        (None, None) => fail("", "give a `pattern` or a `png`".into()),
+    }
 }
 
 /// Resamples a polyline of samples every `step` of arc length, interpolating pressure and

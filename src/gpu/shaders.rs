@@ -4,15 +4,29 @@
 use thiserror::Error;
 
 /// Shared snippets, by import name.
-pub const SHARED: &[(&str, &str)] = &[("shared/grid", include_str!("../../wgsl/shared/grid.wgsl"))];
+pub const SHARED: &[(&str, &str)] = &[
+    ("shared/grid", include_str!("../../wgsl/shared/grid.wgsl")),
+    ("shared/brdf", include_str!("../../wgsl/shared/brdf.wgsl")),
+];
 
 /// Compute kernels, by file stem; each has entry point `main`.
 pub const KERNELS: &[(&str, &str)] = &[("cell_keys", include_str!("../../wgsl/cell_keys.wgsl"))];
+
+/// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)
+/// and `fs_main` (fragment).
+pub const RENDER_SHADERS: &[(&str, &str)] =
+    &[("preview", include_str!("../../wgsl/render/preview.wgsl"))];
+
+/// Entry points every render shader has.
+pub const VERTEX_ENTRY: &str = "vs_main";
+pub const FRAGMENT_ENTRY: &str = "fs_main";
 
 #[derive(Debug, Error)]
 pub enum ShaderError {
     #[error("no kernel named `{0}`")]
     UnknownKernel(String),
+    #[error("no render shader named `{0}`")]
+    UnknownRenderShader(String),
     #[error("{file}: unknown import `{import}`")]
     UnknownImport { file: String, import: String },
     #[error("{file}: WGSL does not validate:\n{message}")]
@@ -26,6 +40,15 @@ pub fn kernel_source(name: &str) -> Result<String, ShaderError> {
         .find(|(n, _)| *n == name)
         .ok_or_else(|| ShaderError::UnknownKernel(name.to_string()))?;
     expand_imports(name, text)
+}
+
+/// The render shader's source with its imports expanded.
+pub fn render_source(name: &str) -> Result<String, ShaderError> {
+    let (_, text) = RENDER_SHADERS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| ShaderError::UnknownRenderShader(name.to_string()))?;
+    expand_imports(&format!("render/{name}"), text)
 }
 
 /// Replaces `#import` lines by the shared snippet they name (one level; snippets import nothing).

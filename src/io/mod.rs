@@ -8,7 +8,9 @@ mod obj;
 mod ply;
 
 pub use error::IoError;
-pub use obj::{ObjReport, parse_obj, write_obj};
+pub use obj::{
+    ObjReport, layer_materials, parse_obj, write_mtl, write_obj, write_obj_with_materials,
+};
 pub use ply::{parse_ply, write_ply};
 
 use std::fs;
@@ -131,10 +133,26 @@ pub fn encode_mesh(mesh: &Mesh, format: Format) -> Vec<u8> {
     bytes
 }
 
-/// Writes a mesh in the format its extension names, atomically.
+/// Writes a mesh in the format its extension names, atomically. An OBJ gets a material library
+/// beside it (`NAME.mtl`, one material per layer) that it names with `mtllib`.
 pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
-    let format = Format::of_path(path)?;
-    write_atomically(path, &encode_mesh(mesh, format))
+    match Format::of_path(path)? {
+        Format::Ply => write_atomically(path, &encode_mesh(mesh, Format::Ply)),
+        Format::Obj => {
+            let library = path.with_extension("mtl");
+            let library_name = library
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "materials.mtl".into());
+            let mut obj = Vec::new();
+            let mut mtl = Vec::new();
+            // Writing into a Vec cannot fail.
+            let _ = write_obj_with_materials(mesh, &mut obj, Some(&library_name));
+            let _ = write_mtl(mesh, &mut mtl);
+            write_atomically(path, &obj)?;
+            write_atomically(&library, &mtl)
+        }
+    }
 }
 
 /// Writes `bytes` to a temporary file beside `path`, syncs it, and renames it over `path`.

@@ -9,7 +9,7 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use super::IoError;
-use crate::mesh::{INVALID, LayerId, MAX_COORDINATE, Mesh, VertexFlags};
+use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh, VertexFlags};
 
 /// What parsing found besides the mesh.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -266,6 +266,16 @@ impl<R: BufRead> BufRead for LineCounter<R> {
 
 /// Writes the live mesh as OBJ: one `o` per layer, its vertices then its faces.
 pub fn write_obj(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+    write_obj_with_materials(mesh, out, None)
+}
+
+/// [`write_obj`], naming the material library `library` (a file name beside the OBJ, written
+/// by [`write_mtl`]) in a `mtllib` line and giving each layer its material with `usemtl`.
+pub fn write_obj_with_materials(
+    mesh: &Mesh,
+    out: &mut impl Write,
+    library: Option<&str>,
+) -> io::Result<()> {
     let live_faces = mesh.live_face_count();
     writeln!(
         out,
@@ -274,6 +284,9 @@ pub fn write_obj(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
         live_faces,
         mesh.layer_count()
     )?;
+    if let Some(library) = library {
+        writeln!(out, "mtllib {library}")?;
+    }
     let mut file_index = vec![0u32; mesh.vertex_count()];
     let mut next_index = 1u32;
     for (layer, layer_name) in mesh.layer_names().iter().enumerate() {
@@ -287,6 +300,10 @@ pub fn write_obj(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
             continue;
         }
         writeln!(out, "o {}", sanitize_name(layer_name))?;
+        if library.is_some() {
+            // Before the layer's faces, so that readers keep one object per layer.
+            writeln!(out, "usemtl {}", sanitize_name(layer_name))?;
+        }
         for (v, p) in mesh.positions().iter().enumerate() {
             if mesh.vertex_layers()[v] == layer
                 && !mesh.flags()[v].contains(VertexFlags::DEAD)
@@ -305,6 +322,72 @@ pub fn write_obj(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Each layer with faces, with its material: the mean BRDF of its live vertices. The
+/// parametrization is linear, so the mean is the layer's average material; a layer nobody has
+/// painted gets exactly its default (generated scenes give each layer a preset).
+pub fn layer_materials(mesh: &Mesh) -> Vec<(LayerId, String, Brdf)> {
+    let mut sums = vec![[0f64; 7]; mesh.layer_count()];
+    let mut counts = vec![0usize; mesh.layer_count()];
+    let mut has_faces = vec![false; mesh.layer_count()];
+    for (t, &l) in mesh.faces().iter().zip(mesh.face_layers()) {
+        if t[0] != INVALID {
+            has_faces[l as usize] = true;
+        }
+    }
+    for (v, brdf) in mesh.brdfs().iter().enumerate() {
+        if mesh.flags()[v].contains(VertexFlags::DEAD)
+            || mesh.adjacency().vertex_corner[v] == INVALID
+        {
+            continue;
+        }
+        let layer = mesh.vertex_layers()[v] as usize;
+        for (sum, value) in sums[layer].iter_mut().zip(brdf.as_array()) {
+            *sum += value as f64;
+        }
+        counts[layer] += 1;
+    }
+    (0..mesh.layer_count())
+        .filter(|&l| has_faces[l])
+        .map(|l| {
+            let n = counts[l].max(1) as f64;
+            let mean = Brdf::from_array(sums[l].map(|s| (s / n) as f32));
+            (l as LayerId, sanitize_name(&mesh.layer_names()[l]), mean)
+        })
+        .collect()
+}
+
+/// Writes a Wavefront material library with one `newmtl` per layer ([`layer_materials`]):
+/// `Kd` the diffuse albedo, `Ks` the specular albedo, `Ns` the Blinn–Phong exponent of the
+/// linearized roughness ([`crate::mesh::blinn_exponent`]).
+pub fn write_mtl(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+    writeln!(out, "# slayer materials: one per layer")?;
+    for (_, name, brdf) in layer_materials(mesh) {
+        writeln!(out)?;
+        writeln!(out, "newmtl {name}")?;
+        if let Some(preset) = crate::material::PRESETS
+            .iter()
+            .find(|m| close(&m.brdf, &brdf))
+        {
+            writeln!(out, "# preset {}", preset.name)?;
+        }
+        writeln!(out, "# linearized roughness {}", brdf.roughness)?;
+        let [r, g, b] = brdf.diffuse;
+        writeln!(out, "Kd {r} {g} {b}")?;
+        let [r, g, b] = brdf.specular;
+        writeln!(out, "Ks {r} {g} {b}")?;
+        writeln!(out, "Ns {}", brdf.blinn_exponent())?;
+        writeln!(out, "illum 2")?;
+    }
+    Ok(())
+}
+
+fn close(a: &Brdf, b: &Brdf) -> bool {
+    a.as_array()
+        .iter()
+        .zip(b.as_array())
+        .all(|(x, y)| (x - y).abs() <= 1e-5)
 }
 
 /// OBJ names end at whitespace.

@@ -47,12 +47,63 @@ impl Brdf {
     pub fn is_finite(&self) -> bool {
         self.as_array().iter().all(|v| v.is_finite())
     }
+
+    /// `self + (other − self)·t`, field by field. The parametrization is linear, so this is the
+    /// in-between material: painting, remeshing and the renderer's interpolation all use it.
+    /// For `t` in [0, 1] every field stays between the two inputs' values.
+    pub fn lerp(&self, other: &Brdf, t: f32) -> Brdf {
+        let (a, b) = (self.as_array(), other.as_array());
+        Brdf::from_array(std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t))
+    }
+
+    /// Every field clamped into its range ([0, 1] for all of them); NaN becomes 0.
+    pub fn clamped(&self) -> Brdf {
+        Brdf::from_array(
+            self.as_array()
+                .map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }),
+        )
+    }
+
+    /// The Blinn–Phong exponent of this BRDF's roughness ([`blinn_exponent`]).
+    pub fn blinn_exponent(&self) -> f32 {
+        blinn_exponent(self.roughness)
+    }
+
+    /// Whether every field lies in [0, 1].
+    pub fn in_range(&self) -> bool {
+        self.as_array().iter().all(|v| (0.0..=1.0).contains(v))
+    }
 }
 
 impl Default for Brdf {
     fn default() -> Self {
         Brdf::CLAY
     }
+}
+
+/// Smallest microfacet slope `α` a BRDF is rendered or exported with. A perfect mirror (`α = 0`) would need an
+/// infinite exponent; at 0.03 the highlight is already far smaller than a pixel's worth of
+/// normal variation on our meshes.
+pub const MIN_SLOPE: f32 = 0.03;
+
+/// The Blinn–Phong exponent of linearized roughness `roughness` in [0, 1].
+///
+/// The mapping is chosen so that equal steps of `r` look like equal steps of blur, which is what
+/// makes a weighted sum of two BRDFs an in-between material (AppIm's requirement, Di Renzo et
+/// al. 2014): the exponent itself is far from linear (a 50/50 mix of exponents 10 and 1000 is
+/// a near-mirror, not a half-rough surface). We take the RMS microfacet slope `α = r²`, which
+/// Burley (Disney, 2012) found to be perceptually linear, and turn it into the Blinn exponent
+/// with Walter et al.'s (2007) match between Beckmann and Blinn–Phong, `e = 2/α² − 2`.
+/// `r = 1` gives `e = 0`, a uniform distribution of microfacets; `r = 0` is clamped at
+/// [`MIN_SLOPE`] (`e ≈ 2221`). Values outside [0, 1] are clamped.
+pub fn blinn_exponent(roughness: f32) -> f32 {
+    let r = if roughness.is_nan() {
+        1.0
+    } else {
+        roughness.clamp(0.0, 1.0)
+    };
+    let alpha = (r * r).max(MIN_SLOPE);
+    2.0 / (alpha * alpha) - 2.0
 }
 
 bitflags::bitflags! {

@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 
-use super::{Brdf, INVALID, Mesh, VertexFlags, face_of, next, prev};
+use super::{INVALID, Mesh, VertexFlags, face_of, next, prev};
 
 impl Mesh {
     /// The two end vertices of the edge opposite `corner`.
@@ -105,7 +105,7 @@ impl Mesh {
         self.normals
             .push(na.lerp(nb, t).try_normalize().unwrap_or(na));
         let (ba, bb) = (self.brdfs[a as usize], self.brdfs[b as usize]);
-        self.brdfs.push(lerp_brdf(ba, bb, t));
+        self.brdfs.push(ba.lerp(&bb, t));
         self.vertex_layers.push(layer);
         self.flags.push(VertexFlags::empty());
         self.adjacency.vertex_corner.push(INVALID);
@@ -271,7 +271,7 @@ impl Mesh {
             }
         }
         self.positions[a as usize] = position;
-        let merged = lerp_brdf(self.brdfs[a as usize], self.brdfs[b as usize], 0.5);
+        let merged = self.brdfs[a as usize].lerp(&self.brdfs[b as usize], 0.5);
         self.brdfs[a as usize] = merged;
         self.flags[b as usize] = VertexFlags::DEAD;
         self.adjacency.vertex_corner[b as usize] = INVALID;
@@ -309,13 +309,4 @@ impl Mesh {
         self.version.topology += 1;
         a
     }
-}
-
-fn lerp_brdf(a: Brdf, b: Brdf, t: f32) -> Brdf {
-    let (x, y) = (a.as_array(), b.as_array());
-    let mut out = [0.0; 7];
-    for k in 0..7 {
-        out[k] = x[k] + (y[k] - x[k]) * t;
-    }
-    Brdf::from_array(out)
 }

@@ -14,7 +14,7 @@ mod measure;
 mod validate;
 mod vertex_faces;
 
-pub use attributes::{Brdf, LayerId, VertexFlags};
+pub use attributes::{Brdf, LayerId, MIN_SLOPE, VertexFlags, blinn_exponent};
 pub use components::Components;
 pub use corner_table::{CornerTable, FanIter, INVALID, face_of, next, prev};
 pub use error::MeshError;

@@ -6,7 +6,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::step::{Region, StrokeState, collide, deform, select};
+use super::step::{Region, StrokeState, collide, deform, paint, select};
 use super::{
     PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
     StrokeReport,
@@ -335,6 +335,22 @@ impl SculptPipeline for CpuPipeline {
             previous = Some(sample.position);
             times.selection += millis(started);
             if first_selection.is_empty() {
+                continue;
+            }
+
+            // Paint in the same pass as the deformation, where the brush is before it moves
+            // anything; booked under deformation.
+            if let Some(spec) = &stroke.paint {
+                let started = Instant::now();
+                let dab = Dab { frame, ..probe };
+                let painted = paint(&state, mesh, &dab, &first_selection, spec);
+                let brdfs = mesh.brdfs_mut();
+                for (&(v, _), brdf) in first_selection.iter().zip(painted) {
+                    brdfs[v as usize] = brdf;
+                }
+                times.deformation += millis(started);
+            }
+            if !stroke.brush.kind.deforms() {
                 continue;
             }
 

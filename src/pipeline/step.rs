@@ -7,12 +7,12 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::brush::{Dab, displacement};
+use crate::brush::{Dab, Paint, displacement, paint_share};
 use crate::collide::neighbourhood::ring_vertices;
 use crate::collide::{LocalFaceGrid, Stamps};
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
-use crate::mesh::{INVALID, Mesh, VertexFlags};
+use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags};
 
 /// Bisection rounds when clamping a move: 2⁻¹⁶ of a step.
 const CLAMP_ROUNDS: u32 = 16;
@@ -139,6 +139,30 @@ pub fn deform(
         selection.par_iter().map(target).collect()
     } else {
         selection.iter().map(target).collect()
+    }
+}
+
+/// Painted BRDFs of the selected vertices (sLayer's reflectance editing): each becomes a
+/// weighted sum of its own BRDF and the brush's at its position, the weight being its falloff
+/// weight × pressure × opacity. Selection already leaves out inactive layers and masked
+/// vertices, so those keep their BRDF.
+pub fn paint(
+    state: &StrokeState<'_>,
+    mesh: &Mesh,
+    dab: &Dab,
+    selection: &[(u32, f32)],
+    paint: &Paint,
+) -> Vec<Brdf> {
+    let normal = dab.frame.normal;
+    let painted = |&(v, w): &(u32, f32)| {
+        let own = mesh.brdfs()[v as usize];
+        let brush = paint.brdf_at(mesh.positions()[v as usize], normal);
+        own.lerp(&brush, paint_share(w, dab.pressure, paint.opacity))
+    };
+    if state.parallel {
+        selection.par_iter().map(painted).collect()
+    } else {
+        selection.iter().map(painted).collect()
     }
 }
 

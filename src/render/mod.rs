@@ -1,0 +1,17 @@
+//! Reflectance and the preview renderer (DESIGN §7, sLayer's "Reflectance Editing").
+//!
+//! [`brdf`] is the microfacet model over the linear BRDF parametrization, on the CPU: the
+//! reference the WGSL preview shader mirrors and the tests check. [`preview`] renders a mesh
+//! offscreen through wgpu (lavapipe included) into an [`Image`] that is written as PNG.
+
+pub mod brdf;
+mod camera;
+mod image;
+mod preview;
+
+pub use camera::{Camera, CameraSpec, FIELD_OF_VIEW_DEGREES};
+pub use image::{Image, ImageDifference, ImageError};
+pub use preview::{
+    BACKGROUND, MAX_PIXELS, PALETTE, PreviewUniforms, RenderError, RenderOptions, RenderVertex,
+    Rendered, render,
+};
