@@ -60,42 +60,32 @@ fn project(t: &[DVec3; 3], axis: DVec3) -> (f64, f64) {
 /// path.
 pub fn surely_apart_at_shared_vertex(p: Vec3, a: [Vec3; 2], b: [Vec3; 2]) -> bool {
     let p = p.as_dvec3();
-    let [a1, a2] = a.map(|x| x.as_dvec3() - p);
-    let [b1, b2] = b.map(|x| x.as_dvec3() - p);
-    let (na, nb) = (a1.cross(a2), b1.cross(b2));
-    let (la, lb) = (na.length(), nb.length());
-    if la == 0.0 || lb == 0.0 {
+    let [u1, u2] = a.map(|x| x.as_dvec3() - p);
+    let [w1, w2] = b.map(|x| x.as_dvec3() - p);
+    let (na, nb) = (u1.cross(u2), w1.cross(w2));
+    let (la, lb) = (na.length_squared(), nb.length_squared());
+    // A view both triangles face: the sum of their unit normals, scaled by |na|²·|nb|² to stay
+    // free of square roots. Folded-back pairs (facing apart) are left to the exact test.
+    let view = na * lb + nb * la;
+    let (fa, fb) = (na.dot(view), nb.dot(view));
+    // (Each is |n|²·(|m|² + n·m) for the two normals: rounding is far below the margin.)
+    if fa <= 1e-9 * la * lb || fb <= 1e-9 * la * lb {
         return false;
     }
-    let (na, nb) = (na / la, nb / lb);
-    // A view both triangles face (folded-back pairs are left to the exact test).
-    if na.dot(nb) < -0.5 {
-        return false;
-    }
-    let view = (na + nb).normalize();
-    let e1 = view.any_orthonormal_vector();
-    let e2 = view.cross(e1);
-    let flat = |x: DVec3| (x.dot(e1), x.dot(e2));
-    let [u1, u2, w1, w2] = [a1, a2, b1, b2].map(flat);
-    let cross = |r: (f64, f64), x: (f64, f64)| r.0 * x.1 - r.1 * x.0;
-    let scale = [a1, a2, b1, b2]
+    // Seen along `view`, the side of x from the line through p along r: det(r, x, view), the 2-D
+    // cross product of their projections (times |view|). Both wedges turn positively
+    // (det(u1, u2, view) = fa > 0 and det(w1, w2, view) = fb > 0).
+    let side = |r: DVec3, x: DVec3| r.cross(x).dot(view);
+    let (s11, s12, s21, s22) = (side(u1, w1), side(u1, w2), side(u2, w1), side(u2, w2));
+    let scale = [u1, u2, w1, w2]
         .iter()
-        .fold(0.0f64, |m, x| m.max(x.length()));
-    let margin = 1e-9 * scale * scale;
-    // Both projections have area: each triangle meets the view line through p only at p.
-    if cross(u1, u2).abs() <= margin || cross(w1, w2).abs() <= margin {
-        return false;
-    }
-    // Two convex wedges with a common apex are apart exactly when a line along one of their
-    // four sides separates them.
-    let separates = |r: (f64, f64), same: [(f64, f64); 2], other: [(f64, f64); 2]| {
-        let s = same.map(|x| cross(r, x));
-        let o = other.map(|x| cross(r, x));
-        (s.iter().all(|&v| v >= -margin) && o.iter().all(|&v| v < -margin))
-            || (s.iter().all(|&v| v <= margin) && o.iter().all(|&v| v > margin))
-    };
-    separates(u1, [u1, u2], [w1, w2])
-        || separates(u2, [u1, u2], [w1, w2])
-        || separates(w1, [w1, w2], [u1, u2])
-        || separates(w2, [w1, w2], [u1, u2])
+        .fold(0.0f64, |m, x| m.max(x.abs().max_element()));
+    let margin = 1e-9 * scale * scale * view.abs().max_element();
+    // Two convex wedges with a common apex are apart exactly when a line along one of their four
+    // sides separates them: along u1 (A on its left) B must lie right, along u2 (A right) B left,
+    // and likewise for w1 and w2 with A.
+    (s11 < -margin && s12 < -margin)
+        || (s21 > margin && s22 > margin)
+        || (s11 > margin && s21 > margin)
+        || (s12 < -margin && s22 < -margin)
 }

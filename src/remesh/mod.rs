@@ -122,17 +122,30 @@ fn remesh(
 ) -> RemeshReport {
     let started = Instant::now();
     let mut remesher = Remesher::new(mesh, grid, seeds, settings, start);
+    let t_new = started.elapsed().as_secs_f64() * 1e3;
+    let (mut t_split, mut t_collapse, mut t_flip, mut t_relax) = (0.0, 0.0, 0.0, 0.0);
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
+        let t = Instant::now();
         remesher.split_long_edges();
+        t_split += t.elapsed().as_secs_f64() * 1e3;
+        let t = Instant::now();
         remesher.collapse_short_edges();
+        t_collapse += t.elapsed().as_secs_f64() * 1e3;
+        let t = Instant::now();
         remesher.flip_toward_regular_valence();
+        t_flip += t.elapsed().as_secs_f64() * 1e3;
         // Relaxation follows edits: a round that changed nothing (after the first, which
         // relaxes what the stroke left out of band) has converged.
         if round > 0 && remesher.edit_count() == edits {
             break;
         }
+        let t = Instant::now();
         remesher.relax();
+        t_relax += t.elapsed().as_secs_f64() * 1e3;
+    }
+    if std::env::var_os("SLAYER_DEBUG_REMESH").is_some() {
+        eprintln!("new {t_new:.1} split {t_split:.1} collapse {t_collapse:.1} flip {t_flip:.1} relax {t_relax:.1}");
     }
     let mut report = remesher.finish();
     report.passes = 1;
@@ -444,9 +457,10 @@ impl<'a> Remesher<'a> {
             let o = self.mesh.adjacency().opposite[c as usize];
             let positions = self.mesh.positions();
             let middle = 0.5 * (positions[a as usize] + positions[b as usize]);
+            // (Meeting in the middle from the other side would test the same faces again.)
+            let first = if c != INVALID && self.mesh.is_collapse_ok(c) { c } else { o };
             let choices = [
-                (c, a, b, Some(middle)),
-                (o, b, a, Some(middle)),
+                (first, a, b, Some(middle)),
                 (c, a, b, None),
                 (o, b, a, None),
             ];
@@ -456,6 +470,7 @@ impl<'a> Remesher<'a> {
                 if corner == INVALID || done || !self.mesh.is_collapse_ok(corner) {
                     continue;
                 }
+                let (keep, remove) = if corner == c { (keep, remove) } else { (b, a) };
                 let boundary_keep = self.mesh.is_boundary_vertex(keep);
                 let boundary_remove = self.mesh.is_boundary_vertex(remove);
                 let at_keep = self.mesh.positions()[keep as usize];
