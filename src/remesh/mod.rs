@@ -195,6 +195,7 @@ struct Remesher<'a> {
     surface: ReferenceSurface,
     report: RemeshReport,
     scratch: Vec<u32>,
+    near: Vec<NearFace>,
 }
 
 impl<'a> Remesher<'a> {
@@ -260,6 +261,7 @@ impl<'a> Remesher<'a> {
             refused_collapses: Default::default(),
             surface,
             scratch: Vec::new(),
+            near: Vec::new(),
         };
         for v in starting {
             remesher.mark_dirty(v);
@@ -719,37 +721,80 @@ impl<'a> Remesher<'a> {
                 Some((ids, at))
             })
             .collect();
+        // One gathering serves both tests: faces near the move (for the distance test) and near
+        // the moved faces (for the crossing test).
+        let reach = Aabb::of_points(&[from, target]).expanded(d);
+        let around = moved
+            .iter()
+            .fold(reach, |b, (_, t)| b.including(t[0]).including(t[1]).including(t[2]));
+        let near = self.gather_near(&around);
         let mut safe = true;
-        let query = Aabb::of_points(&[from, target]).expanded(d);
-        // Faces near the target, through the reference surface's grid of all nearby faces.
-        self.surface.for_each_near(&query, |face| {
-            if !safe {
-                return;
-            }
-            let tri = faces[face as usize];
+        for candidate in &near {
+            let (face, tri) = (candidate.face, candidate.ids);
             // The neighbourhood skipped is the vertex's own, in its own layer.
-            if tri[0] == INVALID
-                || (self.mesh.face_layers()[face as usize] == layer
-                    && tri.iter().any(|w| ring.contains(w)))
+            if self.mesh.face_layers()[face as usize] == layer
+                && tri.iter().any(|w| ring.contains(w))
             {
-                return;
+                continue;
             }
-            let [a, b, c] = tri.map(|w| positions[w as usize]);
             // Faces beyond the collision distance do not matter.
-            if !Aabb::of_points(&[a, b, c]).within(target, d) {
-                return;
+            if !candidate.bounds.within(target, d) {
+                continue;
             }
+            let [a, b, c] = candidate.at;
             let now = closest_point_on_triangle(target, a, b, c).distance(target);
             if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
                 safe = false;
+                break;
+            }
+        }
+        self.scratch = ring;
+        let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
+        let clear = safe && self.faces_clear_among(&moved, &involved, &[], &near);
+        self.near = near;
+        clear
+    }
+
+    /// The faces filed near `query` (live ones, at their current positions), in the reusable
+    /// list.
+    fn gather_near(&mut self, query: &Aabb) -> Vec<NearFace> {
+        let mut near = std::mem::take(&mut self.near);
+        near.clear();
+        let positions = self.mesh.positions();
+        let faces = self.mesh.faces();
+        self.surface.for_each_near(query, |face| {
+            let ids = faces[face as usize];
+            if ids[0] == INVALID {
+                return;
+            }
+            let at = ids.map(|w| positions[w as usize]);
+            let bounds = Aabb::of_points(&at);
+            if bounds.overlaps(query) {
+                near.push(NearFace {
+                    face,
+                    ids,
+                    at,
+                    bounds,
+                });
             }
         });
-        self.scratch = ring;
-        if !safe {
-            return false;
-        }
-        let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
-        self.faces_clear(&moved, &involved, &[])
+        near
+    }
+
+    /// [`faces_clear_among`](Self::faces_clear_among) the faces near the triangles.
+    fn faces_clear(
+        &mut self,
+        triangles: &[([u32; 3], [Vec3; 3])],
+        moving: &[u32],
+        replaced: &[u32],
+    ) -> bool {
+        let bounds = triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
+        let near = self.gather_near(&bounds);
+        let clear = self.faces_clear_among(triangles, moving, replaced, &near);
+        self.near = near;
+        clear
     }
 
     /// No triangle in `triangles` (vertex ids and the positions they will have) crosses a nearby
@@ -757,14 +802,13 @@ impl<'a> Remesher<'a> {
     /// pair tests skip and a later split would turn into a crossing). Faces around a `moving`
     /// vertex are being tested themselves, among each other; `replaced` faces are on their way
     /// out.
-    fn faces_clear(
+    fn faces_clear_among(
         &self,
         triangles: &[([u32; 3], [Vec3; 3])],
         moving: &[u32],
         replaced: &[u32],
+        near: &[NearFace],
     ) -> bool {
-        let positions = self.mesh.positions();
-        let faces = self.mesh.faces();
         for (i, (ids, tri)) in triangles.iter().enumerate() {
             for (other_ids, other) in &triangles[i + 1..] {
                 let shared = ids.iter().filter(|w| other_ids.contains(w)).count();
@@ -776,40 +820,38 @@ impl<'a> Remesher<'a> {
                 }
             }
         }
-        let mut clear = true;
         for (ids, tri) in triangles {
             let bounds = Aabb::of_points(tri);
-            self.surface.for_each_near(&bounds, |face| {
-                if !clear {
-                    return;
-                }
-                let other_ids = faces[face as usize];
-                if other_ids[0] == INVALID
+            for candidate in near {
+                let (face, other_ids, other) = (candidate.face, candidate.ids, candidate.at);
+                if !candidate.bounds.overlaps(&bounds)
                     || replaced.contains(&face)
                     || other_ids.iter().any(|w| moving.contains(w))
                 {
-                    return;
+                    continue;
                 }
                 let shared = other_ids.iter().filter(|w| ids.contains(w)).count();
-                if shared == 3 {
-                    return;
-                }
-                let other = other_ids.map(|w| positions[w as usize]);
-                if !Aabb::of_points(&other).overlaps(&bounds) {
-                    return;
-                }
-                let crossing = if shared == 0 {
-                    triangles_intersect(*tri, other)
-                } else {
-                    neighbours_overlap(*tri, *ids, other, other_ids)
+                let crossing = match shared {
+                    3 => false,
+                    0 => triangles_intersect(*tri, other),
+                    _ => neighbours_overlap(*tri, *ids, other, other_ids),
                 };
                 if crossing {
-                    clear = false;
+                    return false;
                 }
-            });
+            }
         }
-        clear
+        true
     }
+}
+
+/// A face near an edit, as it is now.
+#[derive(Debug, Clone, Copy)]
+struct NearFace {
+    face: u32,
+    ids: [u32; 3],
+    at: [Vec3; 3],
+    bounds: Aabb,
 }
 
 fn normal(t: [Vec3; 3]) -> Vec3 {
