@@ -186,8 +186,8 @@ fn segments_intersect_2d(p: Coord<f64>, q: Coord<f64>, r: Coord<f64>, s: Coord<f
 pub fn neighbours_overlap(a: [Vec3; 3], a_ids: [u32; 3], b: [Vec3; 3], b_ids: [u32; 3]) -> bool {
     let mut shared = [0usize; 3];
     let mut count = 0;
-    for i in 0..3 {
-        if b_ids.contains(&a_ids[i]) {
+    for (i, id) in a_ids.iter().enumerate() {
+        if b_ids.contains(id) {
             shared[count] = i;
             count += 1;
         }

@@ -122,30 +122,17 @@ fn remesh(
 ) -> RemeshReport {
     let started = Instant::now();
     let mut remesher = Remesher::new(mesh, grid, seeds, settings, start);
-    let t_new = started.elapsed().as_secs_f64() * 1e3;
-    let (mut t_split, mut t_collapse, mut t_flip, mut t_relax) = (0.0, 0.0, 0.0, 0.0);
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
-        let t = Instant::now();
         remesher.split_long_edges();
-        t_split += t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
         remesher.collapse_short_edges();
-        t_collapse += t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
         remesher.flip_toward_regular_valence();
-        t_flip += t.elapsed().as_secs_f64() * 1e3;
         // Relaxation follows edits: a round that changed nothing (after the first, which
         // relaxes what the stroke left out of band) has converged.
         if round > 0 && remesher.edit_count() == edits {
             break;
         }
-        let t = Instant::now();
         remesher.relax();
-        t_relax += t.elapsed().as_secs_f64() * 1e3;
-    }
-    if std::env::var_os("SLAYER_DEBUG_REMESH").is_some() {
-        eprintln!("new {t_new:.1} split {t_split:.1} collapse {t_collapse:.1} flip {t_flip:.1} relax {t_relax:.1}");
     }
     let mut report = remesher.finish();
     report.passes = 1;
@@ -460,7 +447,11 @@ impl<'a> Remesher<'a> {
             let positions = self.mesh.positions();
             let middle = 0.5 * (positions[a as usize] + positions[b as usize]);
             // (Meeting in the middle from the other side would test the same faces again.)
-            let first = if c != INVALID && self.mesh.is_collapse_ok(c) { c } else { o };
+            let first = if c != INVALID && self.mesh.is_collapse_ok(c) {
+                c
+            } else {
+                o
+            };
             let choices = [
                 (first, a, b, Some(middle)),
                 (c, a, b, None),
@@ -724,9 +715,9 @@ impl<'a> Remesher<'a> {
         // One gathering serves both tests: faces near the move (for the distance test) and near
         // the moved faces (for the crossing test).
         let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = moved
-            .iter()
-            .fold(reach, |b, (_, t)| b.including(t[0]).including(t[1]).including(t[2]));
+        let around = moved.iter().fold(reach, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
         let near = self.gather_near(&around);
         let mut safe = true;
         for candidate in &near {
