@@ -511,3 +511,53 @@ fn render_mistakes_are_one_line_errors() {
         assert!(text(&out.stderr).contains(value), "{}", text(&out.stderr));
     }
 }
+
+/// Issue 4's check as a user runs it: a deliberately irregular scene, remeshed, comes back
+/// with uniform edges (cv < 0.15) and passes `slayer check`.
+#[test]
+fn remesh_makes_a_jittered_scene_uniform_and_clean() {
+    let dir = scratch("remesh");
+    let (rough, smooth) = (dir.join("rough.ply"), dir.join("smooth.ply"));
+    let out = slayer(&[
+        "scene",
+        "plaster",
+        "--triangles",
+        "8000",
+        "--jitter",
+        "0.4",
+        "-o",
+        rough.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let cv = |path: &Path| {
+        let out = slayer(&["check", path.to_str().unwrap(), "--json"]);
+        assert!(out.status.success(), "{}", text(&out.stdout));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        assert_eq!(report["intersections"], 0);
+        report["edge_length_cv"].as_f64().unwrap()
+    };
+    let before = cv(&rough);
+    assert!(before > 0.2, "the jittered scene is irregular: cv {before}");
+    let out = slayer(&[
+        "remesh",
+        rough.to_str().unwrap(),
+        "-o",
+        smooth.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("smallest angle"));
+    let after = cv(&smooth);
+    assert!(after < 0.15, "cv {before} -> {after}");
+    assert_one_line_error(
+        &slayer(&[
+            "scene",
+            "plaster",
+            "--jitter",
+            "0.9",
+            "-o",
+            rough.to_str().unwrap(),
+        ]),
+        &["--jitter"],
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

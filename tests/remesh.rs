@@ -231,3 +231,44 @@ fn remeshing_after_strokes_keeps_layers_apart() {
         );
     }
 }
+
+/// Remeshing after every sample: more passes than strokes, and the same guarantees.
+#[test]
+fn remeshing_per_sample_keeps_the_mesh_sound() {
+    use slayer::bench::{ScriptSpec, generate_script};
+    use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+    let mut mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 6_000,
+        seed: 5,
+    })
+    .unwrap();
+    let script = generate_script(
+        &mesh,
+        &ScriptSpec {
+            strokes: 8,
+            seed: 5,
+            ..ScriptSpec::default()
+        },
+    );
+    let strokes = script.resolve(&mesh, "script").unwrap();
+    let mut pipeline = CpuPipeline::new(PipelineSettings {
+        remeshing: Remeshing::AfterSample,
+        ..PipelineSettings::default()
+    });
+    let mut passes = 0;
+    for stroke in &strokes {
+        passes += pipeline
+            .apply_stroke(&mut mesh, stroke)
+            .unwrap()
+            .remesh
+            .passes;
+    }
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(&mesh).total(), 0);
+    assert!(
+        passes > strokes.len(),
+        "{passes} passes for {} strokes",
+        strokes.len()
+    );
+}
