@@ -561,3 +561,12 @@ fn remesh_makes_a_jittered_scene_uniform_and_clean() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A missing file is named once, with the system's reason once.
+#[test]
+fn a_missing_file_is_one_plain_line() {
+    let out = slayer(&["check", "/nonexistent/slayer-missing.ply"]);
+    assert_one_line_error(&out, &["slayer-missing.ply"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(stderr.matches("os error").count(), 1, "{stderr}");
+}

@@ -263,7 +263,19 @@ fn main() -> ExitCode {
 
 /// An error and its causes on one line.
 pub fn one_line(error: &anyhow::Error) -> String {
-    format!("{error:#}").replace('\n', " ")
+    // The chain, outermost first; a cause whose text its wrapper already quotes is not repeated
+    // (an I/O error inside "FILE: <io error>" would otherwise print twice).
+    let mut line = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+    }
+    line.replace('\n', " ")
 }
 
 fn adapters(json: bool) -> anyhow::Result<ExitCode> {
