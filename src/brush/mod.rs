@@ -60,18 +60,8 @@ impl BrushKind {
         BrushKind::Paint,
     ];
 
-    /// The brushes that move vertices.
-    pub const DEFORMING: [BrushKind; 9] = [
-        BrushKind::Draw,
-        BrushKind::Inflate,
-        BrushKind::Deflate,
-        BrushKind::Grab,
-        BrushKind::Smooth,
-        BrushKind::Flatten,
-        BrushKind::Pinch,
-        BrushKind::Crease,
-        BrushKind::Twist,
-    ];
+    /// The brushes that move vertices: all but the last, `Paint`.
+    pub const DEFORMING: &[BrushKind] = Self::ALL.split_last().unwrap().1;
 
     pub fn name(self) -> &'static str {
         match self {

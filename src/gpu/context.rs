@@ -255,24 +255,30 @@ impl GpuContext {
             });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         self.queue.submit([encoder.finish()]);
+        let bytes = self.map_read(&staging)?;
+        Ok(bytemuck::pod_collect_to_vec::<u8, T>(&bytes))
+    }
+
+    /// Waits for the GPU and copies a mappable (`MAP_READ`) buffer's bytes out.
+    pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         let (sender, receiver) = mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |result| {
+        buffer.map_async(wgpu::MapMode::Read, .., move |result| {
             let _ = sender.send(result);
         });
+        let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
+            .map_err(|e| failed(&e))?;
         receiver
             .recv()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let view = staging
+            .map_err(|e| failed(&e))?
+            .map_err(|e| failed(&e))?;
+        let bytes = buffer
             .get_mapped_range(..)
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let values = bytemuck::cast_slice::<u8, T>(&view).to_vec();
-        drop(view);
-        staging.unmap();
-        Ok(values)
+            .map_err(|e| failed(&e))?
+            .to_vec();
+        buffer.unmap();
+        Ok(bytes)
     }
 
     /// Workgroup counts covering `invocations` threads of `workgroup_size`, folded into y when

@@ -2,8 +2,6 @@
 //! `wgsl/render/preview.wgsl` and reads the image back. Works on any adapter with storage
 //! buffers in the vertex stage, lavapipe included, so headless machines render too.
 
-use std::sync::mpsc;
-
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use thiserror::Error;
@@ -517,7 +515,7 @@ pub fn render(
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(GpuError::Validation(error.to_string()).into());
     }
-    let padded = map_read(gpu, &readback)?;
+    let padded = gpu.map_read(&readback)?;
     let mut rgba = Vec::with_capacity(row_bytes as usize * height as usize);
     for row in padded.chunks_exact(padded_row_bytes as usize) {
         rgba.extend_from_slice(&row[..row_bytes as usize]);
@@ -532,25 +530,4 @@ pub fn render(
         draws: bind_groups.len(),
         camera,
     })
-}
-
-/// Waits for the GPU and copies a mappable buffer's bytes out.
-fn map_read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    let (sender, receiver) = mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |result| {
-        let _ = sender.send(result);
-    });
-    gpu.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    receiver
-        .recv()
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let bytes = buffer
-        .get_mapped_range(..)
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .to_vec();
-    buffer.unmap();
-    Ok(bytes)
 }
