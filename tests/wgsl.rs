@@ -3,11 +3,12 @@
 
 use std::path::Path;
 
-use slayer::gpu::CellKeyParams;
 use slayer::gpu::shaders::{
     FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
     render_source, validate,
 };
+use slayer::gpu::{CellKeyParams, CountParams, SCAN_BLOCK};
+use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
 
 fn wgsl_files(folder: &Path) -> Vec<String> {
@@ -146,6 +147,48 @@ fn host_structs_match_naga_layout() {
             _pad
         }
     );
+    for kernel in ["cell_counts", "scan", "scan_add", "scatter"] {
+        assert_layout!(
+            kernel,
+            CountParams {
+                count,
+                _pad0,
+                _pad1,
+                _pad2
+            }
+        );
+    }
+}
+
+/// The value of a `u32` constant declared in a kernel (with its imports), per naga.
+fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
+    let source = kernel_source(kernel).unwrap();
+    let (module, _) = validate(kernel, &source).unwrap();
+    let (_, constant) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("{kernel}: no constant {name}"));
+    match module.global_expressions[constant.init] {
+        naga::Expression::Literal(naga::Literal::U32(value)) => value,
+        ref other => panic!("{kernel}: {name} is not a u32 literal: {other:?}"),
+    }
+}
+
+#[test]
+fn wgsl_constants_match_the_host() {
+    for (name, host) in [
+        ("VERTEX_LOCKED", VertexFlags::LOCKED.bits()),
+        ("VERTEX_MASKED", VertexFlags::MASKED.bits()),
+        ("VERTEX_DEAD", VertexFlags::DEAD.bits()),
+        ("INVALID", INVALID),
+    ] {
+        assert_eq!(naga_u32_constant("cell_counts", name), host, "{name}");
+    }
+    // One scan workgroup is one block on the host side.
+    for kernel in ["scan", "scan_add"] {
+        assert_eq!(naga_u32_constant(kernel, "WORKGROUP_SIZE"), SCAN_BLOCK);
+    }
 }
 
 #[test]

@@ -13,3 +13,24 @@ pub struct CellKeyParams {
     pub inv_cell_size: f32,
     pub _pad: u32,
 }
+
+/// `CountParams` in `wgsl/shared/mesh.wgsl`: the element count of a one-dimensional pass.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct CountParams {
+    pub count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl CountParams {
+    pub fn new(count: usize) -> Self {
+        CountParams {
+            count: count as u32,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
+}

@@ -3,9 +3,15 @@
 
 mod cell_keys;
 mod context;
+mod hash_table;
 mod layout;
+mod scan;
 pub mod shaders;
 
-pub use cell_keys::run_cell_keys;
+pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adapters};
-pub use layout::CellKeyParams;
+pub use hash_table::{
+    CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
+};
+pub use layout::{CellKeyParams, CountParams};
+pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
