@@ -5,9 +5,11 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
 use slayer::gpu::{
-    AdapterChoice, CellKeyParams, CountParams, CsrTable, GpuContext, run_cell_counts,
-    run_cell_keys, run_exclusive_scan, run_hash_table, run_scatter, table_size_for,
+    AdapterChoice, BrushSphere, CellKeyParams, CountParams, CsrTable, GpuContext, SelectedVertex,
+    run_cell_counts, run_cell_keys, run_exclusive_scan, run_hash_table, run_scatter, run_select,
+    select_params, table_size_for,
 };
 use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
 use slayer::mesh::{INVALID, VertexFlags};
@@ -303,4 +305,271 @@ fn hash_build_folds_wide_dispatches() {
     let expected = slayer::cpu::hash_table(&positions, &flags, 10.0, table_size);
     let actual = run_hash_table(&gpu, &positions, &flags, 10.0, table_size).expect("GPU run");
     assert_eq!(actual.canonical(), expected);
+}
+
+const FALLOFFS: [Falloff; 5] = [
+    Falloff::Blend { n: 3 },
+    Falloff::Blend { n: 6 },
+    Falloff::Smooth,
+    Falloff::Sphere,
+    Falloff::Linear,
+];
+
+/// Vertices within this share of the radius of the rim may be in one selection and not the
+/// other: `|p − c|² ≤ r²` and `t < 1` are decided on rounded values, and GPUs may fuse the
+/// multiply-adds of the dot product. Seeded inputs put none there; the allowance keeps the test
+/// about real disagreements.
+const RIM_TOLERANCE: f32 = 1e-5;
+/// Largest weight difference: `sqrt(1 − t²)` near the rim turns one ulp of `t` into ~1e-6.
+const WEIGHT_TOLERANCE: f32 = 1e-5;
+
+/// Compares two selections as sets of vertices, with weights within `WEIGHT_TOLERANCE`;
+/// returns the largest weight difference.
+fn assert_same_selection(
+    label: &str,
+    actual: &[(u32, f32)],
+    expected: &[(u32, f32)],
+    positions: &[Vec3],
+    brush: &BrushSphere,
+) -> f32 {
+    let sorted = |s: &[(u32, f32)]| {
+        let mut s = s.to_vec();
+        s.sort_by_key(|&(v, _)| v);
+        s
+    };
+    let (actual, expected) = (sorted(actual), sorted(expected));
+    let on_rim = |v: u32| {
+        let d = positions[v as usize].distance(brush.center);
+        (d - brush.radius).abs() <= RIM_TOLERANCE * brush.radius
+    };
+    let (mut i, mut j, mut worst) = (0, 0, 0.0f32);
+    while i < actual.len() || j < expected.len() {
+        let a = actual.get(i).copied();
+        let e = expected.get(j).copied();
+        match (a, e) {
+            (Some((va, wa)), Some((ve, we))) if va == ve => {
+                worst = worst.max((wa - we).abs());
+                assert!(
+                    (wa - we).abs() <= WEIGHT_TOLERANCE,
+                    "{label}: vertex {va} weighs {wa} here, {we} in the reference"
+                );
+                i += 1;
+                j += 1;
+            }
+            (Some((va, _)), e) if e.is_none_or(|(ve, _)| va < ve) => {
+                assert!(
+                    on_rim(va),
+                    "{label}: vertex {va} selected, not in the reference"
+                );
+                eprintln!("{label}: rim vertex {va} only in one selection");
+                i += 1;
+            }
+            (_, Some((ve, _))) => {
+                assert!(
+                    on_rim(ve),
+                    "{label}: vertex {ve} of the reference not selected"
+                );
+                eprintln!("{label}: rim vertex {ve} only in one selection");
+                j += 1;
+            }
+            _ => unreachable!(),
+        }
+    }
+    worst
+}
+
+fn pairs(selection: &[SelectedVertex]) -> Vec<(u32, f32)> {
+    selection.iter().map(|s| (s.vertex, s.weight)).collect()
+}
+
+/// The CPU mirror chain: hash table, then `select`.
+fn cpu_select(
+    positions: &[Vec3],
+    layers: &[u32],
+    flags: &[u32],
+    active: &[bool],
+    inv_cell_size: f32,
+    brush: &BrushSphere,
+) -> Vec<SelectedVertex> {
+    let table_size = table_size_for(positions.len());
+    let table = slayer::cpu::hash_table(positions, flags, inv_cell_size, table_size);
+    let params = select_params(
+        brush,
+        inv_cell_size,
+        table_size,
+        positions.len(),
+        active.len(),
+    );
+    let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
+    let inputs = slayer::cpu::SelectInputs {
+        positions: bytemuck::cast_slice(positions),
+        vertex_layers: layers,
+        flags,
+        active_layers: &active,
+        offsets: &table.offsets,
+        entries: &table.entries,
+    };
+    let mut selected = vec![SelectedVertex::default(); positions.len()];
+    let mut count = 0u32;
+    slayer::cpu::select(&params, &inputs, &mut selected, &mut count);
+    selected.truncate(count as usize);
+    selected
+}
+
+/// Random vertices on three layers (the middle one inactive), some masked or dead.
+fn random_vertices(size: usize, seed: u64, extent: f32) -> (Vec<Vec3>, Vec<u32>, Vec<u32>) {
+    let positions = random_positions(size, seed, extent);
+    let layers = random_u32s(size, seed + 1, 3);
+    let flags = random_flags(size, seed + 2);
+    (positions, layers, flags)
+}
+
+#[test]
+fn select_matches_cpu_mirror_at_awkward_sizes() {
+    let gpu = gpu();
+    let active = [true, false, true];
+    let mut worst = 0.0f32;
+    for (i, &size) in SIZES.iter().enumerate() {
+        let cell_size = 0.25f32;
+        let extent = 0.5 * cell_size * (size as f32).cbrt().max(1.0);
+        let (positions, layers, flags) = random_vertices(size, 200 + 3 * i as u64, extent);
+        // A brush of a few cells around a vertex (or the origin when there is none), so
+        // buckets shared by cells in and out of the box are filtered.
+        let brush = BrushSphere {
+            center: positions.first().copied().unwrap_or(Vec3::ZERO),
+            radius: 0.6 * extent + 0.3,
+            falloff: FALLOFFS[i % FALLOFFS.len()],
+        };
+        let inv = 1.0 / cell_size;
+        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
+        let actual =
+            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        assert!(
+            size < 64 || !expected.is_empty(),
+            "size {size} selects nothing"
+        );
+        worst = worst.max(assert_same_selection(
+            &format!("size {size}"),
+            &pairs(&actual),
+            &pairs(&expected),
+            &positions,
+            &brush,
+        ));
+    }
+    eprintln!("select: largest weight difference GPU vs mirror {worst:e}");
+}
+
+#[test]
+fn select_scans_vertices_for_huge_brushes_and_folds_wide_dispatches() {
+    // A brush far larger than the mesh (more cells than vertices: the per-vertex scan), and a
+    // small brush over many cells, both with 7 workgroups per dimension.
+    let mut gpu = gpu();
+    gpu.limits.max_compute_workgroups_per_dimension = 7;
+    let active = [true, true, false];
+    let (positions, layers, flags) = random_vertices(100_003, 300, 2.0);
+    let inv = 8.0;
+    for (radius, scans) in [(50.0, true), (1.3, false)] {
+        let brush = BrushSphere {
+            center: Vec3::new(0.1, -0.2, 0.3),
+            radius,
+            falloff: Falloff::Smooth,
+        };
+        let params = select_params(&brush, inv, table_size_for(positions.len()), 100_003, 3);
+        assert_eq!(params.scan_vertices != 0, scans, "radius {radius}");
+        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
+        let actual =
+            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        assert!(expected.len() > 1000);
+        assert_same_selection(
+            &format!("radius {radius}"),
+            &pairs(&actual),
+            &pairs(&expected),
+            &positions,
+            &brush,
+        );
+    }
+}
+
+#[test]
+fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
+    // The mirror against `pipeline::step::select` (the CPU backend) on a mesh with masked
+    // vertices and an inactive layer; GPU against the mirror for the same brushes.
+    let gpu = gpu();
+    let mut mesh = slayer::scene::shapes::stacked_sheets(3, 40, 30, 0.1, 0.05);
+    for v in (0..mesh.vertex_count()).step_by(7) {
+        mesh.flags_mut()[v].insert(VertexFlags::MASKED);
+    }
+    let grid = SpatialHash::build(&mesh, 0.1).unwrap();
+    let active = [true, false, true];
+    let state = slayer::pipeline::step::StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: 0.1,
+        ring: 2,
+        max_edge: 0.15,
+    };
+    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let layers = mesh.vertex_layers().to_vec();
+    let mut worst = 0.0f32;
+    for (k, &falloff) in FALLOFFS.iter().enumerate() {
+        let brush = BrushSphere {
+            center: Vec3::new(1.3 + 0.37 * k as f32, 1.1, 0.04),
+            radius: 0.55,
+            falloff,
+        };
+        let dab = Dab {
+            brush: Brush {
+                kind: BrushKind::Draw,
+                radius: brush.radius,
+                strength: 1.0,
+                falloff,
+                invert: false,
+            },
+            frame: DabFrame {
+                center: brush.center,
+                normal: Vec3::Z,
+                plane_point: brush.center,
+                motion: Vec3::ZERO,
+            },
+            pressure: 1.0,
+            share: 1.0,
+        };
+        let reference = slayer::pipeline::step::select(&state, &mesh, &dab);
+        assert!(reference.len() > 50);
+        let mirror = cpu_select(
+            mesh.positions(),
+            &layers,
+            &flags,
+            &active,
+            grid.inv_cell_size(),
+            &brush,
+        );
+        let label = format!("falloff {}", falloff.name());
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&mirror),
+            &reference,
+            mesh.positions(),
+            &brush,
+        ));
+        let actual = run_select(
+            &gpu,
+            mesh.positions(),
+            &layers,
+            &flags,
+            &active,
+            grid.inv_cell_size(),
+            &brush,
+        )
+        .expect("GPU run");
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&actual),
+            &reference,
+            mesh.positions(),
+            &brush,
+        ));
+    }
+    eprintln!("select: largest weight difference vs the CPU pipeline {worst:e}");
 }

@@ -3,11 +3,14 @@
 
 use std::path::Path;
 
+use slayer::brush::Falloff;
 use slayer::gpu::shaders::{
     FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
     render_source, validate,
 };
-use slayer::gpu::{CellKeyParams, CountParams, SCAN_BLOCK};
+use slayer::gpu::{
+    CellKeyParams, CountParams, SCAN_BLOCK, SelectParams, SelectedVertex, falloff_code,
+};
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
 
@@ -160,6 +163,30 @@ fn host_structs_match_naga_layout() {
     }
 }
 
+#[test]
+fn select_structs_match_naga_layout() {
+    assert_layout!(
+        "select",
+        SelectParams {
+            center,
+            radius,
+            cell_min,
+            table_mask,
+            cell_span,
+            inv_cell_size,
+            candidate_count,
+            scan_vertices,
+            falloff,
+            blend_n,
+            capacity,
+            layer_count,
+            _pad0,
+            _pad1
+        }
+    );
+    assert_layout!("select", SelectedVertex { vertex, weight });
+}
+
 /// The value of a `u32` constant declared in a kernel (with its imports), per naga.
 fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
     let source = kernel_source(kernel).unwrap();
@@ -184,6 +211,18 @@ fn wgsl_constants_match_the_host() {
         ("INVALID", INVALID),
     ] {
         assert_eq!(naga_u32_constant("cell_counts", name), host, "{name}");
+    }
+    for (name, falloff) in [
+        ("FALLOFF_BLEND", Falloff::Blend { n: 3 }),
+        ("FALLOFF_SMOOTH", Falloff::Smooth),
+        ("FALLOFF_SPHERE", Falloff::Sphere),
+        ("FALLOFF_LINEAR", Falloff::Linear),
+    ] {
+        assert_eq!(
+            naga_u32_constant("select", name),
+            falloff_code(falloff).0,
+            "{name}"
+        );
     }
     // One scan workgroup is one block on the host side.
     for kernel in ["scan", "scan_add"] {

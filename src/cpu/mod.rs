@@ -9,6 +9,8 @@ mod hash_table;
 mod scan;
 mod scan_add;
 mod scatter;
+mod select;
+mod shared;
 
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
@@ -16,3 +18,5 @@ pub use hash_table::{exclusive_scan, hash_table};
 pub use scan::scan;
 pub use scan_add::scan_add;
 pub use scatter::scatter;
+pub use select::{SelectInputs, select};
+pub use shared::falloff_weight;

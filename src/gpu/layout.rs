@@ -34,3 +34,35 @@ impl CountParams {
         }
     }
 }
+
+/// `SelectParams` in `wgsl/select.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SelectParams {
+    pub center: [f32; 3],
+    pub radius: f32,
+    /// Lowest cell of the brush's box.
+    pub cell_min: [i32; 3],
+    pub table_mask: u32,
+    /// Size of the box in cells.
+    pub cell_span: [u32; 3],
+    pub inv_cell_size: f32,
+    /// Cells in the box, or vertices when `scan_vertices` is set.
+    pub candidate_count: u32,
+    pub scan_vertices: u32,
+    /// A `FALLOFF_*` code of `wgsl/shared/brush.wgsl`.
+    pub falloff: u32,
+    pub blend_n: u32,
+    pub capacity: u32,
+    pub layer_count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// `SelectedVertex` in `wgsl/select.wgsl`: one entry of the compacted selection.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct SelectedVertex {
+    pub vertex: u32,
+    pub weight: f32,
+}

@@ -8,6 +8,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/grid", include_str!("../../wgsl/shared/grid.wgsl")),
     ("shared/brdf", include_str!("../../wgsl/shared/brdf.wgsl")),
     ("shared/mesh", include_str!("../../wgsl/shared/mesh.wgsl")),
+    ("shared/brush", include_str!("../../wgsl/shared/brush.wgsl")),
 ];
 
 /// Compute kernels, by file stem; each has entry point `main`.
@@ -17,6 +18,7 @@ pub const KERNELS: &[(&str, &str)] = &[
     ("scan", include_str!("../../wgsl/scan.wgsl")),
     ("scan_add", include_str!("../../wgsl/scan_add.wgsl")),
     ("scatter", include_str!("../../wgsl/scatter.wgsl")),
+    ("select", include_str!("../../wgsl/select.wgsl")),
 ];
 
 /// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)
