@@ -8,8 +8,8 @@ use rand_chacha::ChaCha8Rng;
 use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
 use slayer::gpu::{
     AdapterChoice, BrushSphere, CellKeyParams, CountParams, CsrTable, GpuContext, SelectedVertex,
-    run_cell_counts, run_cell_keys, run_exclusive_scan, run_hash_table, run_scatter, run_select,
-    select_params, table_size_for,
+    deform_params, run_cell_counts, run_cell_keys, run_deform, run_exclusive_scan, run_hash_table,
+    run_scatter, run_select, select_params, smoothing_neighbours, table_size_for,
 };
 use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
 use slayer::mesh::{INVALID, VertexFlags};
@@ -572,4 +572,126 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         ));
     }
     eprintln!("select: largest weight difference vs the CPU pipeline {worst:e}");
+}
+
+/// Deformation targets may differ by this share of the brush radius: the shader's sin/cos,
+/// sqrt and fused multiply-adds round differently from the CPU's.
+const DEFORM_TOLERANCE: f32 = 1e-5;
+
+/// Stacked sheets with bumpy heights and matching normals, masked here and there, so that
+/// every field (smooth, flatten, inflate) has something to do.
+fn bumpy_sheets() -> slayer::mesh::Mesh {
+    let mut mesh = slayer::scene::shapes::stacked_sheets(3, 120, 100, 0.05, 0.2);
+    let mut rng = ChaCha8Rng::seed_from_u64(500);
+    for p in mesh.positions_mut() {
+        p.z += 0.01 * (3.0 * p.x).sin() * (2.0 * p.y).cos() + rng.random_range(-0.004..0.004);
+    }
+    mesh.recompute_normals();
+    for v in (0..mesh.vertex_count()).step_by(11) {
+        mesh.flags_mut()[v].insert(VertexFlags::MASKED);
+    }
+    mesh
+}
+
+/// Largest distance between corresponding targets, over the radius.
+fn worst_relative(a: &[Vec3], b: &[Vec3], radius: f32) -> f32 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q) / radius)
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn deform_matches_cpu_mirror_and_the_brush_fields() {
+    // Every deforming brush, alternately inverted, over the falloffs; each on the full
+    // selection (a large odd size) and on a prefix of an awkward size. The mirror is checked
+    // against `pipeline::step::deform` (src/brush/field.rs), the GPU against the mirror.
+    let mut gpu = gpu();
+    let mesh = bumpy_sheets();
+    let grid = SpatialHash::build(&mesh, 0.05).unwrap();
+    let active = [true, false, true];
+    let state = slayer::pipeline::step::StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: 0.05,
+        ring: 2,
+        max_edge: 0.08,
+    };
+    let (neighbour_offsets, neighbours) = smoothing_neighbours(&mesh);
+    let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);
+    for (k, &kind) in BrushKind::DEFORMING.iter().enumerate() {
+        let falloff = FALLOFFS[k % FALLOFFS.len()];
+        let center = Vec3::new(3.0, 2.5, 0.2);
+        let dab = Dab {
+            brush: Brush {
+                kind,
+                radius: 2.2,
+                strength: 0.8,
+                falloff,
+                invert: k % 2 == 1,
+            },
+            frame: DabFrame {
+                center,
+                normal: Vec3::new(0.1, -0.2, 1.0).normalize(),
+                plane_point: center - Vec3::new(0.0, 0.0, 0.15),
+                motion: Vec3::new(0.03, -0.02, 0.04),
+            },
+            pressure: 0.9,
+            share: 0.5,
+        };
+        let full = slayer::pipeline::step::select(&state, &mesh, &dab);
+        assert!(full.len() > 8315, "{} selects {}", kind.name(), full.len());
+        // The last round folds the dispatch into two dimensions.
+        if k == BrushKind::DEFORMING.len() - 1 {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        for size in [8315, SIZES[k % SIZES.len()]] {
+            let selection = &full[..size];
+            let reference = slayer::pipeline::step::deform(&state, &mesh, &dab, selection);
+            let entries: Vec<SelectedVertex> = selection
+                .iter()
+                .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
+                .collect();
+            let params = deform_params(&dab, entries.len());
+            let inputs = slayer::cpu::DeformInputs {
+                positions: mesh.positions(),
+                normals: mesh.normals(),
+                selected: &entries,
+                selection_count: entries.len() as u32,
+                neighbour_offsets: &neighbour_offsets,
+                neighbours: &neighbours,
+            };
+            let mut mirror = vec![Vec3::ZERO; entries.len()];
+            slayer::cpu::deform(&params, &inputs, &mut mirror);
+            let actual = run_deform(&gpu, &mesh, &dab, &entries).expect("GPU run");
+            let (m, g) = (
+                worst_relative(&mirror, &reference, dab.brush.radius),
+                worst_relative(&actual, &mirror, dab.brush.radius),
+            );
+            let label = format!("{} ({}) at size {size}", kind.name(), falloff.name());
+            assert!(
+                m <= DEFORM_TOLERANCE,
+                "{label}: mirror off the field by {m:e} radii"
+            );
+            assert!(
+                g <= DEFORM_TOLERANCE,
+                "{label}: GPU off the mirror by {g:e} radii"
+            );
+            // A prefix may hold only rim vertices whose weight rounds their move away.
+            if size == 8315 {
+                let moved = mirror
+                    .iter()
+                    .zip(selection)
+                    .any(|(q, &(v, _))| *q != mesh.positions()[v as usize]);
+                assert!(moved, "{label}: nothing moved");
+            }
+            worst_mirror = worst_mirror.max(m);
+            worst_gpu = worst_gpu.max(g);
+        }
+    }
+    eprintln!(
+        "deform: largest deviation mirror vs field {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× radius)"
+    );
 }

@@ -3,13 +3,15 @@
 
 use std::path::Path;
 
+use slayer::brush::BrushKind;
 use slayer::brush::Falloff;
 use slayer::gpu::shaders::{
     FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
     render_source, validate,
 };
 use slayer::gpu::{
-    CellKeyParams, CountParams, SCAN_BLOCK, SelectParams, SelectedVertex, falloff_code,
+    CellKeyParams, CountParams, DeformParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
+    falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -185,6 +187,24 @@ fn select_structs_match_naga_layout() {
         }
     );
     assert_layout!("select", SelectedVertex { vertex, weight });
+    assert_layout!("deform", SelectedVertex { vertex, weight });
+    assert_layout!(
+        "deform",
+        DeformParams {
+            center,
+            radius,
+            normal,
+            strength,
+            plane_point,
+            pressure,
+            motion,
+            share,
+            kind,
+            sign,
+            capacity,
+            _pad
+        }
+    );
 }
 
 /// The value of a `u32` constant declared in a kernel (with its imports), per naga.
@@ -221,6 +241,14 @@ fn wgsl_constants_match_the_host() {
         assert_eq!(
             naga_u32_constant("select", name),
             falloff_code(falloff).0,
+            "{name}"
+        );
+    }
+    for kind in BrushKind::ALL {
+        let name = format!("BRUSH_{}", kind.name().to_uppercase());
+        assert_eq!(
+            naga_u32_constant("deform", &name),
+            brush_code(kind),
             "{name}"
         );
     }

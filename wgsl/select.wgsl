@@ -34,11 +34,6 @@ struct SelectParams {
     _pad1: u32,
 }
 
-struct SelectedVertex {
-    vertex: u32,
-    weight: f32,
-}
-
 const WORKGROUP_SIZE: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> params: SelectParams;

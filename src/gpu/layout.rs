@@ -66,3 +66,22 @@ pub struct SelectedVertex {
     pub vertex: u32,
     pub weight: f32,
 }
+
+/// `DeformParams` in `wgsl/deform.wgsl`: one dab.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DeformParams {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub normal: [f32; 3],
+    pub strength: f32,
+    pub plane_point: [f32; 3],
+    pub pressure: f32,
+    pub motion: [f32; 3],
+    pub share: f32,
+    /// A `BRUSH_*` code of `wgsl/shared/brush.wgsl`.
+    pub kind: u32,
+    pub sign: f32,
+    pub capacity: u32,
+    pub _pad: u32,
+}

@@ -3,6 +3,7 @@
 
 mod cell_keys;
 mod context;
+mod deform;
 mod hash_table;
 mod layout;
 mod scan;
@@ -12,10 +13,13 @@ mod vertices;
 
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adapters};
+pub use deform::{
+    DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
+};
 pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
-pub use layout::{CellKeyParams, CountParams, SelectParams, SelectedVertex};
+pub use layout::{CellKeyParams, CountParams, DeformParams, SelectParams, SelectedVertex};
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,

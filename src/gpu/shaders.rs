@@ -19,6 +19,7 @@ pub const KERNELS: &[(&str, &str)] = &[
     ("scan_add", include_str!("../../wgsl/scan_add.wgsl")),
     ("scatter", include_str!("../../wgsl/scatter.wgsl")),
     ("select", include_str!("../../wgsl/select.wgsl")),
+    ("deform", include_str!("../../wgsl/deform.wgsl")),
 ];
 
 /// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)

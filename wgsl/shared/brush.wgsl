@@ -1,5 +1,24 @@
-// Brush falloff curves, as `src/brush/falloff.rs::Falloff::weight`. Codes as
-// `src/gpu/select.rs::falloff_code` writes them (tests/wgsl.rs checks the values).
+// Brushes on the GPU: falloff curves (as `src/brush/falloff.rs::Falloff::weight`), brush
+// kinds, and the selection list `select` writes and `deform` reads. Codes as
+// `src/gpu/select.rs::falloff_code` and `src/gpu/deform.rs::brush_code` write them
+// (tests/wgsl.rs checks the values).
+
+// One entry of the compacted selection.
+struct SelectedVertex {
+    vertex: u32,
+    weight: f32,
+}
+
+const BRUSH_DRAW: u32 = 0u;
+const BRUSH_INFLATE: u32 = 1u;
+const BRUSH_DEFLATE: u32 = 2u;
+const BRUSH_GRAB: u32 = 3u;
+const BRUSH_SMOOTH: u32 = 4u;
+const BRUSH_FLATTEN: u32 = 5u;
+const BRUSH_PINCH: u32 = 6u;
+const BRUSH_CREASE: u32 = 7u;
+const BRUSH_TWIST: u32 = 8u;
+const BRUSH_PAINT: u32 = 9u;
 
 const FALLOFF_BLEND: u32 = 0u;
 const FALLOFF_SMOOTH: u32 = 1u;
