@@ -8,8 +8,9 @@ use rand_chacha::ChaCha8Rng;
 use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
 use slayer::gpu::{
     AdapterChoice, BrushSphere, CellKeyParams, CountParams, CsrTable, GpuContext, SelectedVertex,
-    deform_params, run_cell_counts, run_cell_keys, run_deform, run_exclusive_scan, run_hash_table,
-    run_scatter, run_select, select_params, smoothing_neighbours, table_size_for,
+    deform_params, run_cell_counts, run_cell_keys, run_deform, run_dispatch_args,
+    run_exclusive_scan, run_hash_table, run_scatter, run_select, select_params,
+    smoothing_neighbours, table_size_for,
 };
 use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
 use slayer::mesh::{INVALID, VertexFlags};
@@ -694,4 +695,30 @@ fn deform_matches_cpu_mirror_and_the_brush_fields() {
     eprintln!(
         "deform: largest deviation mirror vs field {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× radius)"
     );
+}
+
+#[test]
+fn dispatch_args_match_the_host_fold_and_the_cpu_mirror() {
+    // The GPU-side sizes equal `dispatch_size` for the same count, folded or not, and an
+    // overflowed count is clamped to the capacity.
+    let mut gpu = gpu();
+    for limit in [65_535, 7] {
+        gpu.limits.max_compute_workgroups_per_dimension = limit;
+        for &count in SIZES.iter().chain(&[100_003]) {
+            let actual = run_dispatch_args(&gpu, count as u32, count, 64).expect("GPU run");
+            let (x, y) = gpu.dispatch_size(count, 64);
+            assert_eq!(actual, [x, y, 1], "count {count}, limit {limit}");
+            let params = slayer::gpu::DispatchParams {
+                workgroup_size: 64,
+                max_per_dimension: limit,
+                capacity: count as u32,
+                _pad: 0,
+            };
+            let mut mirror = [0; 3];
+            slayer::cpu::dispatch_args(&params, count as u32, &mut mirror);
+            assert_eq!(mirror, actual, "mirror at count {count}, limit {limit}");
+        }
+    }
+    let clamped = run_dispatch_args(&gpu, 1_000_000, 640, 64).expect("GPU run");
+    assert_eq!(clamped, [7, 2, 1]);
 }

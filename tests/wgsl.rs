@@ -10,8 +10,8 @@ use slayer::gpu::shaders::{
     render_source, validate,
 };
 use slayer::gpu::{
-    CellKeyParams, CountParams, DeformParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
-    falloff_code,
+    CellKeyParams, CountParams, DeformParams, DispatchParams, SCAN_BLOCK, SelectParams,
+    SelectedVertex, brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -188,6 +188,15 @@ fn select_structs_match_naga_layout() {
     );
     assert_layout!("select", SelectedVertex { vertex, weight });
     assert_layout!("deform", SelectedVertex { vertex, weight });
+    assert_layout!(
+        "dispatch_args",
+        DispatchParams {
+            workgroup_size,
+            max_per_dimension,
+            capacity,
+            _pad
+        }
+    );
     assert_layout!(
         "deform",
         DeformParams {

@@ -6,6 +6,7 @@
 mod cell_counts;
 mod cell_keys;
 mod deform;
+mod dispatch_args;
 mod hash_table;
 mod scan;
 mod scan_add;
@@ -16,6 +17,7 @@ mod shared;
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
 pub use deform::{DeformInputs, deform};
+pub use dispatch_args::dispatch_args;
 pub use hash_table::{exclusive_scan, hash_table};
 pub use scan::scan;
 pub use scan_add::scan_add;

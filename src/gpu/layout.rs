@@ -85,3 +85,13 @@ pub struct DeformParams {
     pub capacity: u32,
     pub _pad: u32,
 }
+
+/// `DispatchParams` in `wgsl/dispatch_args.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DispatchParams {
+    pub workgroup_size: u32,
+    pub max_per_dimension: u32,
+    pub capacity: u32,
+    pub _pad: u32,
+}

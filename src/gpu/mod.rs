@@ -4,6 +4,7 @@
 mod cell_keys;
 mod context;
 mod deform;
+mod dispatch_args;
 mod hash_table;
 mod layout;
 mod scan;
@@ -16,10 +17,13 @@ pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adap
 pub use deform::{
     DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
 };
+pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
-pub use layout::{CellKeyParams, CountParams, DeformParams, SelectParams, SelectedVertex};
+pub use layout::{
+    CellKeyParams, CountParams, DeformParams, DispatchParams, SelectParams, SelectedVertex,
+};
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,

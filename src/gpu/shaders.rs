@@ -20,6 +20,10 @@ pub const KERNELS: &[(&str, &str)] = &[
     ("scatter", include_str!("../../wgsl/scatter.wgsl")),
     ("select", include_str!("../../wgsl/select.wgsl")),
     ("deform", include_str!("../../wgsl/deform.wgsl")),
+    (
+        "dispatch_args",
+        include_str!("../../wgsl/dispatch_args.wgsl"),
+    ),
 ];
 
 /// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)
