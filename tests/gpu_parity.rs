@@ -5,7 +5,15 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use slayer::gpu::{AdapterChoice, CellKeyParams, GpuContext, run_cell_keys};
+use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
+use slayer::gpu::{
+    AdapterChoice, BrushSphere, CellKeyParams, CountParams, CsrTable, GpuContext, SelectedVertex,
+    deform_params, run_cell_counts, run_cell_keys, run_deform, run_dispatch_args,
+    run_exclusive_scan, run_hash_table, run_scatter, run_select, select_params,
+    smoothing_neighbours, table_size_for,
+};
+use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
+use slayer::mesh::{INVALID, VertexFlags};
 
 fn gpu() -> GpuContext {
     let gpu = GpuContext::new(AdapterChoice {
@@ -99,4 +107,618 @@ fn wide_dispatches_fold_into_two_dimensions() {
     let expected = cpu_cell_keys(&positions, 8.0, 1 << 18);
     let actual = run_cell_keys(&gpu, &positions, 8.0, 1 << 18).expect("GPU run");
     assert_eq!(actual, expected);
+}
+
+/// Scan sizes: empty, one, one block ± 1, past a block of blocks (three levels), large odd.
+const SCAN_SIZES: [usize; 7] = [0, 1, 255, 256, 257, 65_537, 300_001];
+
+fn random_u32s(count: usize, seed: u64, below: u32) -> Vec<u32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..count).map(|_| rng.random_range(0..below)).collect()
+}
+
+/// About one vertex in eight dead; dead ones must stay out of every table.
+fn random_flags(count: usize, seed: u64) -> Vec<u32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..count)
+        .map(|_| match rng.random_range(0..8) {
+            0 => VertexFlags::DEAD.bits(),
+            1 => VertexFlags::MASKED.bits(),
+            _ => 0,
+        })
+        .collect()
+}
+
+#[test]
+fn scan_matches_cpu_mirror_and_a_running_sum() {
+    let gpu = gpu();
+    for (i, &size) in SCAN_SIZES.iter().enumerate() {
+        // Values up to 2^20 make the totals of the large sizes wrap past 2^32, as they may.
+        let values = random_u32s(size, 40 + i as u64, if i % 2 == 0 { 9 } else { 1 << 20 });
+        let mut running = 0u32;
+        let sequential: Vec<u32> = values
+            .iter()
+            .map(|&v| {
+                let before = running;
+                running = running.wrapping_add(v);
+                before
+            })
+            .collect();
+        let mut mirror = values.clone();
+        slayer::cpu::exclusive_scan(&mut mirror);
+        assert_eq!(mirror, sequential, "CPU mirror at size {size}");
+        let actual = run_exclusive_scan(&gpu, &values).expect("GPU run");
+        assert_eq!(actual, sequential, "GPU scan at size {size}");
+    }
+}
+
+#[test]
+fn cell_counts_match_cpu_mirror_and_ranks_number_each_bucket() {
+    let gpu = gpu();
+    for (i, &size) in SIZES.iter().enumerate() {
+        // A small table, so buckets hold many vertices and the atomics contend.
+        let table_size = 64u32;
+        let keys = random_u32s(size, 60 + i as u64, table_size);
+        let flags = random_flags(size, 70 + i as u64);
+        let mut counts = vec![0u32; table_size as usize + 1];
+        let mut ranks = vec![0u32; size];
+        slayer::cpu::cell_counts(
+            &CountParams::new(size),
+            &keys,
+            &flags,
+            &mut counts,
+            &mut ranks,
+        );
+        let (gpu_counts, gpu_ranks) =
+            run_cell_counts(&gpu, &keys, &flags, table_size).expect("GPU run");
+        assert_eq!(gpu_counts, counts, "counts at size {size}");
+        // Ranks depend on the order the atomics ran in: per bucket they must be 0..count.
+        let mut seen = vec![Vec::new(); table_size as usize];
+        for v in 0..size {
+            if flags[v] & VertexFlags::DEAD.bits() != 0 {
+                assert_eq!(gpu_ranks[v], INVALID, "dead vertex {v} ranked");
+            } else {
+                seen[keys[v] as usize].push(gpu_ranks[v]);
+            }
+        }
+        for (bucket, mut ranks) in seen.into_iter().enumerate() {
+            ranks.sort_unstable();
+            let expected: Vec<u32> = (0..counts[bucket]).collect();
+            assert_eq!(ranks, expected, "ranks of bucket {bucket} at size {size}");
+        }
+    }
+}
+
+#[test]
+fn scatter_matches_cpu_mirror_given_the_same_ranks() {
+    // With the ranks fixed, scatter is a permutation: the outputs are identical.
+    let gpu = gpu();
+    for (i, &size) in SIZES.iter().enumerate() {
+        let table_size = 128u32;
+        let keys = random_u32s(size, 80 + i as u64, table_size);
+        let flags = random_flags(size, 90 + i as u64);
+        let params = CountParams::new(size);
+        let mut offsets = vec![0u32; table_size as usize + 1];
+        let mut ranks = vec![0u32; size];
+        slayer::cpu::cell_counts(&params, &keys, &flags, &mut offsets, &mut ranks);
+        slayer::cpu::exclusive_scan(&mut offsets);
+        let mut entries = vec![0u32; offsets[table_size as usize] as usize];
+        slayer::cpu::scatter(&params, &keys, &ranks, &offsets, &mut entries);
+        let actual = run_scatter(&gpu, &keys, &ranks, &offsets).expect("GPU run");
+        assert_eq!(actual, entries, "entries at size {size}");
+    }
+}
+
+/// Checks a table against the grid: every occupied cell's vertices, found through the table's
+/// bucket and filtered by cell as the GPU queries do, are the grid's vertices of that cell.
+fn assert_table_answers_like_the_grid(
+    table: &CsrTable,
+    grid: &SpatialHash,
+    positions: &[Vec3],
+    flags: &[u32],
+) {
+    assert_eq!(table.table_size(), grid.bucket_count());
+    let live = flags
+        .iter()
+        .filter(|&&f| f & VertexFlags::DEAD.bits() == 0)
+        .count();
+    assert_eq!(table.entries.len(), live, "filed vertices");
+    let inv = grid.inv_cell_size();
+    for (v, p) in positions.iter().enumerate() {
+        let cell = cell_coordinates(*p, inv);
+        let mut from_table: Vec<u32> = table
+            .bucket(hash_cell(cell, table.table_size() as u32))
+            .iter()
+            .copied()
+            .filter(|&u| cell_coordinates(positions[u as usize], inv) == cell)
+            .collect();
+        from_table.sort_unstable();
+        let mut from_grid: Vec<u32> = grid.cell_vertices(cell).collect();
+        from_grid.sort_unstable();
+        assert_eq!(from_table, from_grid, "cell {cell} of vertex {v}");
+    }
+}
+
+fn grid_of(positions: &[Vec3], flags: &[u32], cell_size: f32) -> SpatialHash {
+    let mut grid = SpatialHash::new(cell_size, positions.len()).unwrap();
+    for (v, p) in positions.iter().enumerate() {
+        if flags[v] & VertexFlags::DEAD.bits() == 0 {
+            grid.insert(v as u32, *p);
+        }
+    }
+    grid
+}
+
+#[test]
+fn hash_table_matches_cpu_chain_and_the_grid() {
+    let gpu = gpu();
+    for (i, &size) in SIZES.iter().enumerate() {
+        // About three vertices per occupied cell, so buckets hold several.
+        let cell_size = 0.25;
+        let extent = 0.5 * cell_size * (size as f32).cbrt().max(1.0);
+        let positions = random_positions(size, 100 + i as u64, extent);
+        let flags = random_flags(size, 110 + i as u64);
+        let grid = grid_of(&positions, &flags, cell_size);
+        let inv = grid.inv_cell_size();
+        let table_size = table_size_for(size);
+        let expected = slayer::cpu::hash_table(&positions, &flags, inv, table_size);
+        assert_table_answers_like_the_grid(&expected, &grid, &positions, &flags);
+        let actual = run_hash_table(&gpu, &positions, &flags, inv, table_size).expect("GPU run");
+        // Offsets are exact; within a bucket the GPU order is the atomics' order.
+        assert_eq!(actual.offsets, expected.offsets, "offsets at size {size}");
+        assert_eq!(actual.canonical(), expected, "buckets at size {size}");
+    }
+}
+
+#[test]
+fn hash_table_of_stacked_sheets_matches_the_meshs_grid() {
+    let gpu = gpu();
+    let mesh = slayer::scene::shapes::stacked_sheets(3, 40, 30, 0.1, 0.05);
+    let grid = SpatialHash::build(&mesh, 0.1).unwrap();
+    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let table = run_hash_table(
+        &gpu,
+        mesh.positions(),
+        &flags,
+        grid.inv_cell_size(),
+        grid.bucket_count() as u32,
+    )
+    .expect("GPU run");
+    assert_table_answers_like_the_grid(&table, &grid, mesh.positions(), &flags);
+}
+
+#[test]
+fn hash_build_folds_wide_dispatches() {
+    // 7 workgroups per dimension: every pass of the build, and a three-level scan whose last
+    // row of workgroups runs past the final block, folds into y.
+    let mut gpu = gpu();
+    gpu.limits.max_compute_workgroups_per_dimension = 7;
+    let values = random_u32s(300_001, 7, 5);
+    let mut expected = values.clone();
+    slayer::cpu::exclusive_scan(&mut expected);
+    assert_eq!(
+        run_exclusive_scan(&gpu, &values).expect("GPU run"),
+        expected
+    );
+    let positions = random_positions(100_003, 8, 2.0);
+    let flags = random_flags(positions.len(), 9);
+    let table_size = table_size_for(positions.len());
+    let expected = slayer::cpu::hash_table(&positions, &flags, 10.0, table_size);
+    let actual = run_hash_table(&gpu, &positions, &flags, 10.0, table_size).expect("GPU run");
+    assert_eq!(actual.canonical(), expected);
+}
+
+const FALLOFFS: [Falloff; 5] = [
+    Falloff::Blend { n: 3 },
+    Falloff::Blend { n: 6 },
+    Falloff::Smooth,
+    Falloff::Sphere,
+    Falloff::Linear,
+];
+
+/// Vertices within this share of the radius of the rim may be in one selection and not the
+/// other: `|p − c|² ≤ r²` and `t < 1` are decided on rounded values, and GPUs may fuse the
+/// multiply-adds of the dot product. Seeded inputs put none there; the allowance keeps the test
+/// about real disagreements.
+const RIM_TOLERANCE: f32 = 1e-5;
+/// Largest weight difference: `sqrt(1 − t²)` near the rim turns one ulp of `t` into ~1e-6.
+const WEIGHT_TOLERANCE: f32 = 1e-5;
+
+/// Compares two selections as sets of vertices, with weights within `WEIGHT_TOLERANCE`;
+/// returns the largest weight difference.
+fn assert_same_selection(
+    label: &str,
+    actual: &[(u32, f32)],
+    expected: &[(u32, f32)],
+    positions: &[Vec3],
+    brush: &BrushSphere,
+) -> f32 {
+    let sorted = |s: &[(u32, f32)]| {
+        let mut s = s.to_vec();
+        s.sort_by_key(|&(v, _)| v);
+        s
+    };
+    let (actual, expected) = (sorted(actual), sorted(expected));
+    let on_rim = |v: u32| {
+        let d = positions[v as usize].distance(brush.center);
+        (d - brush.radius).abs() <= RIM_TOLERANCE * brush.radius
+    };
+    let (mut i, mut j, mut worst) = (0, 0, 0.0f32);
+    while i < actual.len() || j < expected.len() {
+        let a = actual.get(i).copied();
+        let e = expected.get(j).copied();
+        match (a, e) {
+            (Some((va, wa)), Some((ve, we))) if va == ve => {
+                worst = worst.max((wa - we).abs());
+                assert!(
+                    (wa - we).abs() <= WEIGHT_TOLERANCE,
+                    "{label}: vertex {va} weighs {wa} here, {we} in the reference"
+                );
+                i += 1;
+                j += 1;
+            }
+            (Some((va, _)), e) if e.is_none_or(|(ve, _)| va < ve) => {
+                assert!(
+                    on_rim(va),
+                    "{label}: vertex {va} selected, not in the reference"
+                );
+                eprintln!("{label}: rim vertex {va} only in one selection");
+                i += 1;
+            }
+            (_, Some((ve, _))) => {
+                assert!(
+                    on_rim(ve),
+                    "{label}: vertex {ve} of the reference not selected"
+                );
+                eprintln!("{label}: rim vertex {ve} only in one selection");
+                j += 1;
+            }
+            _ => unreachable!(),
+        }
+    }
+    worst
+}
+
+fn pairs(selection: &[SelectedVertex]) -> Vec<(u32, f32)> {
+    selection.iter().map(|s| (s.vertex, s.weight)).collect()
+}
+
+/// The CPU mirror chain: hash table, then `select`.
+fn cpu_select(
+    positions: &[Vec3],
+    layers: &[u32],
+    flags: &[u32],
+    active: &[bool],
+    inv_cell_size: f32,
+    brush: &BrushSphere,
+) -> Vec<SelectedVertex> {
+    let table_size = table_size_for(positions.len());
+    let table = slayer::cpu::hash_table(positions, flags, inv_cell_size, table_size);
+    let params = select_params(
+        brush,
+        inv_cell_size,
+        table_size,
+        positions.len(),
+        active.len(),
+    );
+    let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
+    let inputs = slayer::cpu::SelectInputs {
+        positions: bytemuck::cast_slice(positions),
+        vertex_layers: layers,
+        flags,
+        active_layers: &active,
+        offsets: &table.offsets,
+        entries: &table.entries,
+    };
+    let mut selected = vec![SelectedVertex::default(); positions.len()];
+    let mut count = 0u32;
+    slayer::cpu::select(&params, &inputs, &mut selected, &mut count);
+    selected.truncate(count as usize);
+    selected
+}
+
+/// Random vertices on three layers (the middle one inactive), some masked or dead.
+fn random_vertices(size: usize, seed: u64, extent: f32) -> (Vec<Vec3>, Vec<u32>, Vec<u32>) {
+    let positions = random_positions(size, seed, extent);
+    let layers = random_u32s(size, seed + 1, 3);
+    let flags = random_flags(size, seed + 2);
+    (positions, layers, flags)
+}
+
+#[test]
+fn select_matches_cpu_mirror_at_awkward_sizes() {
+    let gpu = gpu();
+    let active = [true, false, true];
+    let mut worst = 0.0f32;
+    for (i, &size) in SIZES.iter().enumerate() {
+        let cell_size = 0.25f32;
+        let extent = 0.5 * cell_size * (size as f32).cbrt().max(1.0);
+        let (positions, layers, flags) = random_vertices(size, 200 + 3 * i as u64, extent);
+        // A brush of a few cells around a vertex (or the origin when there is none), so
+        // buckets shared by cells in and out of the box are filtered.
+        let brush = BrushSphere {
+            center: positions.first().copied().unwrap_or(Vec3::ZERO),
+            radius: 0.6 * extent + 0.3,
+            falloff: FALLOFFS[i % FALLOFFS.len()],
+        };
+        let inv = 1.0 / cell_size;
+        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
+        let actual =
+            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        assert!(
+            size < 64 || !expected.is_empty(),
+            "size {size} selects nothing"
+        );
+        worst = worst.max(assert_same_selection(
+            &format!("size {size}"),
+            &pairs(&actual),
+            &pairs(&expected),
+            &positions,
+            &brush,
+        ));
+    }
+    eprintln!("select: largest weight difference GPU vs mirror {worst:e}");
+}
+
+#[test]
+fn select_scans_vertices_for_huge_brushes_and_folds_wide_dispatches() {
+    // A brush far larger than the mesh (more cells than vertices: the per-vertex scan), and a
+    // small brush over many cells, both with 7 workgroups per dimension.
+    let mut gpu = gpu();
+    gpu.limits.max_compute_workgroups_per_dimension = 7;
+    let active = [true, true, false];
+    let (positions, layers, flags) = random_vertices(100_003, 300, 2.0);
+    let inv = 8.0;
+    for (radius, scans) in [(50.0, true), (1.3, false)] {
+        let brush = BrushSphere {
+            center: Vec3::new(0.1, -0.2, 0.3),
+            radius,
+            falloff: Falloff::Smooth,
+        };
+        let params = select_params(&brush, inv, table_size_for(positions.len()), 100_003, 3);
+        assert_eq!(params.scan_vertices != 0, scans, "radius {radius}");
+        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
+        let actual =
+            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        assert!(expected.len() > 1000);
+        assert_same_selection(
+            &format!("radius {radius}"),
+            &pairs(&actual),
+            &pairs(&expected),
+            &positions,
+            &brush,
+        );
+    }
+}
+
+#[test]
+fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
+    // The mirror against `pipeline::step::select` (the CPU backend) on a mesh with masked
+    // vertices and an inactive layer; GPU against the mirror for the same brushes.
+    let gpu = gpu();
+    let mut mesh = slayer::scene::shapes::stacked_sheets(3, 40, 30, 0.1, 0.05);
+    for v in (0..mesh.vertex_count()).step_by(7) {
+        mesh.flags_mut()[v].insert(VertexFlags::MASKED);
+    }
+    let grid = SpatialHash::build(&mesh, 0.1).unwrap();
+    let active = [true, false, true];
+    let state = slayer::pipeline::step::StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: 0.1,
+        ring: 2,
+        max_edge: 0.15,
+    };
+    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let layers = mesh.vertex_layers().to_vec();
+    let mut worst = 0.0f32;
+    for (k, &falloff) in FALLOFFS.iter().enumerate() {
+        let brush = BrushSphere {
+            center: Vec3::new(1.3 + 0.37 * k as f32, 1.1, 0.04),
+            radius: 0.55,
+            falloff,
+        };
+        let dab = Dab {
+            brush: Brush {
+                kind: BrushKind::Draw,
+                radius: brush.radius,
+                strength: 1.0,
+                falloff,
+                invert: false,
+            },
+            frame: DabFrame {
+                center: brush.center,
+                normal: Vec3::Z,
+                plane_point: brush.center,
+                motion: Vec3::ZERO,
+            },
+            pressure: 1.0,
+            share: 1.0,
+        };
+        let reference = slayer::pipeline::step::select(&state, &mesh, &dab);
+        assert!(reference.len() > 50);
+        let mirror = cpu_select(
+            mesh.positions(),
+            &layers,
+            &flags,
+            &active,
+            grid.inv_cell_size(),
+            &brush,
+        );
+        let label = format!("falloff {}", falloff.name());
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&mirror),
+            &reference,
+            mesh.positions(),
+            &brush,
+        ));
+        let actual = run_select(
+            &gpu,
+            mesh.positions(),
+            &layers,
+            &flags,
+            &active,
+            grid.inv_cell_size(),
+            &brush,
+        )
+        .expect("GPU run");
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&actual),
+            &reference,
+            mesh.positions(),
+            &brush,
+        ));
+    }
+    eprintln!("select: largest weight difference vs the CPU pipeline {worst:e}");
+}
+
+/// Deformation targets may differ by this share of the brush radius: the shader's sin/cos,
+/// sqrt and fused multiply-adds round differently from the CPU's.
+const DEFORM_TOLERANCE: f32 = 1e-5;
+
+/// Stacked sheets with bumpy heights and matching normals, masked here and there, so that
+/// every field (smooth, flatten, inflate) has something to do.
+fn bumpy_sheets() -> slayer::mesh::Mesh {
+    let mut mesh = slayer::scene::shapes::stacked_sheets(3, 120, 100, 0.05, 0.2);
+    let mut rng = ChaCha8Rng::seed_from_u64(500);
+    for p in mesh.positions_mut() {
+        p.z += 0.01 * (3.0 * p.x).sin() * (2.0 * p.y).cos() + rng.random_range(-0.004..0.004);
+    }
+    mesh.recompute_normals();
+    for v in (0..mesh.vertex_count()).step_by(11) {
+        mesh.flags_mut()[v].insert(VertexFlags::MASKED);
+    }
+    mesh
+}
+
+/// Largest distance between corresponding targets, over the radius.
+fn worst_relative(a: &[Vec3], b: &[Vec3], radius: f32) -> f32 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q) / radius)
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn deform_matches_cpu_mirror_and_the_brush_fields() {
+    // Every deforming brush, alternately inverted, over the falloffs; each on the full
+    // selection (a large odd size) and on a prefix of an awkward size. The mirror is checked
+    // against `pipeline::step::deform` (src/brush/field.rs), the GPU against the mirror.
+    let mut gpu = gpu();
+    let mesh = bumpy_sheets();
+    let grid = SpatialHash::build(&mesh, 0.05).unwrap();
+    let active = [true, false, true];
+    let state = slayer::pipeline::step::StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: 0.05,
+        ring: 2,
+        max_edge: 0.08,
+    };
+    let (neighbour_offsets, neighbours) = smoothing_neighbours(&mesh);
+    let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);
+    for (k, &kind) in BrushKind::DEFORMING.iter().enumerate() {
+        let falloff = FALLOFFS[k % FALLOFFS.len()];
+        let center = Vec3::new(3.0, 2.5, 0.2);
+        let dab = Dab {
+            brush: Brush {
+                kind,
+                radius: 2.2,
+                strength: 0.8,
+                falloff,
+                invert: k % 2 == 1,
+            },
+            frame: DabFrame {
+                center,
+                normal: Vec3::new(0.1, -0.2, 1.0).normalize(),
+                plane_point: center - Vec3::new(0.0, 0.0, 0.15),
+                motion: Vec3::new(0.03, -0.02, 0.04),
+            },
+            pressure: 0.9,
+            share: 0.5,
+        };
+        let full = slayer::pipeline::step::select(&state, &mesh, &dab);
+        assert!(full.len() > 8315, "{} selects {}", kind.name(), full.len());
+        // The last round folds the dispatch into two dimensions.
+        if k == BrushKind::DEFORMING.len() - 1 {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        for size in [8315, SIZES[k % SIZES.len()]] {
+            let selection = &full[..size];
+            let reference = slayer::pipeline::step::deform(&state, &mesh, &dab, selection);
+            let entries: Vec<SelectedVertex> = selection
+                .iter()
+                .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
+                .collect();
+            let params = deform_params(&dab, entries.len());
+            let inputs = slayer::cpu::DeformInputs {
+                positions: mesh.positions(),
+                normals: mesh.normals(),
+                selected: &entries,
+                selection_count: entries.len() as u32,
+                neighbour_offsets: &neighbour_offsets,
+                neighbours: &neighbours,
+            };
+            let mut mirror = vec![Vec3::ZERO; entries.len()];
+            slayer::cpu::deform(&params, &inputs, &mut mirror);
+            let actual = run_deform(&gpu, &mesh, &dab, &entries).expect("GPU run");
+            let (m, g) = (
+                worst_relative(&mirror, &reference, dab.brush.radius),
+                worst_relative(&actual, &mirror, dab.brush.radius),
+            );
+            let label = format!("{} ({}) at size {size}", kind.name(), falloff.name());
+            assert!(
+                m <= DEFORM_TOLERANCE,
+                "{label}: mirror off the field by {m:e} radii"
+            );
+            assert!(
+                g <= DEFORM_TOLERANCE,
+                "{label}: GPU off the mirror by {g:e} radii"
+            );
+            // A prefix may hold only rim vertices whose weight rounds their move away.
+            if size == 8315 {
+                let moved = mirror
+                    .iter()
+                    .zip(selection)
+                    .any(|(q, &(v, _))| *q != mesh.positions()[v as usize]);
+                assert!(moved, "{label}: nothing moved");
+            }
+            worst_mirror = worst_mirror.max(m);
+            worst_gpu = worst_gpu.max(g);
+        }
+    }
+    eprintln!(
+        "deform: largest deviation mirror vs field {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× radius)"
+    );
+}
+
+#[test]
+fn dispatch_args_match_the_host_fold_and_the_cpu_mirror() {
+    // The GPU-side sizes equal `dispatch_size` for the same count, folded or not, and an
+    // overflowed count is clamped to the capacity.
+    let mut gpu = gpu();
+    for limit in [65_535, 7] {
+        gpu.limits.max_compute_workgroups_per_dimension = limit;
+        for &count in SIZES.iter().chain(&[100_003]) {
+            let actual = run_dispatch_args(&gpu, count as u32, count, 64).expect("GPU run");
+            let (x, y) = gpu.dispatch_size(count, 64);
+            assert_eq!(actual, [x, y, 1], "count {count}, limit {limit}");
+            let params = slayer::gpu::DispatchParams {
+                workgroup_size: 64,
+                max_per_dimension: limit,
+                capacity: count as u32,
+                _pad: 0,
+            };
+            let mut mirror = [0; 3];
+            slayer::cpu::dispatch_args(&params, count as u32, &mut mirror);
+            assert_eq!(mirror, actual, "mirror at count {count}, limit {limit}");
+        }
+    }
+    let clamped = run_dispatch_args(&gpu, 1_000_000, 640, 64).expect("GPU run");
+    assert_eq!(clamped, [7, 2, 1]);
 }

@@ -3,11 +3,17 @@
 
 use std::path::Path;
 
-use slayer::gpu::CellKeyParams;
+use slayer::brush::BrushKind;
+use slayer::brush::Falloff;
 use slayer::gpu::shaders::{
     FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
     render_source, validate,
 };
+use slayer::gpu::{
+    CellKeyParams, CountParams, DeformParams, DispatchParams, SCAN_BLOCK, SelectParams,
+    SelectedVertex, brush_code, falloff_code,
+};
+use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
 
 fn wgsl_files(folder: &Path) -> Vec<String> {
@@ -146,6 +152,119 @@ fn host_structs_match_naga_layout() {
             _pad
         }
     );
+    for kernel in ["cell_counts", "scan", "scan_add", "scatter"] {
+        assert_layout!(
+            kernel,
+            CountParams {
+                count,
+                _pad0,
+                _pad1,
+                _pad2
+            }
+        );
+    }
+}
+
+#[test]
+fn select_structs_match_naga_layout() {
+    assert_layout!(
+        "select",
+        SelectParams {
+            center,
+            radius,
+            cell_min,
+            table_mask,
+            cell_span,
+            inv_cell_size,
+            candidate_count,
+            scan_vertices,
+            falloff,
+            blend_n,
+            capacity,
+            layer_count,
+            _pad0,
+            _pad1
+        }
+    );
+    assert_layout!("select", SelectedVertex { vertex, weight });
+    assert_layout!("deform", SelectedVertex { vertex, weight });
+    assert_layout!(
+        "dispatch_args",
+        DispatchParams {
+            workgroup_size,
+            max_per_dimension,
+            capacity,
+            _pad
+        }
+    );
+    assert_layout!(
+        "deform",
+        DeformParams {
+            center,
+            radius,
+            normal,
+            strength,
+            plane_point,
+            pressure,
+            motion,
+            share,
+            kind,
+            sign,
+            capacity,
+            _pad
+        }
+    );
+}
+
+/// The value of a `u32` constant declared in a kernel (with its imports), per naga.
+fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
+    let source = kernel_source(kernel).unwrap();
+    let (module, _) = validate(kernel, &source).unwrap();
+    let (_, constant) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("{kernel}: no constant {name}"));
+    match module.global_expressions[constant.init] {
+        naga::Expression::Literal(naga::Literal::U32(value)) => value,
+        ref other => panic!("{kernel}: {name} is not a u32 literal: {other:?}"),
+    }
+}
+
+#[test]
+fn wgsl_constants_match_the_host() {
+    for (name, host) in [
+        ("VERTEX_LOCKED", VertexFlags::LOCKED.bits()),
+        ("VERTEX_MASKED", VertexFlags::MASKED.bits()),
+        ("VERTEX_DEAD", VertexFlags::DEAD.bits()),
+        ("INVALID", INVALID),
+    ] {
+        assert_eq!(naga_u32_constant("cell_counts", name), host, "{name}");
+    }
+    for (name, falloff) in [
+        ("FALLOFF_BLEND", Falloff::Blend { n: 3 }),
+        ("FALLOFF_SMOOTH", Falloff::Smooth),
+        ("FALLOFF_SPHERE", Falloff::Sphere),
+        ("FALLOFF_LINEAR", Falloff::Linear),
+    ] {
+        assert_eq!(
+            naga_u32_constant("select", name),
+            falloff_code(falloff).0,
+            "{name}"
+        );
+    }
+    for kind in BrushKind::ALL {
+        let name = format!("BRUSH_{}", kind.name().to_uppercase());
+        assert_eq!(
+            naga_u32_constant("deform", &name),
+            brush_code(kind),
+            "{name}"
+        );
+    }
+    // One scan workgroup is one block on the host side.
+    for kernel in ["scan", "scan_add"] {
+        assert_eq!(naga_u32_constant(kernel, "WORKGROUP_SIZE"), SCAN_BLOCK);
+    }
 }
 
 #[test]

@@ -1,7 +1,26 @@
 //! CPU mirrors of the WGSL kernels, one file per kernel with the same name. Their loops keep the
 //! shader's shape (workgroups, local invocations, the same guards) so the two read side by side;
-//! they are the reference every GPU result is compared with.
+//! they are the reference every GPU result is compared with. `hash_table` chains the hash-build
+//! mirrors as the GPU host code chains the kernels.
 
+mod cell_counts;
 mod cell_keys;
+mod deform;
+mod dispatch_args;
+mod hash_table;
+mod scan;
+mod scan_add;
+mod scatter;
+mod select;
+mod shared;
 
+pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
+pub use deform::{DeformInputs, deform};
+pub use dispatch_args::dispatch_args;
+pub use hash_table::{exclusive_scan, hash_table};
+pub use scan::scan;
+pub use scan_add::scan_add;
+pub use scatter::scatter;
+pub use select::{SelectInputs, select};
+pub use shared::falloff_weight;

@@ -24,6 +24,15 @@ pub enum GpuError {
     Validation(String),
     #[error(transparent)]
     Shader(#[from] super::shaders::ShaderError),
+    #[error(
+        "{what} needs {bytes} bytes in one storage binding; the adapter allows {limit} \
+         (chunking large meshes is not implemented yet)"
+    )]
+    TooLarge {
+        what: String,
+        bytes: u64,
+        limit: u64,
+    },
 }
 
 /// Which adapters may be used.
@@ -279,6 +288,67 @@ impl GpuContext {
             .to_vec();
         buffer.unmap();
         Ok(bytes)
+    }
+
+    /// Fails clearly when `count` elements of `T` would not fit one storage binding (lavapipe
+    /// allows 128 MiB); checked before anything is allocated.
+    pub fn check_binding<T>(&self, what: &str, count: usize) -> Result<(), GpuError> {
+        let bytes = (count * std::mem::size_of::<T>()) as u64;
+        let limit = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
+        if bytes > limit {
+            return Err(GpuError::TooLarge {
+                what: what.to_string(),
+                bytes,
+                limit,
+            });
+        }
+        Ok(())
+    }
+
+    /// Records one dispatch of `pipeline` covering `invocations` threads, its bind group 0
+    /// binding `resources[i]` at binding `i` (every kernel declares its bindings in that order).
+    /// Nothing is recorded for zero invocations, so empty inputs need no special case.
+    pub fn record_dispatch(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        label: &str,
+        resources: &[&wgpu::Buffer],
+        invocations: usize,
+        workgroup_size: u32,
+    ) {
+        if invocations == 0 {
+            return;
+        }
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+            .iter()
+            .enumerate()
+            .map(|(i, buffer)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: buffer.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let (x, y) = self.dispatch_size(invocations, workgroup_size);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    pub fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
     }
 
     /// Workgroup counts covering `invocations` threads of `workgroup_size`, folded into y when

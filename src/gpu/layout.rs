@@ -13,3 +13,85 @@ pub struct CellKeyParams {
     pub inv_cell_size: f32,
     pub _pad: u32,
 }
+
+/// `CountParams` in `wgsl/shared/mesh.wgsl`: the element count of a one-dimensional pass.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct CountParams {
+    pub count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl CountParams {
+    pub fn new(count: usize) -> Self {
+        CountParams {
+            count: count as u32,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
+}
+
+/// `SelectParams` in `wgsl/select.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SelectParams {
+    pub center: [f32; 3],
+    pub radius: f32,
+    /// Lowest cell of the brush's box.
+    pub cell_min: [i32; 3],
+    pub table_mask: u32,
+    /// Size of the box in cells.
+    pub cell_span: [u32; 3],
+    pub inv_cell_size: f32,
+    /// Cells in the box, or vertices when `scan_vertices` is set.
+    pub candidate_count: u32,
+    pub scan_vertices: u32,
+    /// A `FALLOFF_*` code of `wgsl/shared/brush.wgsl`.
+    pub falloff: u32,
+    pub blend_n: u32,
+    pub capacity: u32,
+    pub layer_count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// `SelectedVertex` in `wgsl/select.wgsl`: one entry of the compacted selection.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct SelectedVertex {
+    pub vertex: u32,
+    pub weight: f32,
+}
+
+/// `DeformParams` in `wgsl/deform.wgsl`: one dab.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DeformParams {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub normal: [f32; 3],
+    pub strength: f32,
+    pub plane_point: [f32; 3],
+    pub pressure: f32,
+    pub motion: [f32; 3],
+    pub share: f32,
+    /// A `BRUSH_*` code of `wgsl/shared/brush.wgsl`.
+    pub kind: u32,
+    pub sign: f32,
+    pub capacity: u32,
+    pub _pad: u32,
+}
+
+/// `DispatchParams` in `wgsl/dispatch_args.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DispatchParams {
+    pub workgroup_size: u32,
+    pub max_per_dimension: u32,
+    pub capacity: u32,
+    pub _pad: u32,
+}

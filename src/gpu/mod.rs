@@ -3,9 +3,29 @@
 
 mod cell_keys;
 mod context;
+mod deform;
+mod dispatch_args;
+mod hash_table;
 mod layout;
+mod scan;
+mod select;
 pub mod shaders;
+mod vertices;
 
-pub use cell_keys::run_cell_keys;
+pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adapters};
-pub use layout::CellKeyParams;
+pub use deform::{
+    DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
+};
+pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
+pub use hash_table::{
+    CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
+};
+pub use layout::{
+    CellKeyParams, CountParams, DeformParams, DispatchParams, SelectParams, SelectedVertex,
+};
+pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
+pub use select::{
+    BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,
+};
+pub use vertices::VertexBuffers;

@@ -7,10 +7,24 @@ use thiserror::Error;
 pub const SHARED: &[(&str, &str)] = &[
     ("shared/grid", include_str!("../../wgsl/shared/grid.wgsl")),
     ("shared/brdf", include_str!("../../wgsl/shared/brdf.wgsl")),
+    ("shared/mesh", include_str!("../../wgsl/shared/mesh.wgsl")),
+    ("shared/brush", include_str!("../../wgsl/shared/brush.wgsl")),
 ];
 
 /// Compute kernels, by file stem; each has entry point `main`.
-pub const KERNELS: &[(&str, &str)] = &[("cell_keys", include_str!("../../wgsl/cell_keys.wgsl"))];
+pub const KERNELS: &[(&str, &str)] = &[
+    ("cell_keys", include_str!("../../wgsl/cell_keys.wgsl")),
+    ("cell_counts", include_str!("../../wgsl/cell_counts.wgsl")),
+    ("scan", include_str!("../../wgsl/scan.wgsl")),
+    ("scan_add", include_str!("../../wgsl/scan_add.wgsl")),
+    ("scatter", include_str!("../../wgsl/scatter.wgsl")),
+    ("select", include_str!("../../wgsl/select.wgsl")),
+    ("deform", include_str!("../../wgsl/deform.wgsl")),
+    (
+        "dispatch_args",
+        include_str!("../../wgsl/dispatch_args.wgsl"),
+    ),
+];
 
 /// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)
 /// and `fs_main` (fragment).

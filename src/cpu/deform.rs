@@ -1,0 +1,104 @@
+//! Mirror of `wgsl/deform.wgsl`: `src/brush/field.rs::displacement` spelled out as the shader
+//! computes it (the twist's quaternion product in glam's order), over the selection list.
+
+use glam::Vec3;
+
+use crate::gpu::{DeformParams, SelectedVertex};
+
+const DRAW_RATE: f32 = 0.1;
+const PINCH_RATE: f32 = 0.25;
+const TWIST_RATE: f32 = 0.5;
+const WORKGROUP_SIZE: u32 = 64;
+
+/// What the kernel binds besides its parameters and output.
+pub struct DeformInputs<'a> {
+    pub positions: &'a [Vec3],
+    pub normals: &'a [Vec3],
+    pub selected: &'a [SelectedVertex],
+    pub selection_count: u32,
+    pub neighbour_offsets: &'a [u32],
+    pub neighbours: &'a [u32],
+}
+
+fn ring_centroid(inputs: &DeformInputs<'_>, v: u32, p: Vec3) -> Vec3 {
+    let start = inputs.neighbour_offsets[v as usize];
+    let end = inputs.neighbour_offsets[v as usize + 1];
+    if end == start {
+        return p;
+    }
+    let mut sum = Vec3::ZERO;
+    for j in start..end {
+        sum += inputs.positions[inputs.neighbours[j as usize] as usize];
+    }
+    sum / (end - start) as f32
+}
+
+fn pinch(params: &DeformParams, p: Vec3) -> Vec3 {
+    let (center, normal) = (
+        Vec3::from_array(params.center),
+        Vec3::from_array(params.normal),
+    );
+    let to_center = center - p;
+    let tangential = to_center - normal * to_center.dot(normal);
+    tangential * PINCH_RATE
+}
+
+fn rotate(axis: Vec3, angle: f32, v: Vec3) -> Vec3 {
+    let half = angle * 0.5;
+    let b = axis * half.sin();
+    let w = half.cos();
+    let b2 = b.dot(b);
+    v * (w * w - b2) + b * (v.dot(b) * 2.0) + b.cross(v) * (w * 2.0)
+}
+
+fn displacement(
+    params: &DeformParams,
+    inputs: &DeformInputs<'_>,
+    v: u32,
+    p: Vec3,
+    weight: f32,
+) -> Vec3 {
+    let normal = Vec3::from_array(params.normal);
+    let center = Vec3::from_array(params.center);
+    let amount = params.strength * params.pressure * weight * params.share;
+    let sign = params.sign;
+    let lift = sign * amount * DRAW_RATE * params.radius;
+    match params.kind {
+        0 => normal * lift,
+        1 | 2 => inputs.normals[v as usize] * lift,
+        3 => Vec3::from_array(params.motion) * (weight * params.share),
+        4 => (ring_centroid(inputs, v, p) - p) * amount.min(1.0),
+        5 => {
+            let height = (p - Vec3::from_array(params.plane_point)).dot(normal);
+            let pull = if sign > 0.0 { -height } else { 0.5 * height };
+            normal * (pull * amount.min(1.0))
+        }
+        6 => pinch(params, p) * (sign * amount),
+        7 => -normal * lift + pinch(params, p) * amount,
+        8 => {
+            let turned = rotate(normal, sign * amount * TWIST_RATE, p - center);
+            center + turned - p
+        }
+        _ => Vec3::ZERO,
+    }
+}
+
+/// `targets[i]` = where `selected[i]` moves.
+pub fn deform(params: &DeformParams, inputs: &DeformInputs<'_>, targets: &mut [Vec3]) {
+    let workgroups = params.capacity.div_ceil(WORKGROUP_SIZE);
+    for workgroup in 0..workgroups {
+        for local in 0..WORKGROUP_SIZE {
+            let i = workgroup * WORKGROUP_SIZE + local;
+            if i >= inputs.selection_count.min(params.capacity) {
+                continue;
+            }
+            let entry = inputs.selected[i as usize];
+            let p = inputs.positions[entry.vertex as usize];
+            let mut q = p + displacement(params, inputs, entry.vertex, p, entry.weight);
+            if !q.is_finite() {
+                q = p;
+            }
+            targets[i as usize] = q;
+        }
+    }
+}

@@ -1,0 +1,62 @@
+//! Mirrors of the functions in `wgsl/shared/` that the grid module does not already provide
+//! (`cell_of` and `hash_cell` are `crate::grid::cell_coordinates` and `crate::grid::hash_cell`).
+
+/// `falloff_weight` of `wgsl/shared/brush.wgsl`: the codes of `crate::gpu::falloff_code`, and
+/// blend's powers as repeated products in the shader's order (so the mirror may differ from
+/// `Falloff::weight`'s `powi` by a few ulps).
+pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
+    // `t_in.is_nan() || t_in >= 1.0`, spelled as the shader does.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(t_in < 1.0) {
+        return 0.0;
+    }
+    let t = t_in.max(0.0);
+    match kind {
+        0 => {
+            let mut t_n = 1.0f32;
+            for _ in 0..blend_n {
+                t_n *= t;
+            }
+            let base = 1.0 - t_n;
+            let mut w = 1.0f32;
+            for _ in 0..blend_n {
+                w *= base;
+            }
+            w
+        }
+        1 => 1.0 - t * t * (3.0 - 2.0 * t),
+        2 => (1.0 - t * t).sqrt(),
+        _ => 1.0 - t,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brush::Falloff;
+    use crate::gpu::falloff_code;
+
+    #[test]
+    fn falloff_mirror_matches_the_brush_falloff() {
+        // Blend's loop and `powi` multiply in different orders: a few ulps apart at most.
+        for falloff in [
+            Falloff::Blend { n: 3 },
+            Falloff::Blend { n: 8 },
+            Falloff::Smooth,
+            Falloff::Sphere,
+            Falloff::Linear,
+        ] {
+            let (kind, n) = falloff_code(falloff);
+            for k in -10..=1100 {
+                let t = k as f32 / 1000.0;
+                let (mirror, brush) = (falloff_weight(kind, n, t), falloff.weight(t));
+                assert!(
+                    (mirror - brush).abs() <= 1e-6,
+                    "{}: t = {t}: {mirror} vs {brush}",
+                    falloff.name()
+                );
+            }
+            assert_eq!(falloff_weight(kind, n, f32::NAN), 0.0);
+        }
+    }
+}

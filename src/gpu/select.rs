@@ -1,0 +1,179 @@
+//! Host side of `wgsl/select.wgsl`: brush selection through the GPU hash table into a compact
+//! list of (vertex, falloff weight), in the order the append atomics ran in.
+
+use glam::Vec3;
+
+use super::{
+    GpuContext, GpuError, GpuHashTable, SelectParams, SelectedVertex, VertexBuffers, table_size_for,
+};
+use crate::brush::Falloff;
+use crate::grid::cell_coordinates;
+
+const WORKGROUP_SIZE: u32 = 64;
+
+/// Where a brush is and how its effect fades: all selection needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BrushSphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub falloff: Falloff,
+}
+
+/// `(FALLOFF_* code, blend exponent)` of a falloff, as `wgsl/shared/brush.wgsl` reads them.
+pub fn falloff_code(falloff: Falloff) -> (u32, u32) {
+    match falloff {
+        Falloff::Blend { n } => (0, n),
+        Falloff::Smooth => (1, 0),
+        Falloff::Sphere => (2, 0),
+        Falloff::Linear => (3, 0),
+    }
+}
+
+/// The kernel's parameters: one invocation per cell of the brush's box, or per vertex when the
+/// box has more cells than there are vertices (or more than a `u32` counts).
+pub fn select_params(
+    brush: &BrushSphere,
+    inv_cell_size: f32,
+    table_size: u32,
+    vertex_count: usize,
+    layer_count: usize,
+) -> SelectParams {
+    let lo = cell_coordinates(brush.center - brush.radius, inv_cell_size);
+    let hi = cell_coordinates(brush.center + brush.radius, inv_cell_size);
+    let span = (hi - lo).as_i64vec3() + 1;
+    let cells = span.x.max(0) * span.y.max(0) * span.z.max(0);
+    let scan_vertices = cells > vertex_count as i64;
+    let (falloff, blend_n) = falloff_code(brush.falloff);
+    SelectParams {
+        center: brush.center.to_array(),
+        radius: brush.radius,
+        cell_min: lo.to_array(),
+        table_mask: table_size - 1,
+        cell_span: if scan_vertices {
+            [0; 3]
+        } else {
+            span.as_uvec3().to_array()
+        },
+        inv_cell_size,
+        candidate_count: if scan_vertices {
+            vertex_count as u32
+        } else {
+            cells as u32
+        },
+        scan_vertices: scan_vertices as u32,
+        falloff,
+        blend_n,
+        capacity: vertex_count as u32,
+        layer_count: layer_count as u32,
+        _pad0: 0,
+        _pad1: 0,
+    }
+}
+
+/// The selection's GPU buffers. `count` (one `u32`) may exceed the capacity after an overflow
+/// (never with capacity = vertex count: a vertex is reported at most once); it is the input a
+/// later pass turns into indirect dispatch sizes.
+pub struct GpuSelection {
+    pub capacity: usize,
+    pub selected: wgpu::Buffer,
+    pub count: wgpu::Buffer,
+}
+
+impl GpuSelection {
+    pub fn new(gpu: &GpuContext, capacity: usize) -> Result<GpuSelection, GpuError> {
+        gpu.check_binding::<SelectedVertex>("selection", capacity)?;
+        Ok(GpuSelection {
+            capacity,
+            selected: gpu.output_buffer::<SelectedVertex>("selected", capacity),
+            count: gpu.output_buffer::<u32>("selection count", 1),
+        })
+    }
+
+    /// The selected vertices, in the order the kernel appended them.
+    pub fn read(&self, gpu: &GpuContext) -> Result<Vec<SelectedVertex>, GpuError> {
+        let count = gpu.read_buffer::<u32>(&self.count, 1)?[0] as usize;
+        gpu.read_buffer(&self.selected, count.min(self.capacity))
+    }
+}
+
+/// Records a selection into `selection` (its counter is cleared first).
+#[allow(clippy::too_many_arguments)]
+pub fn record_select(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    vertices: &VertexBuffers,
+    active_layers: &wgpu::Buffer,
+    layer_count: usize,
+    table: &GpuHashTable,
+    brush: &BrushSphere,
+    selection: &GpuSelection,
+) -> Result<(), GpuError> {
+    let mut params = select_params(
+        brush,
+        table.inv_cell_size,
+        table.table_size,
+        vertices.count,
+        layer_count,
+    );
+    params.capacity = selection.capacity as u32;
+    let pipeline = gpu.compute_pipeline("select")?;
+    let uniform = gpu.uniform_buffer("select params", &params);
+    encoder.clear_buffer(&selection.count, 0, None);
+    gpu.record_dispatch(
+        encoder,
+        &pipeline,
+        "select",
+        &[
+            &uniform,
+            &vertices.positions,
+            &vertices.layers,
+            &vertices.flags,
+            active_layers,
+            &table.offsets,
+            &table.entries,
+            &selection.selected,
+            &selection.count,
+        ],
+        params.candidate_count as usize,
+        WORKGROUP_SIZE,
+    );
+    Ok(())
+}
+
+/// Builds the hash table (cells of `1 / inv_cell_size`) and selects under `brush`, on the GPU.
+pub fn run_select(
+    gpu: &GpuContext,
+    positions: &[Vec3],
+    layers: &[u32],
+    flags: &[u32],
+    active: &[bool],
+    inv_cell_size: f32,
+    brush: &BrushSphere,
+) -> Result<Vec<SelectedVertex>, GpuError> {
+    let vertices = VertexBuffers::upload(gpu, positions, layers, flags)?;
+    let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
+    let active_buffer = gpu.storage_buffer("active layers", &active, false);
+    let selection = GpuSelection::new(gpu, positions.len())?;
+    let mut encoder = gpu.encoder("select");
+    let table = GpuHashTable::record(
+        gpu,
+        &mut encoder,
+        &vertices.positions,
+        &vertices.flags,
+        vertices.count,
+        inv_cell_size,
+        table_size_for(vertices.count),
+    )?;
+    record_select(
+        gpu,
+        &mut encoder,
+        &vertices,
+        &active_buffer,
+        active.len(),
+        &table,
+        brush,
+        &selection,
+    )?;
+    gpu.queue.submit([encoder.finish()]);
+    selection.read(gpu)
+}

@@ -1,0 +1,147 @@
+// Brush deformation (sLayer Algorithm 2 "deform"; DESIGN §3): the target position of every
+// selected vertex under the dab's field, as `src/brush/field.rs::displacement` computes it.
+// One invocation per selection entry; `targets[i]` belongs to `selected[i]`. Non-finite
+// targets (absurd input) leave the vertex where it is, as on the CPU.
+// CPU mirror: src/cpu/deform.rs.
+
+#import shared/grid
+#import shared/brush
+
+struct DeformParams {
+    center: vec3<f32>,
+    radius: f32,
+    // Unit brush normal.
+    normal: vec3<f32>,
+    strength: f32,
+    // Flatten's plane point.
+    plane_point: vec3<f32>,
+    pressure: f32,
+    // Grab's motion of the brush centre.
+    motion: vec3<f32>,
+    // Share of the sample this step carries (1 / steps).
+    share: f32,
+    // A BRUSH_* code.
+    kind: u32,
+    // +1, or -1 when inverted (deflate is inflate inverted).
+    sign: f32,
+    // Entries in `selected` (its capacity): invocations past the selection count return.
+    capacity: u32,
+    _pad: u32,
+}
+
+// As in src/brush/field.rs.
+const DRAW_RATE: f32 = 0.1;
+const PINCH_RATE: f32 = 0.25;
+const TWIST_RATE: f32 = 0.5;
+const WORKGROUP_SIZE: u32 = 64u;
+
+@group(0) @binding(0) var<uniform> params: DeformParams;
+@group(0) @binding(1) var<storage, read> positions: array<f32>;
+@group(0) @binding(2) var<storage, read> normals: array<f32>;
+@group(0) @binding(3) var<storage, read> selected: array<SelectedVertex>;
+@group(0) @binding(4) var<storage, read> selection_count: u32;
+// Smooth's neighbours, CSR: vertex v averages neighbours[neighbour_offsets[v]..[v + 1]] (its
+// one-ring in fan order; on a boundary only its two boundary neighbours).
+@group(0) @binding(5) var<storage, read> neighbour_offsets: array<u32>;
+@group(0) @binding(6) var<storage, read> neighbours: array<u32>;
+// Packed x, y, z per selection entry.
+@group(0) @binding(7) var<storage, read_write> targets: array<f32>;
+
+fn position(v: u32) -> vec3<f32> {
+    return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+}
+
+fn ring_centroid(v: u32, p: vec3<f32>) -> vec3<f32> {
+    let start = neighbour_offsets[v];
+    let end = neighbour_offsets[v + 1u];
+    if end == start {
+        return p;
+    }
+    var sum = vec3<f32>(0.0);
+    for (var j = start; j < end; j++) {
+        sum += position(neighbours[j]);
+    }
+    return sum / f32(end - start);
+}
+
+fn pinch(p: vec3<f32>) -> vec3<f32> {
+    let to_center = params.center - p;
+    let tangential = to_center - params.normal * dot(to_center, params.normal);
+    return tangential * PINCH_RATE;
+}
+
+// `v` rotated by the unit quaternion (axis * sin(a/2), cos(a/2)), in glam's order of operations.
+fn rotate(axis: vec3<f32>, angle: f32, v: vec3<f32>) -> vec3<f32> {
+    let half = angle * 0.5;
+    let b = axis * sin(half);
+    let w = cos(half);
+    let b2 = dot(b, b);
+    return v * (w * w - b2) + b * (dot(v, b) * 2.0) + cross(b, v) * (w * 2.0);
+}
+
+fn displacement(v: u32, p: vec3<f32>, weight: f32) -> vec3<f32> {
+    let amount = params.strength * params.pressure * weight * params.share;
+    let sign = params.sign;
+    let lift = sign * amount * DRAW_RATE * params.radius;
+    switch params.kind {
+        case BRUSH_DRAW: {
+            return params.normal * lift;
+        }
+        case BRUSH_INFLATE, BRUSH_DEFLATE: {
+            let n = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
+            return n * lift;
+        }
+        case BRUSH_GRAB: {
+            return params.motion * (weight * params.share);
+        }
+        case BRUSH_SMOOTH: {
+            return (ring_centroid(v, p) - p) * min(amount, 1.0);
+        }
+        case BRUSH_FLATTEN: {
+            let height = dot(p - params.plane_point, params.normal);
+            var pull = 0.5 * height;
+            if sign > 0.0 {
+                pull = -height;
+            }
+            return params.normal * (pull * min(amount, 1.0));
+        }
+        case BRUSH_PINCH: {
+            return pinch(p) * (sign * amount);
+        }
+        case BRUSH_CREASE: {
+            return -params.normal * lift + pinch(p) * amount;
+        }
+        case BRUSH_TWIST: {
+            let turned = rotate(params.normal, sign * amount * TWIST_RATE, p - params.center);
+            return params.center + turned - p;
+        }
+        default: {
+            return vec3<f32>(0.0);
+        }
+    }
+}
+
+// WGSL has no isfinite: NaN fails every comparison and infinities exceed the largest float.
+fn is_finite(q: vec3<f32>) -> bool {
+    return all(abs(q) <= vec3<f32>(3.40282347e38));
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn main(
+    @builtin(global_invocation_id) global_id: vec3<u32>,
+    @builtin(num_workgroups) workgroups: vec3<u32>,
+) {
+    let i = flat_index(global_id, workgroups, WORKGROUP_SIZE);
+    if i >= min(selection_count, params.capacity) {
+        return;
+    }
+    let entry = selected[i];
+    let p = position(entry.vertex);
+    var q = p + displacement(entry.vertex, p, entry.weight);
+    if !is_finite(q) {
+        q = p;
+    }
+    targets[3u * i] = q.x;
+    targets[3u * i + 1u] = q.y;
+    targets[3u * i + 2u] = q.z;
+}
