@@ -126,6 +126,9 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     pub adapter: AdapterSummary,
     pub limits: wgpu::Limits,
+    /// Compiled kernels by name: validating and compiling a kernel takes milliseconds, and a
+    /// backend records the same few kernels for every step of every stroke.
+    pipelines: std::sync::Mutex<std::collections::HashMap<String, wgpu::ComputePipeline>>,
 }
 
 impl GpuContext {
@@ -167,11 +170,25 @@ impl GpuContext {
             queue,
             adapter: summary,
             limits,
+            pipelines: Default::default(),
         })
     }
 
-    /// A compute pipeline for kernel `name` (entry point `main`, layout from the shader).
+    /// A compute pipeline for kernel `name` (entry point `main`, layout from the shader),
+    /// compiled on first use and kept.
     pub fn compute_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
+        let cached = self.pipelines.lock().ok().and_then(|p| p.get(name).cloned());
+        if let Some(pipeline) = cached {
+            return Ok(pipeline);
+        }
+        let pipeline = self.compile_pipeline(name)?;
+        if let Ok(mut pipelines) = self.pipelines.lock() {
+            pipelines.insert(name.to_string(), pipeline.clone());
+        }
+        Ok(pipeline)
+    }
+
+    fn compile_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
         let source = super::shaders::kernel_source(name)?;
         // Validate with naga first: its messages carry source locations.
         super::shaders::validate(name, &source)?;
