@@ -177,7 +177,11 @@ impl GpuContext {
     /// A compute pipeline for kernel `name` (entry point `main`, layout from the shader),
     /// compiled on first use and kept.
     pub fn compute_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
-        let cached = self.pipelines.lock().ok().and_then(|p| p.get(name).cloned());
+        let cached = self
+            .pipelines
+            .lock()
+            .ok()
+            .and_then(|p| p.get(name).cloned());
         if let Some(pipeline) = cached {
             return Ok(pipeline);
         }

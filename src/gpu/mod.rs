@@ -6,6 +6,7 @@ mod context;
 mod deform;
 mod dispatch_args;
 mod hash_table;
+mod kernels;
 mod layout;
 mod scan;
 mod select;
@@ -21,6 +22,7 @@ pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch
 pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
+pub use kernels::GpuKernels;
 pub use layout::{
     CellKeyParams, CountParams, DeformParams, DispatchParams, SelectParams, SelectedVertex,
 };

@@ -6,7 +6,8 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::step::{Region, StrokeState, collide, deform, paint, select};
+use super::kernels::{CpuKernels, StepKernels};
+use super::step::{Region, StrokeState, collide, paint};
 use super::{
     PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
     StrokeReport,
@@ -35,6 +36,8 @@ pub struct CpuPipeline {
     parallel: bool,
     edge_length: Option<f32>,
     hook: Option<Box<dyn StrokeHook>>,
+    /// Where selection and deformation run.
+    kernels: Box<dyn StepKernels>,
     region: Region,
     prepared: Option<Prepared>,
     /// Per vertex scratch kept between strokes (reset where used).
@@ -79,11 +82,26 @@ impl CpuPipeline {
             search,
             parallel,
             hook: None,
+            kernels: Box::new(CpuKernels),
             region: Region::default(),
             prepared: None,
             target_of: Vec::new(),
             touched: Vec::new(),
         }
+    }
+
+    /// Grids and all cores, with selection and deformation done by `kernels` (the GPU's, for
+    /// the GPU backend).
+    pub fn with_kernels(settings: PipelineSettings, kernels: Box<dyn StepKernels>) -> CpuPipeline {
+        CpuPipeline {
+            kernels,
+            ..CpuPipeline::new(settings)
+        }
+    }
+
+    /// Why the GPU kernels gave up and the pipeline went on with the CPU's, if they did.
+    pub fn kernel_failure(&self) -> Option<String> {
+        self.kernels.failure()
     }
 
     /// Runs `hook` after every stroke (remeshing).
@@ -229,6 +247,10 @@ impl SculptPipeline for CpuPipeline {
     }
 
     fn name(&self) -> String {
+        let kernels = self.kernels.name();
+        if kernels != "cpu" {
+            return format!("gpu (select, deform on {kernels}; collide, remesh on the cpu)");
+        }
         match (self.search, self.parallel) {
             (Search::Grid, true) => "cpu".into(),
             (Search::Scan, false) => "cpu-reference".into(),
@@ -326,7 +348,7 @@ impl SculptPipeline for CpuPipeline {
             };
             let first_selection = match (&captured, is_grab) {
                 (Some(held), true) => held.clone(),
-                _ => select(&state, mesh, &probe),
+                _ => self.kernels.select(&state, mesh, &probe),
             };
             if is_grab && captured.is_none() {
                 captured = Some(first_selection.clone());
@@ -357,7 +379,7 @@ impl SculptPipeline for CpuPipeline {
             // Split the sample's motion into steps of at most `max_step` edge lengths.
             let started = Instant::now();
             let whole = Dab { frame, ..probe };
-            let full = deform(&state, mesh, &whole, &first_selection);
+            let full = self.kernels.deform(&state, mesh, &whole, &first_selection);
             let longest_move = first_selection
                 .iter()
                 .zip(&full)
@@ -382,12 +404,12 @@ impl SculptPipeline for CpuPipeline {
                 let selection = if step == 0 || is_grab {
                     first_selection.clone()
                 } else {
-                    select(&state, mesh, &dab)
+                    self.kernels.select(&state, mesh, &dab)
                 };
                 times.selection += millis(started);
 
                 let started = Instant::now();
-                let targets = deform(&state, mesh, &dab, &selection);
+                let targets = self.kernels.deform(&state, mesh, &dab, &selection);
                 times.deformation += millis(started);
 
                 let started = Instant::now();

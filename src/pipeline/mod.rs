@@ -9,9 +9,11 @@
 //! collision, remesh.
 
 mod cpu;
+mod kernels;
 pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
+pub use kernels::{CpuKernels, StepKernels};
 
 use serde::Serialize;
 use thiserror::Error;

@@ -1,0 +1,56 @@
+//! The seam between Algorithm 2's control flow and where its data-parallel steps run. The
+//! pipeline (`CpuPipeline`) owns the loop — samples, steps, collisions, the exact backstop,
+//! remeshing — and asks its kernels to select and deform: on the CPU ([`CpuKernels`]) or through
+//! the WGSL kernels ([`crate::gpu::GpuKernels`]). One loop for both keeps their results
+//! comparable vertex for vertex, which is what the parity figures of `bench --backend both`
+//! measure.
+
+use glam::Vec3;
+
+use super::step::{StrokeState, deform, select};
+use crate::brush::Dab;
+use crate::mesh::Mesh;
+
+/// Selection and deformation of one brush step.
+pub trait StepKernels: Send {
+    /// For reports: "cpu", or the GPU adapter's name.
+    fn name(&self) -> String;
+    /// Why these kernels gave up and fell back to the CPU, if they did.
+    fn failure(&self) -> Option<String> {
+        None
+    }
+    /// The vertices under the brush with their falloff weights, in vertex order.
+    fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)>;
+    /// Where the brush moves each selected vertex.
+    fn deform(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        selection: &[(u32, f32)],
+    ) -> Vec<Vec3>;
+}
+
+/// The CPU's selection (through the spatial hash, or by scanning) and deformation (rayon).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct CpuKernels;
+
+impl StepKernels for CpuKernels {
+    fn name(&self) -> String {
+        "cpu".into()
+    }
+
+    fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
+        select(state, mesh, dab)
+    }
+
+    fn deform(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        selection: &[(u32, f32)],
+    ) -> Vec<Vec3> {
+        deform(state, mesh, dab, selection)
+    }
+}

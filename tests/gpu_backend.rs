@@ -1,0 +1,122 @@
+//! The pipeline with the GPU's selection and deformation (lavapipe in CI, never skipped) against
+//! the CPU pipeline on the same strokes: positions, collision counts, soundness, and the fallback
+//! to the CPU when the GPU is lost mid-stroke.
+
+use slayer::bench::{ScriptSpec, generate_script};
+use slayer::collide::find_intersections;
+use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels};
+use slayer::mesh::Mesh;
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+
+fn gpu() -> GpuContext {
+    GpuContext::new(AdapterChoice {
+        allow_software: true,
+    })
+    .unwrap_or_else(|e| panic!("GPU tests need an adapter (run tools/test.sh): {e}"))
+}
+
+fn plaster_and_strokes(strokes: usize) -> (Mesh, Vec<slayer::brush::Stroke>) {
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 6_000,
+        seed: 9,
+    })
+    .unwrap();
+    let script = generate_script(
+        &mesh,
+        &ScriptSpec {
+            strokes,
+            seed: 9,
+            ..ScriptSpec::default()
+        },
+    );
+    let strokes = script.resolve(&mesh, "script").unwrap();
+    (mesh, strokes)
+}
+
+/// Runs `strokes` and returns the collision count.
+fn run(pipeline: &mut CpuPipeline, mesh: &mut Mesh, strokes: &[slayer::brush::Stroke]) -> usize {
+    strokes
+        .iter()
+        .map(|s| pipeline.apply_stroke(mesh, s).unwrap().clamped)
+        .sum()
+}
+
+#[test]
+fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
+    let (start, strokes) = plaster_and_strokes(5);
+    let edge = start.mean_edge_length();
+    // Without remeshing the two meshes keep the same vertices and can be compared one by one.
+    let settings = PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    };
+    let (mut on_cpu, mut on_gpu) = (start.clone(), start.clone());
+    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut gpu_pipeline = CpuPipeline::with_kernels(settings, Box::new(GpuKernels::new(gpu())));
+    let gpu_collisions = run(&mut gpu_pipeline, &mut on_gpu, &strokes);
+    assert_eq!(gpu_pipeline.kernel_failure(), None);
+    let deviation = on_cpu
+        .positions()
+        .iter()
+        .zip(on_gpu.positions())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    eprintln!(
+        "max deviation {deviation:e} ({:.2e} L), collisions cpu {cpu_collisions} gpu {gpu_collisions}",
+        deviation / edge
+    );
+    assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
+    assert!(cpu_collisions > 0, "the strokes collide");
+    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
+    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
+    for mesh in [&on_cpu, &on_gpu] {
+        mesh.validate().unwrap();
+        assert_eq!(find_intersections(mesh).total(), 0);
+    }
+}
+
+#[test]
+fn gpu_kernels_with_remeshing_keep_the_mesh_sound() {
+    let (mut mesh, strokes) = plaster_and_strokes(3);
+    let mut pipeline = CpuPipeline::with_kernels(
+        PipelineSettings::default(),
+        Box::new(GpuKernels::new(gpu())),
+    );
+    run(&mut pipeline, &mut mesh, &strokes);
+    assert_eq!(pipeline.kernel_failure(), None);
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(&mesh).total(), 0);
+}
+
+/// A GPU lost in the middle of a stroke: the stroke finishes on the CPU, the failure is
+/// reported, and the result is what the CPU alone makes.
+#[test]
+fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
+    let (start, strokes) = plaster_and_strokes(2);
+    let settings = PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    };
+    let mut on_cpu = start.clone();
+    run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut kernels = GpuKernels::new(gpu());
+    kernels.fail_after(7);
+    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut mesh = start.clone();
+    run(&mut pipeline, &mut mesh, &strokes);
+    let failure = pipeline
+        .kernel_failure()
+        .expect("the simulated loss is reported");
+    assert!(failure.contains("device lost"), "{failure}");
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(&mesh).total(), 0);
+    let deviation = on_cpu
+        .positions()
+        .iter()
+        .zip(mesh.positions())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
+}
