@@ -570,3 +570,47 @@ fn a_missing_file_is_one_plain_line() {
     let stderr = text(&out.stderr);
     assert_eq!(stderr.matches("os error").count(), 1, "{stderr}");
 }
+
+/// `--backend both` runs the same strokes on the CPU and with the GPU's kernels (lavapipe here)
+/// and writes BENCHMARK.md's `parity` object; an unknown backend is a one-line error.
+#[test]
+fn bench_on_both_backends_writes_parity() {
+    let dir = scratch("bench-both");
+    let json = dir.join("out.json");
+    let out = slayer_headless(&[
+        "bench",
+        "--scene",
+        "plaster",
+        "--triangles",
+        "4000",
+        "--strokes",
+        "2",
+        "--backend",
+        "both",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(report["backend"], "both");
+    let parity = &report["parity"];
+    let edges = parity["max_position_deviation_edges"]
+        .as_f64()
+        .expect("same topology");
+    assert!(edges <= 1e-4, "{edges}");
+    assert_eq!(parity["collision_count_cpu"], parity["collision_count_gpu"]);
+    for field in ["max_position_deviation", "gpu_over_cpu"] {
+        assert!(parity.get(field).is_some(), "missing parity.{field}");
+    }
+    assert_eq!(report["gpu_scenes"][0]["intersections"], 0);
+    let out = slayer(&["bench", "--scene", "plaster", "--backend", "quantum"]);
+    assert!(!out.status.success());
+    let first = text(&out.stderr).lines().next().unwrap_or_default().to_string();
+    assert!(first.contains("unknown backend `quantum`"), "{first}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -6,9 +6,11 @@ use slayer::bench::{
     ScalingRow, SceneResult, ScriptSpec, generate_script, paper_table, run_strokes, scaling_svg,
     scaling_table,
 };
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::mesh::Mesh;
+use slayer::pipeline::{PipelineSettings, Remeshing, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
+use crate::backend::{self, Backend};
 use crate::progress::{Bar, Steps};
 
 pub struct Options {
@@ -19,7 +21,7 @@ pub struct Options {
     pub json: Option<PathBuf>,
     pub scaling: bool,
     pub scaling_sizes: Vec<usize>,
-    pub backend: String,
+    pub backend: Backend,
     /// When the touched region is remeshed.
     pub remeshing: Remeshing,
 }
@@ -33,13 +35,59 @@ pub fn parse_scenes(scene: &str) -> Result<Vec<SceneKind>, slayer::scene::SceneE
     })
 }
 
+/// One scene on one backend (or on both, compared).
+struct SceneRun {
+    result: SceneResult,
+    /// With `--backend both`: the GPU's figures and how they compare.
+    gpu: Option<(SceneResult, Parity)>,
+}
+
+/// How the GPU path's result compares with the CPU's on the same strokes.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Parity {
+    /// Largest distance between a vertex on one path and the same vertex on the other;
+    /// `None` when remeshing made the two topologies differ (then vertices do not correspond).
+    pub max_position_deviation: Option<f64>,
+    pub max_position_deviation_edges: Option<f64>,
+    pub collision_count_cpu: usize,
+    pub collision_count_gpu: usize,
+    /// GPU time over CPU time per phase, from the same run.
+    pub gpu_over_cpu: std::collections::BTreeMap<&'static str, f64>,
+}
+
+fn parity(cpu: (&SceneResult, &Mesh), gpu: (&SceneResult, &Mesh)) -> Parity {
+    let same_topology = cpu.1.faces() == gpu.1.faces();
+    let deviation = same_topology.then(|| {
+        cpu.1
+            .positions()
+            .iter()
+            .zip(gpu.1.positions())
+            .map(|(a, b)| a.distance(*b) as f64)
+            .fold(0.0, f64::max)
+    });
+    let mut ratios = std::collections::BTreeMap::new();
+    for ((name, c), (_, g)) in cpu.0.phase_ms.named().iter().zip(gpu.0.phase_ms.named()) {
+        if *c > 0.0 {
+            ratios.insert(*name, g / c);
+        }
+    }
+    Parity {
+        max_position_deviation: deviation,
+        max_position_deviation_edges: deviation.map(|d| d / cpu.0.mean_edge_length),
+        collision_count_cpu: cpu.0.collisions,
+        collision_count_gpu: gpu.0.collisions,
+        gpu_over_cpu: ratios,
+    }
+}
+
 fn bench_scene(
     kind: SceneKind,
     triangles: usize,
     strokes: usize,
     seed: u64,
     remeshing: Remeshing,
-) -> anyhow::Result<SceneResult> {
+    chosen: Backend,
+) -> anyhow::Result<SceneRun> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
     let mut mesh = generate(&SceneSpec {
@@ -58,11 +106,33 @@ fn bench_scene(
     );
     let strokes = script.resolve(&mesh, "generated script")?;
     steps.finish();
-    let mut pipeline = CpuPipeline::new(PipelineSettings {
+    let settings = PipelineSettings {
         remeshing,
         ..PipelineSettings::default()
-    });
-    sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut pipeline)
+    };
+    let start = mesh.clone();
+    let mut first = backend::choose(chosen, settings)?;
+    let result = sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut first.pipeline)?;
+    report_fallback(&first.pipeline);
+    let gpu = if chosen == Backend::Both {
+        let mut second = backend::gpu(settings)?;
+        let mut on_gpu = start;
+        let name = format!("{} (gpu)", kind.name());
+        let gpu_result = sculpt_with_progress(&name, &mut on_gpu, &strokes, &mut second.pipeline)?;
+        report_fallback(&second.pipeline);
+        let compared = parity((&result, &mesh), (&gpu_result, &on_gpu));
+        Some((gpu_result, compared))
+    } else {
+        None
+    };
+    Ok(SceneRun { result, gpu })
+}
+
+/// A GPU that failed mid-run finished on the CPU: say so, the figures mix both.
+fn report_fallback(pipeline: &slayer::pipeline::CpuPipeline) {
+    if let Some(why) = pipeline.kernel_failure() {
+        eprintln!("warning: the GPU failed ({why}); the run finished on the CPU");
+    }
 }
 
 /// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does.
@@ -79,26 +149,68 @@ pub fn sculpt_with_progress(
 }
 
 pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
-    if options.backend != "cpu" {
-        anyhow::bail!(
-            "backend `{}` is not available yet (only `cpu`)",
-            options.backend
-        );
-    }
-    let pipeline_name = CpuPipeline::new(PipelineSettings::default()).name();
-    let mut scenes = Vec::new();
+    // Open the backend once up front: a missing GPU is an error before any work.
+    let probe = backend::choose(options.backend, PipelineSettings::default())?;
+    let (pipeline_name, adapter) = match options.backend {
+        Backend::Both => (
+            "both".to_string(),
+            backend::gpu(PipelineSettings::default())?.adapter,
+        ),
+        _ => (probe.pipeline.name(), probe.adapter.clone()),
+    };
+    // `auto` has said what it chose; the scenes use that choice without asking again.
+    let resolved = match options.backend {
+        Backend::Auto if pipeline_name == "cpu" => Backend::Cpu,
+        Backend::Auto => Backend::Gpu,
+        other => other,
+    };
+    let mut runs = Vec::new();
     for &kind in &options.scenes {
         let triangles = options.triangles.unwrap_or(kind.default_triangles());
-        scenes.push(bench_scene(
+        runs.push(bench_scene(
             kind,
             triangles,
             options.strokes,
             options.seed,
             options.remeshing,
+            resolved,
         )?);
     }
+    let scenes: Vec<SceneResult> = runs.iter().map(|r| r.result.clone()).collect();
+    let gpu_scenes: Vec<SceneResult> = runs
+        .iter()
+        .filter_map(|r| r.gpu.as_ref().map(|(g, _)| g.clone()))
+        .collect();
+    let parities: Vec<(String, Parity)> = runs
+        .iter()
+        .filter_map(|r| {
+            r.gpu
+                .as_ref()
+                .map(|(_, p)| (r.result.name.clone(), p.clone()))
+        })
+        .collect();
     if !scenes.is_empty() {
         println!("{}", paper_table(&scenes));
+    }
+    if !gpu_scenes.is_empty() {
+        println!("the same strokes with the GPU's selection and deformation ({adapter}):");
+        println!("{}", paper_table(&gpu_scenes));
+        for (name, p) in &parities {
+            println!(
+                "parity {name}: max position deviation {}, collisions cpu {} gpu {}; gpu/cpu time: {}",
+                p.max_position_deviation_edges.map_or(
+                    "n/a (remeshing made the topologies differ)".to_string(),
+                    |d| format!("{d:.2e} L")
+                ),
+                p.collision_count_cpu,
+                p.collision_count_gpu,
+                p.gpu_over_cpu
+                    .iter()
+                    .map(|(k, v)| format!("{k} {v:.2}x"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
     }
     let mut scaling = Vec::new();
     if options.scaling {
@@ -109,7 +221,13 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 options.strokes.min(8),
                 options.seed,
                 options.remeshing,
-            )?;
+                if resolved == Backend::Both {
+                    Backend::Cpu
+                } else {
+                    resolved
+                },
+            )?
+            .result;
             scaling.push(ScalingRow {
                 faces: r.faces,
                 ms_per_sample: r.ms_per_sample,
@@ -122,15 +240,23 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         println!("scaling: the same strokes (radius 12 L) on plaster of growing size");
         println!("{}", scaling_table(&scaling));
     }
-    let clean = scenes.iter().all(|s| s.valid && s.intersections == 0);
+    let clean = scenes
+        .iter()
+        .chain(&gpu_scenes)
+        .all(|s| s.valid && s.intersections == 0);
     if let Some(path) = &options.json {
         let json = serde_json::json!({
             "backend": pipeline_name,
-            "adapter": "none (CPU)",
+            "adapter": adapter,
             "threads": rayon::current_num_threads(),
             "revision": slayer::bench::git_revision(),
             "scenes": scenes,
             "scaling": if options.scaling { Some(&scaling) } else { None },
+            "gpu_scenes": if gpu_scenes.is_empty() { None } else { Some(&gpu_scenes) },
+            // BENCHMARK.md's `parity` is one object: the first scene's; every scene's is in
+            // `parity_by_scene`.
+            "parity": parities.first().map(|(_, p)| p),
+            "parity_by_scene": if parities.is_empty() { None } else { Some(&parities) },
         });
         slayer::io::write_atomically(path, serde_json::to_string_pretty(&json)?.as_bytes())?;
         if options.scaling {

@@ -7,7 +7,7 @@ use slayer::bench::{ScriptSpec, generate_script, paper_table};
 use slayer::brush::{BrushKind, PaintSpec, StencilSpec, StrokeFile};
 use slayer::gpu::GpuContext;
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
+use slayer::pipeline::{PipelineSettings, SculptPipeline};
 use slayer::render::{Image, RenderOptions};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
@@ -65,7 +65,16 @@ fn render_to(gpu: &GpuContext, mesh: &Mesh, path: &Path) -> anyhow::Result<Image
 
 /// Generates the default material (peeling plaster), sculpts it with a short seeded stroke
 /// script, writes the material before and after, checks the result and prints the timings.
-pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
+pub fn run(
+    out: &Path,
+    triangles: usize,
+    backend: crate::backend::Backend,
+) -> anyhow::Result<ExitCode> {
+    if backend == crate::backend::Backend::Both {
+        anyhow::bail!(
+            "--backend both compares the two paths in `slayer bench`; demo takes auto, cpu or gpu"
+        );
+    }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let spec = SceneSpec {
         triangles,
@@ -117,7 +126,7 @@ pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
         None => None,
     };
 
-    let mut pipeline = CpuPipeline::new(PipelineSettings::default());
+    let mut pipeline = crate::backend::choose(backend, PipelineSettings::default())?.pipeline;
     println!(
         "  sculpting {} strokes ({}) on the {} backend -> {}",
         strokes.len(),
@@ -130,6 +139,9 @@ pub fn run(out: &Path, triangles: usize) -> anyhow::Result<ExitCode> {
         strokes_path.display()
     );
     let result = crate::bench::sculpt_with_progress("plaster", &mut mesh, &strokes, &mut pipeline)?;
+    if let Some(why) = pipeline.kernel_failure() {
+        eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
+    }
     println!("{}", paper_table(std::slice::from_ref(&result)));
 
     let after = out.join("plaster-sculpted.ply");

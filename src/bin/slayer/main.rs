@@ -1,5 +1,6 @@
 //! The `slayer` command line: generate scenes, check mesh files, run the demo.
 
+mod backend;
 mod bench;
 mod check;
 mod demo;
@@ -36,6 +37,10 @@ enum Command {
         /// Triangles in the generated material.
         #[arg(long, default_value_t = 640_000)]
         triangles: usize,
+        /// auto (a hardware GPU if there is one, else the CPU), cpu, or gpu (any adapter,
+        /// lavapipe included).
+        #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
+        backend: backend::Backend,
     },
     /// Write a generated scene: plane, sphere, plaster, bark or metal.
     Scene {
@@ -77,6 +82,10 @@ enum Command {
         /// Remesh the touched region: after every stroke, after every stroke sample, or off.
         #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
         remesh: slayer::pipeline::Remeshing,
+        /// auto (a hardware GPU if there is one, else the CPU), cpu, or gpu (any adapter,
+        /// lavapipe included).
+        #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
+        backend: backend::Backend,
     },
     /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax).
     Remesh {
@@ -127,8 +136,11 @@ enum Command {
             default_value = "250000,500000,1000000,2000000,4000000"
         )]
         scaling_sizes: Vec<usize>,
-        #[arg(long, default_value = "cpu")]
-        backend: String,
+        /// cpu; gpu (the GPU's selection and deformation, any adapter including lavapipe);
+        /// auto (a hardware GPU if there is one, else the CPU); both (the same strokes on each,
+        /// compared).
+        #[arg(long, default_value = "cpu", value_name = "cpu|gpu|auto|both")]
+        backend: backend::Backend,
         /// Remesh the touched region: after every stroke, after every stroke sample, or off.
         #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
         remesh: slayer::pipeline::Remeshing,
@@ -176,7 +188,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Demo { out, triangles } => demo::run(&out, triangles),
+        Command::Demo {
+            out,
+            triangles,
+            backend,
+        } => demo::run(&out, triangles, backend),
         Command::Scene {
             name,
             triangles,
@@ -192,7 +208,8 @@ fn main() -> ExitCode {
             output,
             stats,
             remesh,
-        } => sculpt::run(&input, &strokes, &output, stats.as_deref(), remesh),
+            backend,
+        } => sculpt::run(&input, &strokes, &output, stats.as_deref(), remesh, backend),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
         Command::Render {
             file,

@@ -3,7 +3,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use slayer::brush::StrokeFile;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline, StrokeReport};
+use slayer::pipeline::{PipelineSettings, Remeshing, SculptPipeline, StrokeReport};
 
 use crate::progress::Bar;
 
@@ -14,7 +14,13 @@ pub fn run(
     output: &Path,
     stats: Option<&Path>,
     remeshing: Remeshing,
+    backend: crate::backend::Backend,
 ) -> anyhow::Result<ExitCode> {
+    if backend == crate::backend::Backend::Both {
+        anyhow::bail!(
+            "--backend both compares the two paths in `slayer bench`; sculpt takes cpu, gpu or auto"
+        );
+    }
     slayer::io::Format::of_path(output)?;
     let mut mesh = slayer::io::read_mesh(input)?;
     let text =
@@ -22,10 +28,14 @@ pub fn run(
     let name = strokes.display().to_string();
     let file = StrokeFile::parse(&text, &name)?;
     let strokes = file.resolve(&mesh, &name)?;
-    let mut pipeline = CpuPipeline::new(PipelineSettings {
-        remeshing,
-        ..PipelineSettings::default()
-    });
+    let mut pipeline = crate::backend::choose(
+        backend,
+        PipelineSettings {
+            remeshing,
+            ..PipelineSettings::default()
+        },
+    )?
+    .pipeline;
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
     for stroke in &strokes {
@@ -33,6 +43,9 @@ pub fn run(
         bar.inc();
     }
     bar.finish();
+    if let Some(why) = pipeline.kernel_failure() {
+        eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
+    }
     mesh.validate()
         .context("the sculpted mesh failed validation (not written)")?;
     slayer::io::write_mesh(&mesh, output)?;
