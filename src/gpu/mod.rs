@@ -7,9 +7,11 @@ mod deform;
 mod dispatch_args;
 mod hash_table;
 mod layout;
+mod proximity;
 mod scan;
 mod select;
 pub mod shaders;
+mod topology;
 mod vertices;
 
 pub use cell_keys::{record_cell_keys, run_cell_keys};
@@ -22,10 +24,16 @@ pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
 pub use layout::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, SelectParams, SelectedVertex,
+    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
+    ProximityParams, PulledVertex, SelectParams, SelectedVertex,
+};
+pub use proximity::{
+    ProximityBuffers, ProximityQuery, moving_vertices, proximity_params, proximity_reaches,
+    record_proximity, run_proximity,
 };
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,
 };
+pub use topology::{FACE_WORDS, PackedTopology};
 pub use vertices::VertexBuffers;
