@@ -1031,3 +1031,51 @@ fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_pressed_sheets() {
 fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_a_folded_sheet() {
     check_proximity(folded_sheet());
 }
+
+/// Normals may differ by this much (unit vectors): the GPU may fuse the cross products'
+/// multiply-adds.
+const NORMAL_TOLERANCE: f32 = 1e-6;
+
+#[test]
+fn vertex_normals_match_cpu_mirror_and_the_mesh() {
+    // Bumpy sheets (boundaries included) with their positions moved after the normals were
+    // last computed; a seeded shuffle of the vertices at awkward sizes, the largest folded
+    // into two dimensions. The mirror against `Mesh::recompute_normals_at`, the GPU against
+    // the mirror; unlisted normals must stay as they were.
+    let mut gpu = gpu();
+    let mut mesh = bumpy_sheets();
+    let mut rng = ChaCha8Rng::seed_from_u64(600);
+    for p in mesh.positions_mut() {
+        p.z += rng.random_range(-0.01..0.01);
+    }
+    let order = shuffled((0..mesh.vertex_count() as u32).collect(), 601);
+    let topology = slayer::gpu::PackedTopology::of(&mesh);
+    let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+    let mut worst = 0.0f32;
+    for (k, &size) in SIZES.iter().enumerate() {
+        if k + 1 == SIZES.len() {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        let listed = &order[..size];
+        let mut reference = mesh.clone();
+        reference.recompute_normals_at(listed);
+        let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
+        let params = slayer::gpu::NormalParams {
+            count: size as u32,
+            vertex_faces_base: topology.vertex_faces_base,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        slayer::cpu::vertex_normals(&params, &flat, &topology.words, listed, &mut mirror);
+        let mirror: Vec<Vec3> = mirror.chunks(3).map(Vec3::from_slice).collect();
+        assert_eq!(mirror, reference.normals(), "mirror at size {size}");
+        let actual = slayer::gpu::run_vertex_normals(&gpu, &mesh, listed).expect("GPU run");
+        let off = worst_relative(&actual, &mirror, 1.0);
+        assert!(
+            off <= NORMAL_TOLERANCE,
+            "GPU off the mirror by {off:e} at size {size}"
+        );
+        worst = worst.max(off);
+    }
+    eprintln!("vertex_normals: largest deviation GPU vs mirror {worst:e}");
+}

@@ -10,8 +10,9 @@ use slayer::gpu::shaders::{
     render_source, validate,
 };
 use slayer::gpu::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, ProximityParams,
-    PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
+    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
+    ProximityParams, PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
+    falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -329,4 +330,13 @@ fn proximity_and_normal_structs_match_naga_layout() {
         }
     );
     assert_layout!("proximity", PulledVertex { position, pulled });
+    assert_layout!(
+        "vertex_normals",
+        NormalParams {
+            count,
+            vertex_faces_base,
+            _pad0,
+            _pad1
+        }
+    );
 }

@@ -14,6 +14,7 @@ mod scan_add;
 mod scatter;
 mod select;
 mod shared;
+mod vertex_normals;
 
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
@@ -26,3 +27,4 @@ pub use scan_add::scan_add;
 pub use scatter::scatter;
 pub use select::{SelectInputs, select};
 pub use shared::falloff_weight;
+pub use vertex_normals::vertex_normals;

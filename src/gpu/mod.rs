@@ -12,6 +12,7 @@ mod scan;
 mod select;
 pub mod shaders;
 mod topology;
+mod vertex_normals;
 mod vertices;
 
 pub use cell_keys::{record_cell_keys, run_cell_keys};
@@ -36,4 +37,5 @@ pub use select::{
     BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology};
+pub use vertex_normals::{record_vertex_normals, run_vertex_normals};
 pub use vertices::VertexBuffers;

@@ -26,6 +26,10 @@ pub const KERNELS: &[(&str, &str)] = &[
         include_str!("../../wgsl/dispatch_args.wgsl"),
     ),
     ("proximity", include_str!("../../wgsl/proximity.wgsl")),
+    (
+        "vertex_normals",
+        include_str!("../../wgsl/vertex_normals.wgsl"),
+    ),
 ];
 
 /// Render shaders in `wgsl/render/`, by file stem; each has entry points `vs_main` (vertex)
