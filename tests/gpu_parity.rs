@@ -722,3 +722,360 @@ fn dispatch_args_match_the_host_fold_and_the_cpu_mirror() {
     let clamped = run_dispatch_args(&gpu, 1_000_000, 640, 64).expect("GPU run");
     assert_eq!(clamped, [7, 2, 1]);
 }
+
+/// Pulled-back positions may differ by this share of the edge length: one flipped decision in
+/// the last bisection rounds moves a result by 2⁻¹⁶ of its move, and the GPU may fuse the
+/// closest-point arithmetic's multiply-adds.
+const PROXIMITY_TOLERANCE: f32 = 1e-5;
+
+fn longest_edge(mesh: &slayer::mesh::Mesh) -> f32 {
+    (0..mesh.face_count())
+        .filter(|&f| !mesh.is_face_dead(f))
+        .map(|f| {
+            let [a, b, c] = mesh.face_positions(f);
+            a.distance(b).max(b.distance(c)).max(c.distance(a))
+        })
+        .fold(0.0, f32::max)
+}
+
+/// A step to test proximity on: the mesh at the step's start, its selection (a seeded shuffle
+/// of the vertices that move) and every vertex's tentative position.
+struct ProximityScene {
+    name: &'static str,
+    mesh: slayer::mesh::Mesh,
+    order: Vec<u32>,
+    targets: Vec<Vec3>,
+    edge: f32,
+}
+
+fn shuffled(mut vertices: Vec<u32>, seed: u64) -> Vec<u32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    for i in (1..vertices.len()).rev() {
+        vertices.swap(i, rng.random_range(0..=i));
+    }
+    vertices
+}
+
+/// Each vertex of `moved` pushed down by `depth` (± 0.02) and jittered sideways by ± 0.02.
+fn pushed_down(mesh: &slayer::mesh::Mesh, moved: &[u32], depth: f32, seed: u64) -> Vec<Vec3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut targets = mesh.positions().to_vec();
+    for &v in moved {
+        targets[v as usize] += Vec3::new(
+            rng.random_range(-0.02..0.02),
+            rng.random_range(-0.02..0.02),
+            -depth + rng.random_range(-0.02..0.02),
+        );
+    }
+    targets
+}
+
+/// Two sheets 0.15 apart (edges 0.1), the upper one pushed 0.12 down: most of it comes within
+/// the collision distance of the lower sheet and clamps.
+fn pressed_sheets() -> ProximityScene {
+    let mesh = slayer::scene::shapes::stacked_sheets(2, 80, 60, 0.1, 0.15);
+    let upper: Vec<u32> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| mesh.vertex_layers()[v as usize] == 1)
+        .collect();
+    let targets = pushed_down(&mesh, &upper, 0.12, 71);
+    ProximityScene {
+        name: "pressed sheets",
+        order: shuffled(upper, 72),
+        mesh,
+        targets,
+        edge: 0.1,
+    }
+}
+
+/// One sheet folded over itself (flat, a half-turn of radius 0.1, flat again 0.2 above), its
+/// upper part pushed 0.17 down onto the lower: same-layer collisions outside the ring.
+fn folded_sheet() -> ProximityScene {
+    let mut mesh = slayer::scene::shapes::stacked_sheets(1, 80, 20, 0.1, 0.0);
+    let (bend, radius) = (4.0f32, 0.1f32);
+    let arc = std::f32::consts::PI * radius;
+    let mut upper = Vec::new();
+    for (v, p) in mesh.positions_mut().iter_mut().enumerate() {
+        let s = p.x;
+        if s <= bend {
+            continue;
+        }
+        if s < bend + arc {
+            let angle = (s - bend) / radius;
+            p.x = bend + radius * angle.sin();
+            p.z = radius - radius * angle.cos();
+        } else {
+            p.x = bend - (s - bend - arc);
+            p.z = 2.0 * radius;
+            upper.push(v as u32);
+        }
+    }
+    let targets = pushed_down(&mesh, &upper, 0.17, 73);
+    ProximityScene {
+        name: "folded sheet",
+        order: shuffled(upper, 74),
+        mesh,
+        targets,
+        edge: 0.1,
+    }
+}
+
+/// The proximity mirror's verdicts for `selection` of `scene`, with `current` positions.
+fn cpu_proximity(
+    scene: &ProximityScene,
+    query: &slayer::gpu::ProximityQuery<'_>,
+) -> Vec<slayer::gpu::PulledVertex> {
+    let mesh = &scene.mesh;
+    let starts: Vec<Vec3> = query
+        .selection
+        .iter()
+        .map(|&v| mesh.positions()[v as usize])
+        .collect();
+    let (moving, rings) = slayer::gpu::moving_vertices(mesh, query.selection, &starts, query.ring);
+    let topology = slayer::gpu::PackedTopology::of(mesh);
+    let table_size = table_size_for(mesh.vertex_count());
+    let params = slayer::gpu::proximity_params(query, topology.vertex_faces_base, table_size);
+    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let table = slayer::cpu::hash_table(mesh.positions(), &flags, params.inv_cell_size, table_size);
+    let flat: Vec<f32> = query.current.iter().flat_map(|p| p.to_array()).collect();
+    let mut pulled = vec![slayer::gpu::PulledVertex::default(); query.selection.len()];
+    slayer::cpu::proximity(
+        &params,
+        &slayer::cpu::ProximityInputs {
+            positions: &flat,
+            offsets: &table.offsets,
+            entries: &table.entries,
+            topology: &topology.words,
+            moving: &moving,
+            rings: &rings,
+            marks: query.marks.unwrap_or(&[]),
+        },
+        &mut pulled,
+    );
+    pulled
+}
+
+/// `pipeline::step::pull_back` (the CPU backend's first pass) for the same step.
+fn reference_pull_back(
+    scene: &ProximityScene,
+    selection: &[u32],
+    distance: f32,
+    ring: u32,
+) -> Vec<Option<Vec3>> {
+    let mesh = &scene.mesh;
+    let grid = SpatialHash::build(mesh, scene.edge).unwrap();
+    let mut current = mesh.clone();
+    for &v in selection {
+        current.positions_mut()[v as usize] = scene.targets[v as usize];
+    }
+    let active = vec![true; mesh.layer_count()];
+    let state = slayer::pipeline::step::StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: distance,
+        ring,
+        max_edge: longest_edge(mesh).max(longest_edge(&current)),
+    };
+    let pairs: Vec<(u32, f32)> = selection.iter().map(|&v| (v, 1.0)).collect();
+    let targets: Vec<Vec3> = selection
+        .iter()
+        .map(|&v| scene.targets[v as usize])
+        .collect();
+    let mut target_of = vec![INVALID; mesh.vertex_count()];
+    for (i, &v) in selection.iter().enumerate() {
+        target_of[v as usize] = i as u32;
+    }
+    let mut region = slayer::pipeline::step::Region::default();
+    region.gather(&state, mesh, &pairs, &targets, &target_of);
+    let mut scratch = slayer::pipeline::step::Scratch::default();
+    selection
+        .iter()
+        .map(|&v| {
+            let start = mesh.positions()[v as usize];
+            if current.positions()[v as usize] == start {
+                return None;
+            }
+            slayer::pipeline::step::pull_back(
+                &state,
+                &region,
+                &current,
+                v,
+                start,
+                None,
+                &mut scratch,
+            )
+        })
+        .collect()
+}
+
+/// Largest distance between two verdict lists over `edge`, after checking their flags agree.
+fn compare_pulled(
+    label: &str,
+    actual: &[slayer::gpu::PulledVertex],
+    expected: &[slayer::gpu::PulledVertex],
+    edge: f32,
+) -> f32 {
+    assert_eq!(actual.len(), expected.len(), "{label}");
+    let mut worst = 0.0f32;
+    for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
+        assert_eq!(
+            a.pulled, e.pulled,
+            "{label}: entry {i} pulled {a:?} vs {e:?}"
+        );
+        let off = Vec3::from_array(a.position).distance(Vec3::from_array(e.position)) / edge;
+        worst = worst.max(off);
+    }
+    assert!(
+        worst <= PROXIMITY_TOLERANCE,
+        "{label}: off by {worst:e} edge lengths"
+    );
+    worst
+}
+
+/// Both Jacobi passes of proximity on `scene` at awkward selection sizes (the largest folds its
+/// dispatch into two dimensions): the mirror against `pull_back`, the GPU against the mirror;
+/// then a second pass that tests only the faces of the vertices the first pulled back.
+fn check_proximity(scene: ProximityScene) {
+    let mut gpu = gpu();
+    let (distance, ring) = (0.05, 2);
+    let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);
+    let all = scene.order.len();
+    let large_odd = if all >= 4001 { 4001 } else { all | 1 };
+    let sizes = [0, 1, 63, 64, 65, 1000.min(all), large_odd.min(all)];
+    for (k, &size) in sizes.iter().enumerate() {
+        let label = format!("{} at size {size}", scene.name);
+        gpu.limits.max_compute_workgroups_per_dimension =
+            if k + 1 == sizes.len() { 7 } else { 65_535 };
+        let selection = &scene.order[..size];
+        let mut current = scene.mesh.positions().to_vec();
+        for &v in selection {
+            current[v as usize] = scene.targets[v as usize];
+        }
+        let query = slayer::gpu::ProximityQuery {
+            mesh: &scene.mesh,
+            current: &current,
+            selection,
+            distance,
+            ring,
+            max_edge: longest_edge(&scene.mesh),
+            cell_size: scene.edge,
+            marks: None,
+        };
+        let mirror = cpu_proximity(&scene, &query);
+        let reference: Vec<slayer::gpu::PulledVertex> =
+            reference_pull_back(&scene, selection, distance, ring)
+                .into_iter()
+                .zip(selection)
+                .map(|(p, &v)| match p {
+                    Some(p) => slayer::gpu::PulledVertex {
+                        position: p.to_array(),
+                        pulled: 1,
+                    },
+                    None => slayer::gpu::PulledVertex {
+                        position: current[v as usize].to_array(),
+                        pulled: 0,
+                    },
+                })
+                .collect();
+        worst_mirror = worst_mirror.max(compare_pulled(
+            &format!("{label}: mirror vs pull_back"),
+            &mirror,
+            &reference,
+            scene.edge,
+        ));
+        let actual = slayer::gpu::run_proximity(&gpu, &query).expect("GPU run");
+        worst_gpu = worst_gpu.max(compare_pulled(
+            &format!("{label}: GPU vs mirror"),
+            &actual,
+            &mirror,
+            scene.edge,
+        ));
+        if size >= 1000 {
+            let clamped = mirror.iter().filter(|p| p.pulled == 1).count();
+            assert!(clamped * 4 > size, "{label}: only {clamped} clamp");
+        }
+
+        // Second pass: the first's results written in, only faces it changed.
+        let mut after = current.clone();
+        let mut marks = vec![0u32; scene.mesh.vertex_count()];
+        for (p, &v) in mirror.iter().zip(selection) {
+            after[v as usize] = Vec3::from_array(p.position);
+            marks[v as usize] = p.pulled;
+        }
+        let query = slayer::gpu::ProximityQuery {
+            current: &after,
+            marks: Some(&marks),
+            ..query
+        };
+        let mirror = cpu_proximity(&scene, &query);
+        let actual = slayer::gpu::run_proximity(&gpu, &query).expect("GPU run");
+        worst_gpu = worst_gpu.max(compare_pulled(
+            &format!("{label}, second pass: GPU vs mirror"),
+            &actual,
+            &mirror,
+            scene.edge,
+        ));
+    }
+    eprintln!(
+        "proximity, {}: largest deviation mirror vs pull_back {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× edge)",
+        scene.name
+    );
+}
+
+#[test]
+fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_pressed_sheets() {
+    check_proximity(pressed_sheets());
+}
+
+#[test]
+fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_a_folded_sheet() {
+    check_proximity(folded_sheet());
+}
+
+/// Normals may differ by this much (unit vectors): the GPU may fuse the cross products'
+/// multiply-adds.
+const NORMAL_TOLERANCE: f32 = 1e-6;
+
+#[test]
+fn vertex_normals_match_cpu_mirror_and_the_mesh() {
+    // Bumpy sheets (boundaries included) with their positions moved after the normals were
+    // last computed; a seeded shuffle of the vertices at awkward sizes, the largest folded
+    // into two dimensions. The mirror against `Mesh::recompute_normals_at`, the GPU against
+    // the mirror; unlisted normals must stay as they were.
+    let mut gpu = gpu();
+    let mut mesh = bumpy_sheets();
+    let mut rng = ChaCha8Rng::seed_from_u64(600);
+    for p in mesh.positions_mut() {
+        p.z += rng.random_range(-0.01..0.01);
+    }
+    let order = shuffled((0..mesh.vertex_count() as u32).collect(), 601);
+    let topology = slayer::gpu::PackedTopology::of(&mesh);
+    let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+    let mut worst = 0.0f32;
+    for (k, &size) in SIZES.iter().enumerate() {
+        if k + 1 == SIZES.len() {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        let listed = &order[..size];
+        let mut reference = mesh.clone();
+        reference.recompute_normals_at(listed);
+        let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
+        let params = slayer::gpu::NormalParams {
+            count: size as u32,
+            vertex_faces_base: topology.vertex_faces_base,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        slayer::cpu::vertex_normals(&params, &flat, &topology.words, listed, &mut mirror);
+        let mirror: Vec<Vec3> = mirror.chunks(3).map(Vec3::from_slice).collect();
+        assert_eq!(mirror, reference.normals(), "mirror at size {size}");
+        let actual = slayer::gpu::run_vertex_normals(&gpu, &mesh, listed).expect("GPU run");
+        let off = worst_relative(&actual, &mirror, 1.0);
+        assert!(
+            off <= NORMAL_TOLERANCE,
+            "GPU off the mirror by {off:e} at size {size}"
+        );
+        worst = worst.max(off);
+    }
+    eprintln!("vertex_normals: largest deviation GPU vs mirror {worst:e}");
+}

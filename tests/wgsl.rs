@@ -10,8 +10,9 @@ use slayer::gpu::shaders::{
     render_source, validate,
 };
 use slayer::gpu::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, SCAN_BLOCK, SelectParams,
-    SelectedVertex, brush_code, falloff_code,
+    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
+    ProximityParams, PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
+    falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -298,6 +299,44 @@ fn render_host_structs_match_naga_layout() {
             line_width,
             _pad,
             palette
+        }
+    );
+}
+
+#[test]
+fn proximity_and_normal_structs_match_naga_layout() {
+    assert_layout!(
+        "proximity",
+        ProximityParams {
+            distance,
+            cell_reach,
+            vertex_reach,
+            inv_cell_size,
+            table_mask,
+            count,
+            vertex_faces_base,
+            all_faces
+        }
+    );
+    assert_layout!(
+        "proximity",
+        MovingVertex {
+            start,
+            vertex,
+            layer,
+            ring_start,
+            ring_end,
+            _pad
+        }
+    );
+    assert_layout!("proximity", PulledVertex { position, pulled });
+    assert_layout!(
+        "vertex_normals",
+        NormalParams {
+            count,
+            vertex_faces_base,
+            _pad0,
+            _pad1
         }
     );
 }

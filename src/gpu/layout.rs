@@ -95,3 +95,58 @@ pub struct DispatchParams {
     pub capacity: u32,
     pub _pad: u32,
 }
+
+/// `ProximityParams` in `wgsl/proximity.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ProximityParams {
+    /// Collision distance.
+    pub distance: f32,
+    /// Half-size of the box of cells searched around the tentative position.
+    pub cell_reach: f32,
+    /// Bucket entries farther than this from the tentative position (on some axis) are skipped.
+    pub vertex_reach: f32,
+    pub inv_cell_size: f32,
+    pub table_mask: u32,
+    /// Entries in the moving list.
+    pub count: u32,
+    /// Where the vertex→faces rows start in the packed topology.
+    pub vertex_faces_base: u32,
+    /// 1 to test every face, 0 to test only faces with a marked vertex.
+    pub all_faces: u32,
+}
+
+/// `MovingVertex` in `wgsl/proximity.wgsl`: one entry of a step's selection.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct MovingVertex {
+    /// Position at the start of the step.
+    pub start: [f32; 3],
+    pub vertex: u32,
+    pub layer: u32,
+    /// The exclusion ring is `rings[ring_start..ring_end]`.
+    pub ring_start: u32,
+    pub ring_end: u32,
+    pub _pad: u32,
+}
+
+/// `PulledVertex` in `wgsl/proximity.wgsl`: one entry's verdict.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct PulledVertex {
+    pub position: [f32; 3],
+    /// 1 when pulled back.
+    pub pulled: u32,
+}
+
+/// `NormalParams` in `wgsl/vertex_normals.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct NormalParams {
+    /// Vertices listed.
+    pub count: u32,
+    /// Where the vertex→faces rows start in the packed topology.
+    pub vertex_faces_base: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}

@@ -8,9 +8,12 @@ mod dispatch_args;
 mod hash_table;
 mod kernels;
 mod layout;
+mod proximity;
 mod scan;
 mod select;
 pub mod shaders;
+mod topology;
+mod vertex_normals;
 mod vertices;
 
 pub use cell_keys::{record_cell_keys, run_cell_keys};
@@ -24,10 +27,17 @@ pub use hash_table::{
 };
 pub use kernels::GpuKernels;
 pub use layout::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, SelectParams, SelectedVertex,
+    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
+    ProximityParams, PulledVertex, SelectParams, SelectedVertex,
+};
+pub use proximity::{
+    ProximityBuffers, ProximityQuery, moving_vertices, proximity_params, proximity_reaches,
+    record_proximity, run_proximity,
 };
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,
 };
+pub use topology::{FACE_WORDS, PackedTopology};
+pub use vertex_normals::{record_vertex_normals, run_vertex_normals};
 pub use vertices::VertexBuffers;

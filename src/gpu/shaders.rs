@@ -9,6 +9,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/brdf", include_str!("../../wgsl/shared/brdf.wgsl")),
     ("shared/mesh", include_str!("../../wgsl/shared/mesh.wgsl")),
     ("shared/brush", include_str!("../../wgsl/shared/brush.wgsl")),
+    ("shared/geom", include_str!("../../wgsl/shared/geom.wgsl")),
 ];
 
 /// Compute kernels, by file stem; each has entry point `main`.
@@ -23,6 +24,11 @@ pub const KERNELS: &[(&str, &str)] = &[
     (
         "dispatch_args",
         include_str!("../../wgsl/dispatch_args.wgsl"),
+    ),
+    ("proximity", include_str!("../../wgsl/proximity.wgsl")),
+    (
+        "vertex_normals",
+        include_str!("../../wgsl/vertex_normals.wgsl"),
     ),
 ];
 

@@ -183,7 +183,9 @@ pub struct Region {
 }
 
 impl Region {
-    fn gather(
+    /// Collects the faces around the step's moves (public so that `tests/gpu_parity.rs` can
+    /// check the GPU proximity mirror against [`pull_back`]).
+    pub fn gather(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
@@ -290,7 +292,8 @@ fn triangle(mesh: &Mesh, f: u32) -> [Vec3; 3] {
 
 /// Tests one moving vertex, now at its tentative position, against the faces near its move
 /// (only those in `changed`, if given). Returns the position it must be pulled back to, if any.
-fn pull_back(
+/// Public as the reference for the GPU kernel `proximity` (`tests/gpu_parity.rs`).
+pub fn pull_back(
     state: &StrokeState<'_>,
     region: &Region,
     mesh: &Mesh,

@@ -1,0 +1,161 @@
+//! Mirror of `wgsl/proximity.wgsl`: one Jacobi pass of `pipeline::step::pull_back` over the
+//! moving list, with the shader's loops (cells of the box around the tentative position, bucket
+//! entries, each entry's faces) and the same `closest_point_on_triangle`. Faces met twice are
+//! harmless: each entry keeps the minimum safe fraction.
+
+use glam::{UVec3, Vec3};
+
+use crate::geom::closest_point_on_triangle;
+use crate::gpu::{MovingVertex, ProximityParams, PulledVertex};
+use crate::grid::{cell_coordinates, hash_cell};
+
+const CLAMP_ROUNDS: u32 = 16;
+const WORKGROUP_SIZE: u32 = 64;
+
+/// What the kernel binds besides its parameters and output.
+pub struct ProximityInputs<'a> {
+    /// Current packed x, y, z triples.
+    pub positions: &'a [f32],
+    /// The hash table (`CsrTable::offsets` and `entries`).
+    pub offsets: &'a [u32],
+    pub entries: &'a [u32],
+    /// `PackedTopology::words`.
+    pub topology: &'a [u32],
+    pub moving: &'a [MovingVertex],
+    pub rings: &'a [u32],
+    /// Per vertex; unread when `params.all_faces` is 1.
+    pub marks: &'a [u32],
+}
+
+fn position(inputs: &ProximityInputs<'_>, v: u32) -> Vec3 {
+    let i = 3 * v as usize;
+    Vec3::new(
+        inputs.positions[i],
+        inputs.positions[i + 1],
+        inputs.positions[i + 2],
+    )
+}
+
+fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    closest_point_on_triangle(p, a, b, c).distance(p)
+}
+
+fn touches_ring(
+    inputs: &ProximityInputs<'_>,
+    entry: &MovingVertex,
+    a: u32,
+    b: u32,
+    c: u32,
+) -> bool {
+    let mut touches = false;
+    for r in entry.ring_start..entry.ring_end {
+        let w = inputs.rings[r as usize];
+        touches = touches || w == a || w == b || w == c;
+    }
+    touches
+}
+
+fn safe_fraction(
+    params: &ProximityParams,
+    inputs: &ProximityInputs<'_>,
+    entry: &MovingVertex,
+    f: u32,
+    x: Vec3,
+) -> f32 {
+    let words = &inputs.topology[4 * f as usize..4 * f as usize + 4];
+    let (a, b, c, layer) = (words[0], words[1], words[2], words[3]);
+    if params.all_faces == 0
+        && (inputs.marks[a as usize] | inputs.marks[b as usize] | inputs.marks[c as usize]) == 0
+    {
+        return 1.0;
+    }
+    let v = entry.vertex;
+    if a == v || b == v || c == v {
+        return 1.0;
+    }
+    if layer == entry.layer && touches_ring(inputs, entry, a, b, c) {
+        return 1.0;
+    }
+    let (pa, pb, pc) = (
+        position(inputs, a),
+        position(inputs, b),
+        position(inputs, c),
+    );
+    let d = params.distance;
+    let here = distance_to_triangle(x, pa, pb, pc);
+    if here >= d {
+        return 1.0;
+    }
+    let start = Vec3::from_array(entry.start);
+    let threshold = d.min(distance_to_triangle(start, pa, pb, pc));
+    if here >= threshold {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..CLAMP_ROUNDS {
+        let mid = 0.5 * (lo + hi);
+        if distance_to_triangle(start + (x - start) * mid, pa, pb, pc) >= threshold {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// `pulled[i]` = the verdict on `inputs.moving[i]`, for the first `params.count` entries.
+pub fn proximity(
+    params: &ProximityParams,
+    inputs: &ProximityInputs<'_>,
+    pulled: &mut [PulledVertex],
+) {
+    let table_size = params.table_mask.wrapping_add(1);
+    let workgroups = params.count.div_ceil(WORKGROUP_SIZE);
+    for workgroup in 0..workgroups {
+        for local in 0..WORKGROUP_SIZE {
+            let i = workgroup * WORKGROUP_SIZE + local;
+            if i >= params.count {
+                continue;
+            }
+            let entry = &inputs.moving[i as usize];
+            let x = position(inputs, entry.vertex);
+            let start = Vec3::from_array(entry.start);
+            let mut t = 1.0f32;
+            if x != start {
+                let reach = Vec3::splat(params.cell_reach);
+                let low = cell_coordinates(x - reach, params.inv_cell_size);
+                let high = cell_coordinates(x + reach, params.inv_cell_size);
+                let span = (high - low).as_uvec3() + UVec3::ONE;
+                let cells = span.x * span.y * span.z;
+                for n in 0..cells {
+                    let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
+                    let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
+                    let end = inputs.offsets[bucket + 1];
+                    for j in inputs.offsets[bucket]..end {
+                        let u = inputs.entries[j as usize];
+                        let offset = (position(inputs, u) - x).abs();
+                        if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
+                            let row = (params.vertex_faces_base + u) as usize;
+                            let last = inputs.topology[row + 1];
+                            for k in inputs.topology[row]..last {
+                                let f = inputs.topology[k as usize];
+                                t = t.min(safe_fraction(params, inputs, entry, f, x));
+                            }
+                        }
+                    }
+                }
+            }
+            pulled[i as usize] = if t < 1.0 {
+                PulledVertex {
+                    position: (start + (x - start) * t).to_array(),
+                    pulled: 1,
+                }
+            } else {
+                PulledVertex {
+                    position: x.to_array(),
+                    pulled: 0,
+                }
+            };
+        }
+    }
+}

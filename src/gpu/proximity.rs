@@ -1,0 +1,220 @@
+//! Host side of `wgsl/proximity.wgsl`: one Jacobi pass of vertex–triangle proximity and
+//! clamping over a step's selection, as `pipeline::step::pull_back` does it on the CPU.
+//!
+//! What a GPU backend keeps between passes: the moving list and rings (built once per step on
+//! the CPU: rings are connectivity, which only remeshing changes), the per-vertex marks (a
+//! vertex pulled back in a pass marks its faces as changed for the next one, exactly the faces
+//! the CPU's `changed` holds), and the positions with the pass's results written in.
+
+use glam::Vec3;
+
+use super::{
+    GpuContext, GpuError, MovingVertex, PackedTopology, ProximityParams, PulledVertex,
+    table_size_for,
+};
+use crate::collide::neighbourhood::ring_vertices;
+use crate::mesh::Mesh;
+
+const WORKGROUP_SIZE: u32 = 64;
+
+/// Margin on the broad phase's reaches so that rounding never drops a face exact arithmetic
+/// keeps; extra candidates cost time, never results.
+const REACH_SLACK: f32 = 1.01;
+
+/// One moving entry per selected vertex (vertex `selection[i]` started the step at
+/// `starts[i]`), with its exclusion ring appended to the returned ring list.
+pub fn moving_vertices(
+    mesh: &Mesh,
+    selection: &[u32],
+    starts: &[Vec3],
+    ring: u32,
+) -> (Vec<MovingVertex>, Vec<u32>) {
+    assert_eq!(
+        selection.len(),
+        starts.len(),
+        "one start per selected vertex"
+    );
+    let mut rings = Vec::new();
+    let mut scratch = Vec::new();
+    let moving = selection
+        .iter()
+        .zip(starts)
+        .map(|(&v, start)| {
+            ring_vertices(mesh, v, ring, &mut scratch);
+            let ring_start = rings.len() as u32;
+            rings.extend_from_slice(&scratch);
+            MovingVertex {
+                start: start.to_array(),
+                vertex: v,
+                layer: mesh.vertex_layers()[v as usize],
+                ring_start,
+                ring_end: rings.len() as u32,
+                _pad: 0,
+            }
+        })
+        .collect();
+    (moving, rings)
+}
+
+/// Broad-phase reaches for collision distance `distance`, `max_edge` an upper bound on edge
+/// lengths when the hash table was built, and `max_move` the farthest any vertex has moved
+/// since. An edge grows by at most its two ends' moves, so a face within `distance` of a point
+/// has every vertex within `distance + max_edge + 2·max_move` of it (the vertex reach), filed
+/// at most `max_move` farther (the cell reach).
+pub fn proximity_reaches(distance: f32, max_edge: f32, max_move: f32) -> (f32, f32) {
+    let vertex_reach = distance + max_edge + 2.0 * max_move;
+    (
+        REACH_SLACK * (vertex_reach + max_move),
+        REACH_SLACK * vertex_reach,
+    )
+}
+
+/// Buffers `proximity` binds besides its parameters and output.
+pub struct ProximityBuffers<'a> {
+    /// Current packed positions (targets written in).
+    pub positions: &'a wgpu::Buffer,
+    /// The hash table's `offsets` and `entries` (`GpuHashTable`).
+    pub offsets: &'a wgpu::Buffer,
+    pub entries: &'a wgpu::Buffer,
+    /// [`PackedTopology`] words.
+    pub topology: &'a wgpu::Buffer,
+    pub moving: &'a wgpu::Buffer,
+    pub rings: &'a wgpu::Buffer,
+    /// Per-vertex marks; any buffer when `params.all_faces` is 1.
+    pub marks: &'a wgpu::Buffer,
+}
+
+/// Records one pass writing `pulled[i]` for each of the `params.count` moving entries.
+pub fn record_proximity(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    inputs: &ProximityBuffers<'_>,
+    params: &ProximityParams,
+    pulled: &wgpu::Buffer,
+) -> Result<(), GpuError> {
+    let pipeline = gpu.compute_pipeline("proximity")?;
+    let uniform = gpu.uniform_buffer("proximity params", params);
+    gpu.record_dispatch(
+        encoder,
+        &pipeline,
+        "proximity",
+        &[
+            &uniform,
+            inputs.positions,
+            inputs.offsets,
+            inputs.entries,
+            inputs.topology,
+            inputs.moving,
+            inputs.rings,
+            inputs.marks,
+            pulled,
+        ],
+        params.count as usize,
+        WORKGROUP_SIZE,
+    );
+    Ok(())
+}
+
+/// One proximity pass, everything taken from the CPU.
+pub struct ProximityQuery<'a> {
+    /// The mesh at the start of the step: its positions are the ones hashed and the starts.
+    pub mesh: &'a Mesh,
+    /// Per vertex: where it is now (the selection at its targets).
+    pub current: &'a [Vec3],
+    pub selection: &'a [u32],
+    pub distance: f32,
+    /// Exclusion ring (graph distance).
+    pub ring: u32,
+    /// Upper bound on edge lengths at the step's start.
+    pub max_edge: f32,
+    pub cell_size: f32,
+    /// Per vertex: nonzero where pulled back in the last pass; `None` tests every face.
+    pub marks: Option<&'a [u32]>,
+}
+
+/// The parameters of `query`'s pass over `count` entries.
+pub fn proximity_params(
+    query: &ProximityQuery<'_>,
+    vertex_faces_base: u32,
+    table_size: u32,
+) -> ProximityParams {
+    let positions = query.mesh.positions();
+    let max_move = query
+        .selection
+        .iter()
+        .map(|&v| positions[v as usize].distance(query.current[v as usize]))
+        .fold(0.0f32, f32::max);
+    let (cell_reach, vertex_reach) = proximity_reaches(query.distance, query.max_edge, max_move);
+    ProximityParams {
+        distance: query.distance,
+        cell_reach,
+        vertex_reach,
+        inv_cell_size: 1.0 / query.cell_size,
+        table_mask: table_size - 1,
+        count: query.selection.len() as u32,
+        vertex_faces_base,
+        all_faces: query.marks.is_none() as u32,
+    }
+}
+
+/// Builds the hash table of the step's start positions and runs one pass on the GPU.
+pub fn run_proximity(
+    gpu: &GpuContext,
+    query: &ProximityQuery<'_>,
+) -> Result<Vec<PulledVertex>, GpuError> {
+    let mesh = query.mesh;
+    assert_eq!(
+        query.current.len(),
+        mesh.vertex_count(),
+        "one position per vertex"
+    );
+    let starts: Vec<Vec3> = query
+        .selection
+        .iter()
+        .map(|&v| mesh.positions()[v as usize])
+        .collect();
+    let (moving, rings) = moving_vertices(mesh, query.selection, &starts, query.ring);
+    let topology = PackedTopology::of(mesh);
+    let table_size = table_size_for(mesh.vertex_count());
+    let params = proximity_params(query, topology.vertex_faces_base, table_size);
+    gpu.check_binding::<u32>("exclusion rings", rings.len())?;
+    let hashed = super::VertexBuffers::upload(
+        gpu,
+        mesh.positions(),
+        mesh.vertex_layers(),
+        &mesh.flags().iter().map(|f| f.bits()).collect::<Vec<_>>(),
+    )?;
+    let current = gpu.storage_buffer("current positions", query.current, false);
+    let topology = topology.upload(gpu)?;
+    let moving = gpu.storage_buffer("moving", &moving, false);
+    let rings = gpu.storage_buffer("rings", &rings, false);
+    let marks = gpu.storage_buffer("marks", query.marks.unwrap_or(&[]), false);
+    let pulled = gpu.output_buffer::<PulledVertex>("pulled", query.selection.len());
+    let mut encoder = gpu.encoder("proximity");
+    let table = super::GpuHashTable::record(
+        gpu,
+        &mut encoder,
+        &hashed.positions,
+        &hashed.flags,
+        mesh.vertex_count(),
+        params.inv_cell_size,
+        table_size,
+    )?;
+    record_proximity(
+        gpu,
+        &mut encoder,
+        &ProximityBuffers {
+            positions: &current,
+            offsets: &table.offsets,
+            entries: &table.entries,
+            topology: &topology,
+            moving: &moving,
+            rings: &rings,
+            marks: &marks,
+        },
+        &params,
+        &pulled,
+    )?;
+    gpu.queue.submit([encoder.finish()]);
+    gpu.read_buffer(&pulled, query.selection.len())
+}

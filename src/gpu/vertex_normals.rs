@@ -1,0 +1,69 @@
+//! Host side of `wgsl/vertex_normals.wgsl`: normals of the vertices a step moved (and their
+//! neighbours, whose faces moved too), recomputed on the GPU so the per-sample loop never waits
+//! for the CPU.
+
+use glam::Vec3;
+
+use super::{GpuContext, GpuError, NormalParams, PackedTopology};
+use crate::mesh::Mesh;
+
+const WORKGROUP_SIZE: u32 = 64;
+
+/// Records the pass rewriting the normals (packed x, y, z per vertex) of the first `count`
+/// entries of `vertices`, from `positions` and the packed topology.
+#[allow(clippy::too_many_arguments)]
+pub fn record_vertex_normals(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    positions: &wgpu::Buffer,
+    topology: &wgpu::Buffer,
+    vertex_faces_base: u32,
+    vertices: &wgpu::Buffer,
+    count: usize,
+    normals: &wgpu::Buffer,
+) -> Result<(), GpuError> {
+    let params = NormalParams {
+        count: count as u32,
+        vertex_faces_base,
+        _pad0: 0,
+        _pad1: 0,
+    };
+    let pipeline = gpu.compute_pipeline("vertex_normals")?;
+    let uniform = gpu.uniform_buffer("vertex_normals params", &params);
+    gpu.record_dispatch(
+        encoder,
+        &pipeline,
+        "vertex_normals",
+        &[&uniform, positions, topology, vertices, normals],
+        count,
+        WORKGROUP_SIZE,
+    );
+    Ok(())
+}
+
+/// `mesh`'s normals with those of `vertices` recomputed on the GPU.
+pub fn run_vertex_normals(
+    gpu: &GpuContext,
+    mesh: &Mesh,
+    vertices: &[u32],
+) -> Result<Vec<Vec3>, GpuError> {
+    gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
+    let topology = PackedTopology::of(mesh);
+    let positions = gpu.storage_buffer("positions", mesh.positions(), false);
+    let topology_buffer = topology.upload(gpu)?;
+    let listed = gpu.storage_buffer("listed vertices", vertices, false);
+    let normals = gpu.storage_buffer("normals", mesh.normals(), true);
+    let mut encoder = gpu.encoder("vertex_normals");
+    record_vertex_normals(
+        gpu,
+        &mut encoder,
+        &positions,
+        &topology_buffer,
+        topology.vertex_faces_base,
+        &listed,
+        vertices.len(),
+        &normals,
+    )?;
+    gpu.queue.submit([encoder.finish()]);
+    gpu.read_buffer(&normals, mesh.vertex_count())
+}
