@@ -610,7 +610,11 @@ fn bench_on_both_backends_writes_parity() {
     assert_eq!(report["gpu_scenes"][0]["intersections"], 0);
     let out = slayer(&["bench", "--scene", "plaster", "--backend", "quantum"]);
     assert!(!out.status.success());
-    let first = text(&out.stderr).lines().next().unwrap_or_default().to_string();
+    let first = text(&out.stderr)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
     assert!(first.contains("unknown backend `quantum`"), "{first}");
     std::fs::remove_dir_all(dir).unwrap();
 }
