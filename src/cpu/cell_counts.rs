@@ -2,10 +2,9 @@
 //! so the CPU table lists each bucket's vertices ascending; the GPU's order within a bucket is
 //! arbitrary and only the bucket's set is comparable.
 
+use super::shared::invocations;
 use crate::gpu::CountParams;
 use crate::mesh::{INVALID, VertexFlags};
-
-const WORKGROUP_SIZE: u32 = 64;
 
 /// `counts[keys[i]] += 1` for every live vertex `i`, and `ranks[i]` = its count before that.
 pub fn cell_counts(
@@ -15,21 +14,14 @@ pub fn cell_counts(
     counts: &mut [u32],
     ranks: &mut [u32],
 ) {
-    let workgroups = params.count.div_ceil(WORKGROUP_SIZE);
-    for workgroup in 0..workgroups {
-        for local in 0..WORKGROUP_SIZE {
-            let i = workgroup * WORKGROUP_SIZE + local;
-            if i >= params.count {
-                continue;
-            }
-            let i = i as usize;
-            if flags[i] & VertexFlags::DEAD.bits() != 0 {
-                ranks[i] = INVALID;
-                continue;
-            }
-            let count = &mut counts[keys[i] as usize];
-            ranks[i] = *count;
-            *count += 1;
+    for i in invocations(params.count) {
+        let i = i as usize;
+        if flags[i] & VertexFlags::DEAD.bits() != 0 {
+            ranks[i] = INVALID;
+            continue;
         }
+        let count = &mut counts[keys[i] as usize];
+        ranks[i] = *count;
+        *count += 1;
     }
 }

@@ -3,13 +3,12 @@
 
 use glam::Vec3;
 
+use super::shared::invocations;
 use crate::gpu::{DeformParams, SelectedVertex};
 
 const DRAW_RATE: f32 = 0.1;
 const PINCH_RATE: f32 = 0.25;
 const TWIST_RATE: f32 = 0.5;
-const WORKGROUP_SIZE: u32 = 64;
-
 /// What the kernel binds besides its parameters and output.
 pub struct DeformInputs<'a> {
     pub positions: &'a [Vec3],
@@ -85,20 +84,13 @@ fn displacement(
 
 /// `targets[i]` = where `selected[i]` moves.
 pub fn deform(params: &DeformParams, inputs: &DeformInputs<'_>, targets: &mut [Vec3]) {
-    let workgroups = params.capacity.div_ceil(WORKGROUP_SIZE);
-    for workgroup in 0..workgroups {
-        for local in 0..WORKGROUP_SIZE {
-            let i = workgroup * WORKGROUP_SIZE + local;
-            if i >= inputs.selection_count.min(params.capacity) {
-                continue;
-            }
-            let entry = inputs.selected[i as usize];
-            let p = inputs.positions[entry.vertex as usize];
-            let mut q = p + displacement(params, inputs, entry.vertex, p, entry.weight);
-            if !q.is_finite() {
-                q = p;
-            }
-            targets[i as usize] = q;
+    for i in invocations(inputs.selection_count.min(params.capacity)) {
+        let entry = inputs.selected[i as usize];
+        let p = inputs.positions[entry.vertex as usize];
+        let mut q = p + displacement(params, inputs, entry.vertex, p, entry.weight);
+        if !q.is_finite() {
+            q = p;
         }
+        targets[i as usize] = q;
     }
 }

@@ -1,5 +1,6 @@
 //! CPU mirrors of the WGSL kernels, one file per kernel with the same name. Their loops keep the
-//! shader's shape (workgroups, local invocations, the same guards) so the two read side by side;
+//! shader's shape (invocations in the GPU's order through `shared::invocations`, the same
+//! guards) so the two read side by side;
 //! they are the reference every GPU result is compared with. `hash_table` chains the hash-build
 //! mirrors as the GPU host code chains the kernels.
 

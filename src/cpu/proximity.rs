@@ -5,13 +5,12 @@
 
 use glam::{UVec3, Vec3};
 
+use super::shared::{invocations, packed_position};
 use crate::geom::closest_point_on_triangle;
 use crate::gpu::{MovingVertex, ProximityParams, PulledVertex};
 use crate::grid::{cell_coordinates, hash_cell};
 
 const CLAMP_ROUNDS: u32 = 16;
-const WORKGROUP_SIZE: u32 = 64;
-
 /// What the kernel binds besides its parameters and output.
 pub struct ProximityInputs<'a> {
     /// Current packed x, y, z triples.
@@ -25,15 +24,6 @@ pub struct ProximityInputs<'a> {
     pub rings: &'a [u32],
     /// Per vertex; unread when `params.all_faces` is 1.
     pub marks: &'a [u32],
-}
-
-fn position(inputs: &ProximityInputs<'_>, v: u32) -> Vec3 {
-    let i = 3 * v as usize;
-    Vec3::new(
-        inputs.positions[i],
-        inputs.positions[i + 1],
-        inputs.positions[i + 2],
-    )
 }
 
 fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
@@ -77,9 +67,9 @@ fn safe_fraction(
         return 1.0;
     }
     let (pa, pb, pc) = (
-        position(inputs, a),
-        position(inputs, b),
-        position(inputs, c),
+        packed_position(inputs.positions, a),
+        packed_position(inputs.positions, b),
+        packed_position(inputs.positions, c),
     );
     let d = params.distance;
     let here = distance_to_triangle(x, pa, pb, pc);
@@ -110,52 +100,45 @@ pub fn proximity(
     pulled: &mut [PulledVertex],
 ) {
     let table_size = params.table_mask.wrapping_add(1);
-    let workgroups = params.count.div_ceil(WORKGROUP_SIZE);
-    for workgroup in 0..workgroups {
-        for local in 0..WORKGROUP_SIZE {
-            let i = workgroup * WORKGROUP_SIZE + local;
-            if i >= params.count {
-                continue;
-            }
-            let entry = &inputs.moving[i as usize];
-            let x = position(inputs, entry.vertex);
-            let start = Vec3::from_array(entry.start);
-            let mut t = 1.0f32;
-            if x != start {
-                let reach = Vec3::splat(params.cell_reach);
-                let low = cell_coordinates(x - reach, params.inv_cell_size);
-                let high = cell_coordinates(x + reach, params.inv_cell_size);
-                let span = (high - low).as_uvec3() + UVec3::ONE;
-                let cells = span.x * span.y * span.z;
-                for n in 0..cells {
-                    let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-                    let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
-                    let end = inputs.offsets[bucket + 1];
-                    for j in inputs.offsets[bucket]..end {
-                        let u = inputs.entries[j as usize];
-                        let offset = (position(inputs, u) - x).abs();
-                        if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
-                            let row = (params.vertex_faces_base + u) as usize;
-                            let last = inputs.topology[row + 1];
-                            for k in inputs.topology[row]..last {
-                                let f = inputs.topology[k as usize];
-                                t = t.min(safe_fraction(params, inputs, entry, f, x));
-                            }
+    for i in invocations(params.count) {
+        let entry = &inputs.moving[i as usize];
+        let x = packed_position(inputs.positions, entry.vertex);
+        let start = Vec3::from_array(entry.start);
+        let mut t = 1.0f32;
+        if x != start {
+            let reach = Vec3::splat(params.cell_reach);
+            let low = cell_coordinates(x - reach, params.inv_cell_size);
+            let high = cell_coordinates(x + reach, params.inv_cell_size);
+            let span = (high - low).as_uvec3() + UVec3::ONE;
+            let cells = span.x * span.y * span.z;
+            for n in 0..cells {
+                let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
+                let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
+                let end = inputs.offsets[bucket + 1];
+                for j in inputs.offsets[bucket]..end {
+                    let u = inputs.entries[j as usize];
+                    let offset = (packed_position(inputs.positions, u) - x).abs();
+                    if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
+                        let row = (params.vertex_faces_base + u) as usize;
+                        let last = inputs.topology[row + 1];
+                        for k in inputs.topology[row]..last {
+                            let f = inputs.topology[k as usize];
+                            t = t.min(safe_fraction(params, inputs, entry, f, x));
                         }
                     }
                 }
             }
-            pulled[i as usize] = if t < 1.0 {
-                PulledVertex {
-                    position: (start + (x - start) * t).to_array(),
-                    pulled: 1,
-                }
-            } else {
-                PulledVertex {
-                    position: x.to_array(),
-                    pulled: 0,
-                }
-            };
         }
+        pulled[i as usize] = if t < 1.0 {
+            PulledVertex {
+                position: (start + (x - start) * t).to_array(),
+                pulled: 1,
+            }
+        } else {
+            PulledVertex {
+                position: x.to_array(),
+                pulled: 0,
+            }
+        };
     }
 }

@@ -30,6 +30,26 @@ pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
     }
 }
 
+/// Workgroup size of the one-dimensional kernels.
+pub const WORKGROUP_SIZE: u32 = 64;
+
+/// The invocation indices a dispatch over `count` items runs, workgroup by workgroup as the GPU
+/// numbers them (`flat_index` in `wgsl/shared/grid.wgsl`), without those past `count` that
+/// return at the kernel's first guard.
+pub fn invocations(count: u32) -> impl Iterator<Item = u32> {
+    (0..count.div_ceil(WORKGROUP_SIZE))
+        .flat_map(|workgroup| {
+            (0..WORKGROUP_SIZE).map(move |local| workgroup * WORKGROUP_SIZE + local)
+        })
+        .filter(move |&i| i < count)
+}
+
+/// Vertex `v` of a packed x, y, z buffer, as the kernels read positions.
+pub fn packed_position(positions: &[f32], v: u32) -> glam::Vec3 {
+    let i = 3 * v as usize;
+    glam::Vec3::new(positions[i], positions[i + 1], positions[i + 2])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,14 +3,8 @@
 
 use glam::Vec3;
 
+use super::shared::{invocations, packed_position};
 use crate::gpu::NormalParams;
-
-const WORKGROUP_SIZE: u32 = 64;
-
-fn position(positions: &[f32], v: u32) -> Vec3 {
-    let i = 3 * v as usize;
-    Vec3::new(positions[i], positions[i + 1], positions[i + 2])
-}
 
 /// Writes the normal of each of the first `params.count` `vertices` into `normals` (packed
 /// x, y, z per mesh vertex).
@@ -21,31 +15,24 @@ pub fn vertex_normals(
     vertices: &[u32],
     normals: &mut [f32],
 ) {
-    let workgroups = params.count.div_ceil(WORKGROUP_SIZE);
-    for workgroup in 0..workgroups {
-        for local in 0..WORKGROUP_SIZE {
-            let i = workgroup * WORKGROUP_SIZE + local;
-            if i >= params.count {
-                continue;
-            }
-            let v = vertices[i as usize];
-            let row = (params.vertex_faces_base + v) as usize;
-            let last = topology[row + 1];
-            let mut sum = Vec3::ZERO;
-            for k in topology[row]..last {
-                let f = topology[k as usize] as usize;
-                let a = position(positions, topology[4 * f]);
-                let b = position(positions, topology[4 * f + 1]);
-                let c = position(positions, topology[4 * f + 2]);
-                sum += (b - a).cross(c - a);
-            }
-            let rcp = 1.0 / sum.dot(sum).sqrt();
-            let n = if rcp.is_finite() && rcp > 0.0 {
-                sum * rcp
-            } else {
-                Vec3::Z
-            };
-            normals[3 * v as usize..3 * v as usize + 3].copy_from_slice(&n.to_array());
+    for i in invocations(params.count) {
+        let v = vertices[i as usize];
+        let row = (params.vertex_faces_base + v) as usize;
+        let last = topology[row + 1];
+        let mut sum = Vec3::ZERO;
+        for k in topology[row]..last {
+            let f = topology[k as usize] as usize;
+            let a = packed_position(positions, topology[4 * f]);
+            let b = packed_position(positions, topology[4 * f + 1]);
+            let c = packed_position(positions, topology[4 * f + 2]);
+            sum += (b - a).cross(c - a);
         }
+        let rcp = 1.0 / sum.dot(sum).sqrt();
+        let n = if rcp.is_finite() && rcp > 0.0 {
+            sum * rcp
+        } else {
+            Vec3::Z
+        };
+        normals[3 * v as usize..3 * v as usize + 3].copy_from_slice(&n.to_array());
     }
 }

@@ -79,18 +79,24 @@ impl GpuKernels {
                     && r.vertices.count == mesh.vertex_count()
                     && r.layer_count == mesh.layer_count() =>
             {
-                if r.version.positions != version.positions {
+                let moved = r.version.positions != version.positions;
+                let attributes = r.version.attributes != version.attributes;
+                if moved {
                     gpu.queue.write_buffer(
                         &r.vertices.positions,
                         0,
                         bytemuck::cast_slice(mesh.positions()),
                     );
-                    gpu.queue
-                        .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
                 }
-                if r.version.attributes != version.attributes {
-                    gpu.queue
-                        .write_buffer(&r.vertices.flags, 0, &flag_words(mesh));
+                if attributes {
+                    gpu.queue.write_buffer(
+                        &r.vertices.flags,
+                        0,
+                        bytemuck::cast_slice(&flag_bits(mesh)),
+                    );
+                }
+                // Normals follow the positions and carry no version of their own.
+                if moved || attributes {
                     gpu.queue
                         .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
                 }
@@ -98,8 +104,8 @@ impl GpuKernels {
             }
             _ => {
                 let layers = mesh.vertex_layers().to_vec();
-                let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
-                let vertices = VertexBuffers::upload(gpu, mesh.positions(), &layers, &flags)?;
+                let vertices =
+                    VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
                 let (offsets, neighbours) = smoothing_neighbours(mesh);
                 gpu.check_binding::<u32>("smoothing neighbours", neighbours.len())?;
                 self.resident = Some(Resident {
@@ -225,9 +231,9 @@ impl GpuKernels {
     }
 }
 
-fn flag_words(mesh: &Mesh) -> Vec<u8> {
-    let words: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
-    bytemuck::cast_slice(&words).to_vec()
+/// The vertex flags as the kernels read them, one `u32` each.
+fn flag_bits(mesh: &Mesh) -> Vec<u32> {
+    mesh.flags().iter().map(|f| f.bits()).collect()
 }
 
 impl StepKernels for GpuKernels {

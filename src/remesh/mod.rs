@@ -17,6 +17,7 @@ use std::time::Instant;
 use glam::Vec3;
 use serde::Serialize;
 
+use crate::collide::Stamps;
 use crate::collide::neighbourhood::ring_vertices;
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::grid::SpatialHash;
@@ -183,6 +184,8 @@ struct Remesher<'a> {
     report: RemeshReport,
     scratch: Vec<u32>,
     near: Vec<NearFace>,
+    /// The vertices a relaxation round may move.
+    movable: Stamps,
 }
 
 impl<'a> Remesher<'a> {
@@ -249,6 +252,7 @@ impl<'a> Remesher<'a> {
             surface,
             scratch: Vec::new(),
             near: Vec::new(),
+            movable: Stamps::default(),
         };
         for v in starting {
             remesher.mark_dirty(v);
@@ -611,19 +615,22 @@ impl<'a> Remesher<'a> {
     /// Tangential relaxation toward the centroid of the one-ring, projected back onto the
     /// surface as it was, for interior region vertices; boundaries stay in place.
     fn relax(&mut self) {
-        let mut movable = vec![false; self.mesh.vertex_count()];
+        // One set for every round, emptied in O(1), rather than a vector over the whole mesh
+        // made anew each round.
+        let mut movable = std::mem::take(&mut self.movable);
+        movable.start(self.mesh.vertex_count());
         let mut live: Vec<u32> = Vec::new();
         for &v in &self.dirty_list {
             if !self.live(v) {
                 continue;
             }
             for u in std::iter::once(v).chain(self.mesh.neighbours(v)) {
-                if self.in_region[u as usize] && !movable[u as usize] {
-                    movable[u as usize] = true;
+                if self.in_region[u as usize] && movable.insert(u as usize) {
                     live.push(u);
                 }
             }
         }
+        self.movable = movable;
         let proposals: Vec<(u32, Vec3)> = live
             .iter()
             .filter(|&&v| !self.mesh.is_boundary_vertex(v))

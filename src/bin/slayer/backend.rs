@@ -30,10 +30,12 @@ impl std::str::FromStr for Backend {
     }
 }
 
-/// A pipeline and the adapter it runs on ("none (CPU)" for the CPU).
+/// A pipeline, the adapter it runs on ("none (CPU)" for the CPU), and which backend that is
+/// (`Cpu` or `Gpu`: what `auto` resolved to).
 pub struct Chosen {
     pub pipeline: CpuPipeline,
     pub adapter: String,
+    pub backend: Backend,
 }
 
 /// The CPU pipeline.
@@ -41,6 +43,7 @@ pub fn cpu(settings: PipelineSettings) -> Chosen {
     Chosen {
         pipeline: CpuPipeline::new(settings),
         adapter: "none (CPU)".into(),
+        backend: Backend::Cpu,
     }
 }
 
@@ -55,31 +58,33 @@ pub fn gpu(settings: PipelineSettings) -> anyhow::Result<Chosen> {
             "--backend gpu: no GPU adapter ({e}); install a Vulkan driver (mesa-vulkan-drivers gives lavapipe) or use --backend cpu"
         )
     })?;
-    let adapter = context.adapter.to_string();
-    Ok(Chosen {
-        pipeline: CpuPipeline::with_kernels(settings, Box::new(GpuKernels::new(context))),
-        adapter,
-    })
+    Ok(on_gpu(context, settings))
 }
 
-/// `cpu`, `gpu` or `auto` (`both` is the bench's business), saying what `auto` chose.
+fn on_gpu(context: GpuContext, settings: PipelineSettings) -> Chosen {
+    Chosen {
+        adapter: context.adapter.to_string(),
+        pipeline: CpuPipeline::with_kernels(settings, Box::new(GpuKernels::new(context))),
+        backend: Backend::Gpu,
+    }
+}
+
+/// `cpu`, `gpu` or `auto`, saying what `auto` chose; `both` runs two pipelines, which only
+/// `slayer bench` does.
 pub fn choose(backend: Backend, settings: PipelineSettings) -> anyhow::Result<Chosen> {
     match backend {
-        Backend::Cpu | Backend::Both => Ok(cpu(settings)),
+        Backend::Cpu => Ok(cpu(settings)),
         Backend::Gpu => gpu(settings),
+        Backend::Both => anyhow::bail!(
+            "--backend both compares the two paths in `slayer bench`; here use cpu, gpu or auto"
+        ),
         Backend::Auto => match GpuContext::new(AdapterChoice {
             allow_software: false,
         }) {
             Ok(context) => {
-                let adapter = context.adapter.to_string();
-                println!("backend auto: the GPU, on {adapter}");
-                Ok(Chosen {
-                    pipeline: CpuPipeline::with_kernels(
-                        settings,
-                        Box::new(GpuKernels::new(context)),
-                    ),
-                    adapter,
-                })
+                let chosen = on_gpu(context, settings);
+                println!("backend auto: the GPU, on {}", chosen.adapter);
+                Ok(chosen)
             }
             Err(_) => {
                 println!("backend auto: the CPU (no hardware GPU; --backend gpu runs on lavapipe)");

@@ -111,7 +111,10 @@ fn bench_scene(
         ..PipelineSettings::default()
     };
     let start = mesh.clone();
-    let mut first = backend::choose(chosen, settings)?;
+    let mut first = match chosen {
+        Backend::Both => backend::cpu(settings),
+        single => backend::choose(single, settings)?,
+    };
     let result = sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut first.pipeline)?;
     report_fallback(&first.pipeline);
     let gpu = if chosen == Backend::Both {
@@ -149,20 +152,17 @@ pub fn sculpt_with_progress(
 }
 
 pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
-    // Open the backend once up front: a missing GPU is an error before any work.
-    let probe = backend::choose(options.backend, PipelineSettings::default())?;
-    let (pipeline_name, adapter) = match options.backend {
-        Backend::Both => (
-            "both".to_string(),
-            backend::gpu(PipelineSettings::default())?.adapter,
-        ),
-        _ => (probe.pipeline.name(), probe.adapter.clone()),
-    };
-    // `auto` has said what it chose; the scenes use that choice without asking again.
-    let resolved = match options.backend {
-        Backend::Auto if pipeline_name == "cpu" => Backend::Cpu,
-        Backend::Auto => Backend::Gpu,
-        other => other,
+    // Open the backend once up front: a missing GPU is an error before any work, and `auto`
+    // says what it chose once; the scenes then use that choice without asking again.
+    let (pipeline_name, adapter, resolved) = match options.backend {
+        Backend::Both => {
+            let gpu = backend::gpu(PipelineSettings::default())?;
+            ("both".to_string(), gpu.adapter, Backend::Both)
+        }
+        other => {
+            let probe = backend::choose(other, PipelineSettings::default())?;
+            (probe.pipeline.name(), probe.adapter, probe.backend)
+        }
     };
     let mut runs = Vec::new();
     for &kind in &options.scenes {

@@ -70,11 +70,8 @@ pub fn run(
     triangles: usize,
     backend: crate::backend::Backend,
 ) -> anyhow::Result<ExitCode> {
-    if backend == crate::backend::Backend::Both {
-        anyhow::bail!(
-            "--backend both compares the two paths in `slayer bench`; demo takes auto, cpu or gpu"
-        );
-    }
+    // The backend first: a wrong choice fails before minutes of work.
+    let mut pipeline = crate::backend::choose(backend, PipelineSettings::default())?.pipeline;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let spec = SceneSpec {
         triangles,
@@ -126,7 +123,6 @@ pub fn run(
         None => None,
     };
 
-    let mut pipeline = crate::backend::choose(backend, PipelineSettings::default())?.pipeline;
     println!(
         "  sculpting {} strokes ({}) on the {} backend -> {}",
         strokes.len(),

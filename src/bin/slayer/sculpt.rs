@@ -16,11 +16,6 @@ pub fn run(
     remeshing: Remeshing,
     backend: crate::backend::Backend,
 ) -> anyhow::Result<ExitCode> {
-    if backend == crate::backend::Backend::Both {
-        anyhow::bail!(
-            "--backend both compares the two paths in `slayer bench`; sculpt takes cpu, gpu or auto"
-        );
-    }
     slayer::io::Format::of_path(output)?;
     let mut mesh = slayer::io::read_mesh(input)?;
     let text =
