@@ -383,8 +383,9 @@ fn pairs(selection: &[SelectedVertex]) -> Vec<(u32, f32)> {
     selection.iter().map(|s| (s.vertex, s.weight)).collect()
 }
 
-/// The CPU mirror chain: hash table, then `select`.
+/// The CPU mirror chain: hash table of the `hashed` positions, then `select` at `positions`.
 fn cpu_select(
+    hashed: &[Vec3],
     positions: &[Vec3],
     layers: &[u32],
     flags: &[u32],
@@ -393,9 +394,15 @@ fn cpu_select(
     brush: &BrushSphere,
 ) -> Vec<SelectedVertex> {
     let table_size = table_size_for(positions.len());
-    let table = slayer::cpu::hash_table(positions, flags, inv_cell_size, table_size);
+    let table = slayer::cpu::hash_table(hashed, flags, inv_cell_size, table_size);
+    let drift = hashed
+        .iter()
+        .zip(positions)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
     let params = select_params(
         brush,
+        drift,
         inv_cell_size,
         table_size,
         positions.len(),
@@ -409,6 +416,7 @@ fn cpu_select(
         active_layers: &active,
         offsets: &table.offsets,
         entries: &table.entries,
+        hashed: bytemuck::cast_slice(hashed),
     };
     let mut selected = vec![SelectedVertex::default(); positions.len()];
     let mut count = 0u32;
@@ -442,9 +450,13 @@ fn select_matches_cpu_mirror_at_awkward_sizes() {
             falloff: FALLOFFS[i % FALLOFFS.len()],
         };
         let inv = 1.0 / cell_size;
-        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
-        let actual =
-            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        let expected = cpu_select(
+            &positions, &positions, &layers, &flags, &active, inv, &brush,
+        );
+        let actual = run_select(
+            &gpu, &positions, &positions, &layers, &flags, &active, inv, &brush,
+        )
+        .expect("GPU run");
         assert!(
             size < 64 || !expected.is_empty(),
             "size {size} selects nothing"
@@ -475,11 +487,22 @@ fn select_scans_vertices_for_huge_brushes_and_folds_wide_dispatches() {
             radius,
             falloff: Falloff::Smooth,
         };
-        let params = select_params(&brush, inv, table_size_for(positions.len()), 100_003, 3);
+        let params = select_params(
+            &brush,
+            0.0,
+            inv,
+            table_size_for(positions.len()),
+            100_003,
+            3,
+        );
         assert_eq!(params.scan_vertices != 0, scans, "radius {radius}");
-        let expected = cpu_select(&positions, &layers, &flags, &active, inv, &brush);
-        let actual =
-            run_select(&gpu, &positions, &layers, &flags, &active, inv, &brush).expect("GPU run");
+        let expected = cpu_select(
+            &positions, &positions, &layers, &flags, &active, inv, &brush,
+        );
+        let actual = run_select(
+            &gpu, &positions, &positions, &layers, &flags, &active, inv, &brush,
+        )
+        .expect("GPU run");
         assert!(expected.len() > 1000);
         assert_same_selection(
             &format!("radius {radius}"),
@@ -540,6 +563,7 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         assert!(reference.len() > 50);
         let mirror = cpu_select(
             mesh.positions(),
+            mesh.positions(),
             &layers,
             &flags,
             &active,
@@ -557,6 +581,7 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         let actual = run_select(
             &gpu,
             mesh.positions(),
+            mesh.positions(),
             &layers,
             &flags,
             &active,
@@ -573,6 +598,69 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         ));
     }
     eprintln!("select: largest weight difference vs the CPU pipeline {worst:e}");
+}
+
+#[test]
+fn select_finds_vertices_that_moved_since_the_table_was_built() {
+    // A backend keeps its table while vertices drift (up to a few cells here): the selection
+    // at the current positions must be exactly the brute-force one, on the mirror and the GPU.
+    let gpu = gpu();
+    let active = [true, false, true];
+    let cell_size = 0.25f32;
+    let mut worst = 0.0f32;
+    for (i, &size) in SIZES.iter().enumerate() {
+        let extent = 0.5 * cell_size * (size as f32).cbrt().max(1.0);
+        let (hashed, layers, flags) = random_vertices(size, 700 + 3 * i as u64, extent);
+        let nudges = random_positions(size, 701 + 3 * i as u64, 1.0);
+        // Every third vertex moves, some by up to three cells.
+        let positions: Vec<Vec3> = hashed
+            .iter()
+            .zip(&nudges)
+            .enumerate()
+            .map(|(v, (p, n))| if v % 3 == 0 { *p + *n * 0.75 } else { *p })
+            .collect();
+        let brush = BrushSphere {
+            center: positions.first().copied().unwrap_or(Vec3::ZERO),
+            radius: 0.6 * extent + 0.3,
+            falloff: FALLOFFS[i % FALLOFFS.len()],
+        };
+        let inv = 1.0 / cell_size;
+        let brute: Vec<(u32, f32)> = (0..size as u32)
+            .filter(|&v| {
+                let f = flags[v as usize];
+                let l = layers[v as usize] as usize;
+                f & (VertexFlags::MASKED | VertexFlags::DEAD).bits() == 0
+                    && active[l]
+                    && positions[v as usize].distance(brush.center) <= brush.radius
+            })
+            .map(|v| {
+                let t = positions[v as usize].distance(brush.center) / brush.radius;
+                (v, brush.falloff.weight(t))
+            })
+            .filter(|&(_, w)| w > 0.0)
+            .collect();
+        let expected = cpu_select(&hashed, &positions, &layers, &flags, &active, inv, &brush);
+        let actual = run_select(
+            &gpu, &hashed, &positions, &layers, &flags, &active, inv, &brush,
+        )
+        .expect("GPU run");
+        let label = format!("size {size}, drifted");
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&expected),
+            &brute,
+            &positions,
+            &brush,
+        ));
+        worst = worst.max(assert_same_selection(
+            &label,
+            &pairs(&actual),
+            &pairs(&expected),
+            &positions,
+            &brush,
+        ));
+    }
+    eprintln!("select after drift: largest weight difference {worst:e}");
 }
 
 /// Deformation targets may differ by this share of the brush radius: the shader's sin/cos,
@@ -837,7 +925,7 @@ fn cpu_proximity(
     let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
     let table = slayer::cpu::hash_table(mesh.positions(), &flags, params.inv_cell_size, table_size);
     let flat: Vec<f32> = query.current.iter().flat_map(|p| p.to_array()).collect();
-    let mut pulled = vec![slayer::gpu::PulledVertex::default(); query.selection.len()];
+    let mut pulls = vec![0u32; query.selection.len()];
     slayer::cpu::proximity(
         &params,
         &slayer::cpu::ProximityInputs {
@@ -849,9 +937,9 @@ fn cpu_proximity(
             rings: &rings,
             marks: query.marks.unwrap_or(&[]),
         },
-        &mut pulled,
+        &mut pulls,
     );
-    pulled
+    slayer::gpu::verdicts(&moving, &flat, &pulls)
 }
 
 /// `pipeline::step::pull_back` (the CPU backend's first pass) for the same step.
@@ -1078,4 +1166,203 @@ fn vertex_normals_match_cpu_mirror_and_the_mesh() {
         worst = worst.max(off);
     }
     eprintln!("vertex_normals: largest deviation GPU vs mirror {worst:e}");
+}
+
+/// Random moving entries over distinct vertices of `vertex_count`, with targets, verdicts (about
+/// half pulled) and marks, for `apply_moves`.
+#[allow(clippy::type_complexity)]
+fn random_moves(
+    count: usize,
+    vertex_count: usize,
+    seed: u64,
+) -> (Vec<slayer::gpu::MovingVertex>, Vec<Vec3>, Vec<u32>) {
+    let vertices = shuffled((0..vertex_count as u32).collect(), seed);
+    let starts = random_positions(count, seed + 1, 2.0);
+    let targets = random_positions(count, seed + 2, 2.0);
+    // About half pulled back, by random amounts (65536 − 65536·t, t in [0, 1)).
+    let amounts = random_u32s(count, seed + 3, 65536);
+    let coins = random_u32s(count, seed + 4, 2);
+    let moving = (0..count)
+        .map(|i| slayer::gpu::MovingVertex {
+            start: starts[i].to_array(),
+            vertex: vertices[i],
+            layer: 0,
+            ring_start: 0,
+            ring_end: 0,
+            _pad: 0,
+        })
+        .collect();
+    let pulls = (0..count).map(|i| coins[i] * (amounts[i] + 1)).collect();
+    (moving, targets, pulls)
+}
+
+#[test]
+fn apply_moves_matches_cpu_mirror_in_every_mode() {
+    use slayer::gpu::{ApplyMode, ApplyParams, run_apply_moves};
+    let gpu = gpu();
+    for (i, &count) in SIZES.iter().enumerate() {
+        let vertex_count = count + count / 2 + 1;
+        let (moving, targets, pulls) = random_moves(count, vertex_count, 900 + i as u64);
+        let positions = random_positions(vertex_count, 950 + i as u64, 2.0);
+        let marks = random_u32s(vertex_count, 960 + i as u64, 2);
+        for mode in [
+            ApplyMode::Place,
+            ApplyMode::Pull,
+            ApplyMode::PullLast,
+            ApplyMode::Gather,
+        ] {
+            let actual = run_apply_moves(&gpu, mode, &moving, &targets, &pulls, &positions, &marks)
+                .expect("GPU run");
+            let mut mirror_pulls = pulls.clone();
+            let mut flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+            let mut mirror_marks = marks.clone();
+            let mut next_count = 0;
+            let mut finals = vec![0.0f32; 3 * count];
+            let target_words: Vec<f32> = targets.iter().flat_map(|p| p.to_array()).collect();
+            slayer::cpu::apply_moves(
+                &ApplyParams::new(count, mode),
+                &mut slayer::cpu::ApplyBuffers {
+                    moving: &moving,
+                    targets: &target_words,
+                    pulls: &mut mirror_pulls,
+                    positions: &mut flat,
+                    marks: &mut mirror_marks,
+                    next_count: &mut next_count,
+                    finals: &mut finals,
+                },
+            );
+            let label = format!("{mode:?} over {count} entries");
+            let expected: Vec<Vec3> = bytemuck::cast_slice::<f32, Vec3>(&flat).to_vec();
+            assert_eq!(actual.positions, expected, "{label}: positions");
+            assert_eq!(actual.marks, mirror_marks, "{label}: marks");
+            assert_eq!(actual.pulls, mirror_pulls, "{label}: amounts");
+            assert_eq!(actual.next_count, next_count, "{label}: next count");
+            if mode == ApplyMode::Gather {
+                assert_eq!(
+                    actual.finals,
+                    bytemuck::cast_slice::<f32, Vec3>(&finals).to_vec(),
+                    "{label}: finals"
+                );
+            }
+            // What each mode means, on the mirror: untouched vertices stay, entries move, and
+            // a pull lands where `verdicts` (and `pull_back`) put it.
+            let any_pulled = pulls.iter().any(|&p| p != 0);
+            let flat_before: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+            let verdicts = slayer::gpu::verdicts(&moving, &flat_before, &pulls);
+            for (k, entry) in moving.iter().enumerate() {
+                let v = entry.vertex as usize;
+                let now = expected[v];
+                match mode {
+                    ApplyMode::Place => assert_eq!(now, targets[k]),
+                    ApplyMode::Pull if pulls[k] != 0 => {
+                        assert_eq!(now.to_array(), verdicts[k].position)
+                    }
+                    ApplyMode::PullLast if pulls[k] != 0 => {
+                        assert_eq!(now.to_array(), entry.start)
+                    }
+                    _ => assert_eq!(now, positions[v]),
+                }
+            }
+            let pulls = matches!(mode, ApplyMode::Pull | ApplyMode::PullLast);
+            assert_eq!(next_count != 0, pulls && any_pulled, "{label}");
+        }
+    }
+}
+
+/// The whole Jacobi loop of a step on the GPU (`GpuKernels::clamp`: targets placed, passes
+/// sized by indirect dispatch, finals gathered) against `pipeline::step::clamp_moves`.
+fn check_clamp_loop(scene: ProximityScene) {
+    use slayer::pipeline::StepKernels;
+    let mut kernels = slayer::gpu::GpuKernels::new(gpu());
+    let mesh = &scene.mesh;
+    let grid = SpatialHash::build(mesh, scene.edge).unwrap();
+    let active = vec![true; mesh.layer_count()];
+    let mut sorted = scene.order.clone();
+    sorted.sort_unstable();
+    let mut worst = 0.0f32;
+    for size in [0, 1, 63, 64, 65, 1000, sorted.len()] {
+        let selection: Vec<(u32, f32)> = sorted[..size.min(sorted.len())]
+            .iter()
+            .map(|&v| (v, 1.0))
+            .collect();
+        let targets: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| scene.targets[v as usize])
+            .collect();
+        let before: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| mesh.positions()[v as usize])
+            .collect();
+        let mut moved = mesh.clone();
+        for (&(v, _), q) in selection.iter().zip(&targets) {
+            moved.positions_mut()[v as usize] = *q;
+        }
+        let state = slayer::pipeline::step::StrokeState {
+            grid: Some(&grid),
+            active: &active,
+            parallel: true,
+            collision_distance: 0.5 * scene.edge,
+            ring: 2,
+            max_edge: longest_edge(mesh),
+        };
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        for (i, &(v, _)) in selection.iter().enumerate() {
+            target_of[v as usize] = i as u32;
+        }
+        let mut region = slayer::pipeline::step::Region::default();
+        region.gather(&state, mesh, &selection, &targets, &target_of);
+        let mut on_cpu = mesh.clone();
+        slayer::pipeline::step::clamp_moves(
+            &state,
+            &region,
+            &mut on_cpu,
+            &selection,
+            &targets,
+            &before,
+        );
+        let mut on_gpu = mesh.clone();
+        kernels.clamp(&state, &region, &mut on_gpu, &selection, &targets, &before);
+        assert_eq!(kernels.failure(), None);
+        let clamped = selection
+            .iter()
+            .zip(&targets)
+            .filter(|&(&(v, _), q)| on_cpu.positions()[v as usize] != *q)
+            .count();
+        for (&(v, _), start) in selection.iter().zip(&before) {
+            let (a, b) = (
+                on_gpu.positions()[v as usize],
+                on_cpu.positions()[v as usize],
+            );
+            // Either both moved it back to its start or neither did, and where it ended agrees.
+            assert_eq!(a == *start, b == *start, "{}: vertex {v}", scene.name);
+            worst = worst.max(a.distance(b) / scene.edge);
+        }
+        assert!(
+            worst <= PROXIMITY_TOLERANCE,
+            "{}: {size} entries deviate by {worst} L",
+            scene.name
+        );
+        if size >= 1000 {
+            assert!(
+                clamped * 4 >= size,
+                "{}: only {clamped} clamped",
+                scene.name
+            );
+        }
+        // The GPU copy now holds the step's start again for the next one.
+        let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+        kernels.moved(&on_gpu, &selected, 0.0);
+        kernels.moved(mesh, &selected, 0.0);
+    }
+    eprintln!("{}: clamp loop GPU vs CPU {worst:e} L", scene.name);
+}
+
+#[test]
+fn clamp_loop_matches_the_cpu_pipeline_on_pressed_sheets() {
+    check_clamp_loop(pressed_sheets());
+}
+
+#[test]
+fn clamp_loop_matches_the_cpu_pipeline_on_a_folded_sheet() {
+    check_clamp_loop(folded_sheet());
 }

@@ -10,8 +10,8 @@ use slayer::gpu::shaders::{
     render_source, validate,
 };
 use slayer::gpu::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
-    ProximityParams, PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
+    ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
+    NormalParams, ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
     falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
@@ -183,7 +183,7 @@ fn select_structs_match_naga_layout() {
             blend_n,
             capacity,
             layer_count,
-            _pad0,
+            drift,
             _pad1
         }
     );
@@ -218,7 +218,7 @@ fn select_structs_match_naga_layout() {
 }
 
 /// The value of a `u32` constant declared in a kernel (with its imports), per naga.
-fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
+fn naga_constant(kernel: &str, name: &str) -> naga::Literal {
     let source = kernel_source(kernel).unwrap();
     let (module, _) = validate(kernel, &source).unwrap();
     let (_, constant) = module
@@ -227,8 +227,22 @@ fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
         .find(|(_, c)| c.name.as_deref() == Some(name))
         .unwrap_or_else(|| panic!("{kernel}: no constant {name}"));
     match module.global_expressions[constant.init] {
-        naga::Expression::Literal(naga::Literal::U32(value)) => value,
-        ref other => panic!("{kernel}: {name} is not a u32 literal: {other:?}"),
+        naga::Expression::Literal(literal) => literal,
+        ref other => panic!("{kernel}: {name} is not a literal: {other:?}"),
+    }
+}
+
+fn naga_u32_constant(kernel: &str, name: &str) -> u32 {
+    match naga_constant(kernel, name) {
+        naga::Literal::U32(value) => value,
+        other => panic!("{kernel}: {name} is not a u32: {other:?}"),
+    }
+}
+
+fn naga_f32_constant(kernel: &str, name: &str) -> f32 {
+    match naga_constant(kernel, name) {
+        naga::Literal::F32(value) => value,
+        other => panic!("{kernel}: {name} is not an f32: {other:?}"),
     }
 }
 
@@ -260,6 +274,28 @@ fn wgsl_constants_match_the_host() {
             naga_u32_constant("deform", &name),
             brush_code(kind),
             "{name}"
+        );
+    }
+    for (name, mode) in [
+        ("MODE_PLACE", ApplyMode::Place),
+        ("MODE_PULL", ApplyMode::Pull),
+        ("MODE_PULL_LAST", ApplyMode::PullLast),
+        ("MODE_GATHER", ApplyMode::Gather),
+    ] {
+        assert_eq!(
+            naga_u32_constant("apply_moves", name),
+            mode as u32,
+            "{name}"
+        );
+    }
+    assert_eq!(
+        naga_f32_constant("proximity", "CLAMP_SLACK"),
+        slayer::pipeline::step::CLAMP_SLACK
+    );
+    for kernel in ["proximity", "apply_moves"] {
+        assert_eq!(
+            naga_f32_constant(kernel, "PULL_SCALE"),
+            slayer::cpu::PULL_SCALE
         );
     }
     // One scan workgroup is one block on the host side.
@@ -315,7 +351,9 @@ fn proximity_and_normal_structs_match_naga_layout() {
             table_mask,
             count,
             vertex_faces_base,
-            all_faces
+            all_faces,
+            span,
+            cells_per_entry
         }
     );
     assert_layout!(
@@ -329,7 +367,27 @@ fn proximity_and_normal_structs_match_naga_layout() {
             _pad
         }
     );
-    assert_layout!("proximity", PulledVertex { position, pulled });
+    assert_layout!(
+        "apply_moves",
+        ApplyParams {
+            count,
+            mode,
+            next_invocations,
+            _pad
+        }
+    );
+    assert_layout!(
+        "apply_moves",
+        MovingVertex {
+            start,
+            vertex,
+            layer,
+            ring_start,
+            ring_end,
+            _pad
+        }
+    );
+
     assert_layout!(
         "vertex_normals",
         NormalParams {

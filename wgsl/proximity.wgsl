@@ -6,10 +6,20 @@
 // is bisected for the last safe fraction; the result is the smallest fraction over all faces.
 // Taking a minimum makes the result independent of the order faces are met in, and of meeting
 // a face twice (through two of its vertices, or two cells sharing a bucket).
+//
+// One invocation per (entry, cell of the entry's box): it walks the cell's bucket and the faces
+// of the vertices found, and folds its smallest fraction into the entry's slot of `pulls` with
+// an atomic maximum of the pull-back amount (65536 − 65536·t: the bisection's fractions are
+// multiples of 2⁻¹⁶, so the amount is exact; zero means not pulled). Short invocations keep the
+// GPU busy whatever the reach, and stay far below the loop-iteration cap of Mesa's lavapipe,
+// which counts every loop iteration of an invocation (65535 in all) and silently stops loops
+// past it: one invocation walking a whole box of cells met it and skipped faces.
+// `apply_moves` turns the amounts into positions.
 // CPU mirror: src/cpu/proximity.rs.
 
 #import shared/grid
 #import shared/geom
+#import shared/moves
 
 struct ProximityParams {
     // Collision distance d.
@@ -30,30 +40,15 @@ struct ProximityParams {
     vertex_faces_base: u32,
     // 1: test every face (the first pass); 0: only faces with a vertex marked in `marks`.
     all_faces: u32,
-}
-
-// One entry of the step's selection.
-struct MovingVertex {
-    // Position at the start of the step.
-    start: vec3<f32>,
-    vertex: u32,
-    layer: u32,
-    // The vertex's exclusion ring (itself included) is rings[ring_start..ring_end].
-    ring_start: u32,
-    ring_end: u32,
-    _pad: u32,
-}
-
-// The pass's verdict on one entry.
-struct PulledVertex {
-    // Where the vertex must be: pulled back along its move, or x unchanged.
-    position: vec3<f32>,
-    // 1 when pulled back.
-    pulled: u32,
+    // Cells per entry, from the cell of x − cell_reach: enough for any x (the host sizes it).
+    span: vec3<u32>,
+    cells_per_entry: u32,
 }
 
 // Bisection rounds when clamping a move: 2^-16 of a step (CLAMP_ROUNDS of the CPU).
 const CLAMP_ROUNDS: u32 = 16u;
+// CLAMP_SLACK of src/pipeline/step.rs: 1/1024.
+const CLAMP_SLACK: f32 = 0.0009765625;
 const WORKGROUP_SIZE: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> params: ProximityParams;
@@ -69,7 +64,8 @@ const WORKGROUP_SIZE: u32 = 64u;
 // Per vertex: nonzero when it was pulled back in the last pass, so that its faces changed
 // (the CPU's `changed` marks the faces around exactly those vertices).
 @group(0) @binding(7) var<storage, read> marks: array<u32>;
-@group(0) @binding(8) var<storage, read_write> pulled: array<PulledVertex>;
+// Per entry: the largest pull-back amount found, 65536 − 65536·t; zero when not pulled.
+@group(0) @binding(8) var<storage, read_write> pulls: array<atomic<u32>>;
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -88,49 +84,51 @@ fn touches_ring(entry: MovingVertex, a: u32, b: u32, c: u32) -> bool {
 }
 
 // The last safe fraction of the move against face f, or 1 when f does not constrain it.
+// One exit (no early returns): see `touches_ring` and shared/geom.wgsl.
 fn safe_fraction(entry: MovingVertex, f: u32, x: vec3<f32>) -> f32 {
     let a = topology[4u * f];
     let b = topology[4u * f + 1u];
     let c = topology[4u * f + 2u];
     let layer = topology[4u * f + 3u];
-    if params.all_faces == 0u && (marks[a] | marks[b] | marks[c]) == 0u {
-        return 1.0;
-    }
     let v = entry.vertex;
-    if a == v || b == v || c == v {
-        return 1.0;
-    }
-    // The vertex's own neighbourhood is near by construction, not by collision.
-    if layer == entry.layer && touches_ring(entry, a, b, c) {
-        return 1.0;
-    }
-    let pa = position(a);
-    let pb = position(b);
-    let pc = position(c);
-    let d = params.distance;
-    let here = distance_to_triangle(x, pa, pb, pc);
-    if here >= d {
-        return 1.0;
-    }
-    // Never closer than the collision distance, nor closer than it already was.
-    let start = entry.start;
-    let threshold = min(d, distance_to_triangle(start, pa, pb, pc));
-    if here >= threshold {
-        return 1.0;
-    }
-    // Distance along the move is convex and safe at its start: bisect over the whole move.
-    var lo = 0.0;
-    var hi = 1.0;
-    for (var round = 0u; round < CLAMP_ROUNDS; round++) {
-        let mid = 0.5 * (lo + hi);
-        if distance_to_triangle(start + (x - start) * mid, pa, pb, pc) >= threshold {
-            lo = mid;
-        } else {
-            hi = mid;
+    // Faces the last pass left alone, the vertex's own faces, and its own neighbourhood (near
+    // by construction, not by collision) do not constrain it.
+    let unchanged = params.all_faces == 0u && (marks[a] | marks[b] | marks[c]) == 0u;
+    let own = a == v || b == v || c == v;
+    var t = 1.0;
+    if !unchanged && !own && !(layer == entry.layer && touches_ring(entry, a, b, c)) {
+        let pa = position(a);
+        let pb = position(b);
+        let pc = position(c);
+        let d = params.distance;
+        let here = distance_to_triangle(x, pa, pb, pc);
+        // Never closer than the collision distance, nor closer than it already was, give or
+        // take the slack (a move along the face must not stop on the arithmetic's last bits).
+        let start = entry.start;
+        if here < d {
+            let threshold = min(d, distance_to_triangle(start, pa, pb, pc));
+            if here < threshold - CLAMP_SLACK * d {
+                // Distance along the move is convex and safe at its start: bisect over the
+                // whole move.
+                var lo = 0.0;
+                var hi = 1.0;
+                for (var round = 0u; round < CLAMP_ROUNDS; round++) {
+                    let mid = 0.5 * (lo + hi);
+                    if distance_to_triangle(start + (x - start) * mid, pa, pb, pc) >= threshold {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                t = lo;
+            }
         }
     }
-    return lo;
+    return t;
 }
+
+// Bisection fractions are multiples of 1 / PULL_SCALE.
+const PULL_SCALE: f32 = 65536.0;
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(
@@ -138,37 +136,32 @@ fn main(
     @builtin(num_workgroups) workgroups: vec3<u32>,
 ) {
     let i = flat_index(global_id, workgroups, WORKGROUP_SIZE);
-    if i >= params.count {
+    if i >= params.count * params.cells_per_entry {
         return;
     }
-    let entry = moving[i];
+    let e = i / params.cells_per_entry;
+    let n = i % params.cells_per_entry;
+    let entry = moving[e];
     let x = position(entry.vertex);
     var t = 1.0;
     if any(x != entry.start) {
-        // One flat loop over the box's cells, as `select` walks its box.
         let low = cell_of(x - vec3<f32>(params.cell_reach), params.inv_cell_size);
-        let high = cell_of(x + vec3<f32>(params.cell_reach), params.inv_cell_size);
-        let span = bitcast<vec3<u32>>(high - low) + vec3<u32>(1u);
-        let cells = span.x * span.y * span.z;
-        for (var n = 0u; n < cells; n++) {
-            let step = vec3<u32>(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-            let bucket = hash_cell(low + bitcast<vec3<i32>>(step), params.table_mask);
-            let end = offsets[bucket + 1u];
-            for (var j = offsets[bucket]; j < end; j++) {
-                let u = entries[j];
-                if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
-                    let row = params.vertex_faces_base + u;
-                    let last = topology[row + 1u];
-                    for (var k = topology[row]; k < last; k++) {
-                        t = min(t, safe_fraction(entry, topology[k], x));
-                    }
+        let span = params.span;
+        let step = vec3<u32>(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
+        let bucket = hash_cell(low + bitcast<vec3<i32>>(step), params.table_mask);
+        let end = offsets[bucket + 1u];
+        for (var j = offsets[bucket]; j < end; j++) {
+            let u = entries[j];
+            if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
+                let row = params.vertex_faces_base + u;
+                let last = topology[row + 1u];
+                for (var k = topology[row]; k < last; k++) {
+                    t = min(t, safe_fraction(entry, topology[k], x));
                 }
             }
         }
     }
-    var result = PulledVertex(x, 0u);
     if t < 1.0 {
-        result = PulledVertex(entry.start + (x - entry.start) * t, 1u);
+        atomicMax(&pulls[e], 65536u - u32(t * PULL_SCALE));
     }
-    pulled[i] = result;
 }

@@ -6,8 +6,14 @@
 // vertices filed in that cell (other cells may share the bucket), so the work follows the
 // brush, not the mesh. When the box has more cells than the mesh has vertices (a huge brush),
 // the host sets `scan_vertices` and each invocation tests one vertex instead, as
-// `SpatialHash::for_each_in_box` falls back to a scan. Each vertex lies in one cell, so it is
-// reported at most once; the list's order is the atomics' order.
+// `SpatialHash::for_each_in_box` falls back to a scan. Each vertex is filed in one cell, so it
+// is reported at most once; the list's order is the atomics' order.
+//
+// The table may be older than the positions: a backend rebuilds it only when vertices have
+// drifted far (a rebuild costs a pass over the whole mesh; a step moves a few thousand
+// vertices). Vertices are found in the cell of the position they were filed at (`hashed`),
+// so the box is grown by `drift`, the farthest any vertex has moved since, and the sphere test
+// reads the current position.
 // CPU mirror: src/cpu/select.rs.
 
 #import shared/grid
@@ -30,7 +36,8 @@ struct SelectParams {
     // Room in `selected`; the counter still counts past it, so the host sees an overflow.
     capacity: u32,
     layer_count: u32,
-    _pad0: u32,
+    // How far any vertex may have moved since the table was built (the box includes it).
+    drift: f32,
     _pad1: u32,
 }
 
@@ -46,6 +53,8 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(6) var<storage, read> entries: array<u32>;
 @group(0) @binding(7) var<storage, read_write> selected: array<SelectedVertex>;
 @group(0) @binding(8) var<storage, read_write> selection_count: atomic<u32>;
+// The positions the table was built from (packed x, y, z; may be `positions` itself).
+@group(0) @binding(9) var<storage, read> hashed: array<f32>;
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -94,7 +103,8 @@ fn main(
     let end = offsets[bucket + 1u];
     for (var j = offsets[bucket]; j < end; j++) {
         let v = entries[j];
-        if all(cell_of(position(v), params.inv_cell_size) == cell) {
+        let filed_at = vec3<f32>(hashed[3u * v], hashed[3u * v + 1u], hashed[3u * v + 2u]);
+        if all(cell_of(filed_at, params.inv_cell_size) == cell) {
             consider(v);
         }
     }

@@ -4,6 +4,7 @@
 //! they are the reference every GPU result is compared with. `hash_table` chains the hash-build
 //! mirrors as the GPU host code chains the kernels.
 
+mod apply_moves;
 mod cell_counts;
 mod cell_keys;
 mod deform;
@@ -17,15 +18,16 @@ mod select;
 mod shared;
 mod vertex_normals;
 
+pub use apply_moves::{ApplyBuffers, apply_moves};
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
 pub use deform::{DeformInputs, deform};
 pub use dispatch_args::dispatch_args;
 pub use hash_table::{exclusive_scan, hash_table};
-pub use proximity::{ProximityInputs, proximity};
+pub use proximity::{PULL_SCALE, ProximityInputs, proximity};
 pub use scan::scan;
 pub use scan_add::scan_add;
 pub use scatter::scatter;
 pub use select::{SelectInputs, select};
-pub use shared::falloff_weight;
+pub use shared::{falloff_weight, packed_position};
 pub use vertex_normals::vertex_normals;

@@ -1,16 +1,20 @@
 //! Mirror of `wgsl/proximity.wgsl`: one Jacobi pass of `pipeline::step::pull_back` over the
-//! moving list, with the shader's loops (cells of the box around the tentative position, bucket
-//! entries, each entry's faces) and the same `closest_point_on_triangle`. Faces met twice are
-//! harmless: each entry keeps the minimum safe fraction.
+//! moving list, with the shader's invocations (entry, cell of the box around its tentative
+//! position), loops (bucket entries, each entry's faces) and the same
+//! `closest_point_on_triangle`. Faces met twice are harmless: each entry keeps the largest
+//! pull-back amount, the smallest safe fraction.
 
 use glam::{UVec3, Vec3};
 
 use super::shared::{invocations, packed_position};
 use crate::geom::closest_point_on_triangle;
-use crate::gpu::{MovingVertex, ProximityParams, PulledVertex};
+use crate::gpu::{MovingVertex, ProximityParams};
 use crate::grid::{cell_coordinates, hash_cell};
+use crate::pipeline::step::CLAMP_SLACK;
 
 const CLAMP_ROUNDS: u32 = 16;
+/// Bisection fractions are multiples of 1 / PULL_SCALE.
+pub const PULL_SCALE: f32 = 65536.0;
 /// What the kernel binds besides its parameters and output.
 pub struct ProximityInputs<'a> {
     /// Current packed x, y, z triples.
@@ -78,7 +82,7 @@ fn safe_fraction(
     }
     let start = Vec3::from_array(entry.start);
     let threshold = d.min(distance_to_triangle(start, pa, pb, pc));
-    if here >= threshold {
+    if here >= threshold - CLAMP_SLACK * d {
         return 1.0;
     }
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
@@ -93,52 +97,36 @@ fn safe_fraction(
     lo
 }
 
-/// `pulled[i]` = the verdict on `inputs.moving[i]`, for the first `params.count` entries.
-pub fn proximity(
-    params: &ProximityParams,
-    inputs: &ProximityInputs<'_>,
-    pulled: &mut [PulledVertex],
-) {
+/// Folds into `pulls[e]` the largest pull-back amount (65536 − 65536·t) every invocation
+/// (entry, cell of its box) finds, as the kernel's atomics do; zero where nothing pulls.
+pub fn proximity(params: &ProximityParams, inputs: &ProximityInputs<'_>, pulls: &mut [u32]) {
     let table_size = params.table_mask.wrapping_add(1);
-    for i in invocations(params.count) {
-        let entry = &inputs.moving[i as usize];
+    let span = UVec3::from_array(params.span);
+    for i in invocations(params.count * params.cells_per_entry) {
+        let e = i / params.cells_per_entry;
+        let n = i % params.cells_per_entry;
+        let entry = &inputs.moving[e as usize];
         let x = packed_position(inputs.positions, entry.vertex);
-        let start = Vec3::from_array(entry.start);
         let mut t = 1.0f32;
-        if x != start {
-            let reach = Vec3::splat(params.cell_reach);
-            let low = cell_coordinates(x - reach, params.inv_cell_size);
-            let high = cell_coordinates(x + reach, params.inv_cell_size);
-            let span = (high - low).as_uvec3() + UVec3::ONE;
-            let cells = span.x * span.y * span.z;
-            for n in 0..cells {
-                let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-                let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
-                let end = inputs.offsets[bucket + 1];
-                for j in inputs.offsets[bucket]..end {
-                    let u = inputs.entries[j as usize];
-                    let offset = (packed_position(inputs.positions, u) - x).abs();
-                    if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
-                        let row = (params.vertex_faces_base + u) as usize;
-                        let last = inputs.topology[row + 1];
-                        for k in inputs.topology[row]..last {
-                            let f = inputs.topology[k as usize];
-                            t = t.min(safe_fraction(params, inputs, entry, f, x));
-                        }
+        if x != Vec3::from_array(entry.start) {
+            let low = cell_coordinates(x - Vec3::splat(params.cell_reach), params.inv_cell_size);
+            let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
+            let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
+            for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
+                let u = inputs.entries[j as usize];
+                let offset = (packed_position(inputs.positions, u) - x).abs();
+                if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
+                    let row = (params.vertex_faces_base + u) as usize;
+                    for k in inputs.topology[row]..inputs.topology[row + 1] {
+                        let f = inputs.topology[k as usize];
+                        t = t.min(safe_fraction(params, inputs, entry, f, x));
                     }
                 }
             }
         }
-        pulled[i as usize] = if t < 1.0 {
-            PulledVertex {
-                position: (start + (x - start) * t).to_array(),
-                pulled: 1,
-            }
-        } else {
-            PulledVertex {
-                position: x.to_array(),
-                pulled: 0,
-            }
-        };
+        if t < 1.0 {
+            let amount = 65536 - (t * PULL_SCALE) as u32;
+            pulls[e as usize] = pulls[e as usize].max(amount);
+        }
     }
 }

@@ -18,6 +18,8 @@ pub struct SelectInputs<'a> {
     pub active_layers: &'a [u32],
     pub offsets: &'a [u32],
     pub entries: &'a [u32],
+    /// The packed positions the table was built from (may be `positions`).
+    pub hashed: &'a [f32],
 }
 
 fn consider(
@@ -76,8 +78,7 @@ pub fn select(
         let bucket = hash_cell(cell, params.table_mask + 1) as usize;
         for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
             let v = inputs.entries[j as usize];
-            if cell_coordinates(packed_position(inputs.positions, v), params.inv_cell_size) == cell
-            {
+            if cell_coordinates(packed_position(inputs.hashed, v), params.inv_cell_size) == cell {
                 consider(params, inputs, v, selected, selection_count);
             }
         }

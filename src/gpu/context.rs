@@ -344,6 +344,35 @@ impl GpuContext {
         if invocations == 0 {
             return;
         }
+        let (x, y) = self.dispatch_size(invocations, workgroup_size);
+        self.record_pass(encoder, pipeline, label, resources, |pass| {
+            pass.dispatch_workgroups(x, y, 1)
+        });
+    }
+
+    /// As [`GpuContext::record_dispatch`], with the workgroup counts read by the GPU from
+    /// `args` (three `u32`s an earlier pass wrote, see `dispatch_args`).
+    pub fn record_dispatch_indirect(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        label: &str,
+        resources: &[&wgpu::Buffer],
+        args: &wgpu::Buffer,
+    ) {
+        self.record_pass(encoder, pipeline, label, resources, |pass| {
+            pass.dispatch_workgroups_indirect(args, 0)
+        });
+    }
+
+    fn record_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        label: &str,
+        resources: &[&wgpu::Buffer],
+        dispatch: impl FnOnce(&mut wgpu::ComputePass<'_>),
+    ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
             .iter()
             .enumerate()
@@ -357,14 +386,13 @@ impl GpuContext {
             layout: &pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
-        let (x, y) = self.dispatch_size(invocations, workgroup_size);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(label),
             timestamp_writes: None,
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(x, y, 1);
+        dispatch(&mut pass);
     }
 
     pub fn encoder(&self, label: &str) -> wgpu::CommandEncoder {

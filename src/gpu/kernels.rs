@@ -1,23 +1,53 @@
-//! The GPU's selection and deformation behind the pipeline's [`StepKernels`] seam: the mesh is
-//! uploaded once and kept (positions and normals re-sent when they changed, everything when the
-//! topology did), the hash table is rebuilt on the GPU when positions moved, and each step
-//! selects and deforms there. Collisions, the exact backstop and remeshing stay on the CPU
-//! until the proximity kernel joins (issue 5).
+//! The GPU's side of a brush step behind the pipeline's [`StepKernels`] seam: selection,
+//! deformation and the proximity passes (the collision response's first phase) run as WGSL
+//! kernels over a copy of the mesh that stays on the GPU. The pipeline keeps the loop, the
+//! exact backstop and remeshing on the CPU, and tells the kernels what it changed.
+//!
+//! What stays resident, and when it is refreshed:
+//! - positions, normals: uploaded in full when the mesh changed behind the kernels' back; after
+//!   a step only the rows the pipeline reports (`moved`, `normals_changed`) are sent;
+//! - connectivity (packed topology, smoothing neighbours), layers, flags: when the topology
+//!   (remeshing) or the flags changed;
+//! - the hash table: rebuilt only when the vertices have drifted more than a cell since it was
+//!   built — queries grow their reach by the drift instead (`select`, `proximity`);
+//! - per-step buffers: grown when a step needs more, never reallocated otherwise.
+//!
+//! A step is three submissions, each with one blocking read-back: the selection, the targets,
+//! and the whole Jacobi loop of proximity passes (targets placed, passes sized by the GPU
+//! through indirect dispatch, final positions gathered).
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
-//! adapter's limits) is not fatal: the kernels keep why and finish on the CPU, and the
-//! mesh — which only the CPU writes — is untouched by the failure.
+//! adapter's limits) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
+//! which the CPU writes — is untouched by the failure.
 
 use glam::Vec3;
 
+use super::reusable::{ReusableBuffer, upload_rows};
 use super::{
-    BrushSphere, DeformBuffers, GpuContext, GpuError, GpuHashTable, GpuSelection, SelectedVertex,
-    VertexBuffers, record_deform, record_select, smoothing_neighbours, table_size_for,
+    APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BrushSphere, DeformBuffers,
+    GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, PROXIMITY_WORKGROUP_SIZE,
+    PackedTopology, ProximityBuffers, ProximityParams, SelectedVertex, VertexBuffers,
+    cells_per_entry, check_invocations, indirect_args_buffer, moving_vertices, proximity_reaches,
+    record_apply_moves, record_deform, record_dispatch_args, record_proximity, record_select,
+    smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
 use crate::mesh::{Mesh, MeshVersion};
-use crate::pipeline::step::StrokeState;
+use crate::pipeline::step::{MAX_PASSES, Region, StrokeState, clamp_moves};
 use crate::pipeline::{CpuKernels, StepKernels};
+
+/// The hash table is rebuilt once vertices may have drifted this many cells from where they
+/// were filed: queries grow by the drift, so past a cell or so they walk more buckets than a
+/// rebuild costs.
+const DRIFT_LIMIT_CELLS: f32 = 1.0;
+
+/// The table and the positions it was built from.
+struct Hashed {
+    table: GpuHashTable,
+    positions: wgpu::Buffer,
+    /// How far any vertex may have moved since the build.
+    drift: f32,
+}
 
 /// What lives on the GPU between steps.
 struct Resident {
@@ -27,15 +57,52 @@ struct Resident {
     neighbour_offsets: wgpu::Buffer,
     neighbours: wgpu::Buffer,
     selection: GpuSelection,
-    /// The hash table, for the positions of `table_version`.
-    table: Option<GpuHashTable>,
-    table_version: u64,
+    /// Packed topology words and where the vertex→faces rows start; built when first needed.
+    topology: Option<(wgpu::Buffer, u32)>,
+    /// Per vertex: pulled back in the last proximity pass (zero between steps).
+    marks: wgpu::Buffer,
+    hashed: Option<Hashed>,
     layer_count: usize,
+}
+
+/// Per-step buffers, reused from step to step.
+struct StepBuffers {
+    selected: ReusableBuffer,
+    selection_count: wgpu::Buffer,
+    targets: ReusableBuffer,
+    moving: ReusableBuffer,
+    rings: ReusableBuffer,
+    /// Per entry: the last proximity pass's pull-back amount.
+    pulls: ReusableBuffer,
+    finals: ReusableBuffer,
+    next_count: wgpu::Buffer,
+    pass_args: wgpu::Buffer,
+    apply_args: wgpu::Buffer,
+    readback: ReusableBuffer,
+}
+
+impl StepBuffers {
+    fn new(gpu: &GpuContext) -> StepBuffers {
+        StepBuffers {
+            selected: ReusableBuffer::storage("selected"),
+            selection_count: gpu.output_buffer::<u32>("selection count", 1),
+            targets: ReusableBuffer::storage("targets"),
+            moving: ReusableBuffer::storage("moving"),
+            rings: ReusableBuffer::storage("exclusion rings"),
+            pulls: ReusableBuffer::storage("pull-back amounts"),
+            finals: ReusableBuffer::storage("finals"),
+            next_count: gpu.output_buffer::<u32>("next pass count", 1),
+            pass_args: indirect_args_buffer(gpu, "proximity pass sizes"),
+            apply_args: indirect_args_buffer(gpu, "apply pass sizes"),
+            readback: ReusableBuffer::readback("step readback"),
+        }
+    }
 }
 
 pub struct GpuKernels {
     gpu: GpuContext,
     resident: Option<Resident>,
+    step: StepBuffers,
     /// Set once the GPU failed: why. Everything after runs on the CPU.
     failed: Option<String>,
     /// Test hook: fail as a lost device would after this many more GPU calls.
@@ -45,6 +112,7 @@ pub struct GpuKernels {
 impl GpuKernels {
     pub fn new(gpu: GpuContext) -> GpuKernels {
         GpuKernels {
+            step: StepBuffers::new(&gpu),
             gpu,
             resident: None,
             failed: None,
@@ -79,26 +147,21 @@ impl GpuKernels {
                     && r.vertices.count == mesh.vertex_count()
                     && r.layer_count == mesh.layer_count() =>
             {
-                let moved = r.version.positions != version.positions;
-                let attributes = r.version.attributes != version.attributes;
-                if moved {
-                    gpu.queue.write_buffer(
-                        &r.vertices.positions,
-                        0,
-                        bytemuck::cast_slice(mesh.positions()),
-                    );
+                if r.version.positions != version.positions {
+                    // Moved by something that did not say what: send everything, and file
+                    // the vertices anew (how far they went is unknown).
+                    let positions = bytemuck::cast_slice(mesh.positions());
+                    gpu.queue.write_buffer(&r.vertices.positions, 0, positions);
+                    gpu.queue
+                        .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
+                    r.hashed = None;
                 }
-                if attributes {
+                if r.version.attributes != version.attributes {
                     gpu.queue.write_buffer(
                         &r.vertices.flags,
                         0,
                         bytemuck::cast_slice(&flag_bits(mesh)),
                     );
-                }
-                // Normals follow the positions and carry no version of their own.
-                if moved || attributes {
-                    gpu.queue
-                        .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
                 }
                 r.version = version;
             }
@@ -114,12 +177,55 @@ impl GpuKernels {
                     neighbour_offsets: gpu.storage_buffer("neighbour offsets", &offsets, false),
                     neighbours: gpu.storage_buffer("neighbours", &neighbours, false),
                     selection: GpuSelection::new(gpu, mesh.vertex_count().max(1))?,
-                    table: None,
-                    table_version: u64::MAX,
+                    topology: None,
+                    marks: gpu.output_buffer::<u32>("proximity marks", mesh.vertex_count()),
+                    hashed: None,
                     layer_count: mesh.layer_count(),
                     vertices,
                 });
             }
+        }
+        Ok(())
+    }
+
+    /// Syncs the resident mesh with `mesh` and makes its hash table fresh enough for `cell`
+    /// sized cells (rebuilt when missing or drifted too far).
+    fn prepare(&mut self, mesh: &Mesh, cell: f32) -> Result<(), GpuError> {
+        self.check_injected_failure()?;
+        self.sync(mesh)?;
+        let gpu = &self.gpu;
+        let Some(r) = self.resident.as_mut() else {
+            return Ok(());
+        };
+        let stale = r.hashed.as_ref().is_none_or(|h| {
+            h.drift > DRIFT_LIMIT_CELLS * cell || h.table.inv_cell_size != 1.0 / cell
+        });
+        if stale {
+            let count = r.vertices.count;
+            let positions = gpu.output_buffer::<Vec3>("hashed positions", count);
+            let mut encoder = gpu.encoder("hash table");
+            encoder.copy_buffer_to_buffer(
+                &r.vertices.positions,
+                0,
+                &positions,
+                0,
+                (count * std::mem::size_of::<Vec3>()) as u64,
+            );
+            let table = GpuHashTable::record(
+                gpu,
+                &mut encoder,
+                &positions,
+                &r.vertices.flags,
+                count,
+                1.0 / cell,
+                table_size_for(count),
+            )?;
+            gpu.queue.submit([encoder.finish()]);
+            r.hashed = Some(Hashed {
+                table,
+                positions,
+                drift: 0.0,
+            });
         }
         Ok(())
     }
@@ -130,38 +236,29 @@ impl GpuKernels {
         mesh: &Mesh,
         dab: &Dab,
     ) -> Result<Vec<(u32, f32)>, GpuError> {
-        self.check_injected_failure()?;
-        self.sync(mesh)?;
+        let cell = cell_size(state);
+        let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
+        self.prepare(mesh, cell)?;
         let gpu = &self.gpu;
         let Some(r) = self.resident.as_mut() else {
             return Ok(Vec::new());
         };
-        let cell = state.grid.map_or(state.max_edge, |g| g.cell_size());
-        let mut encoder = gpu.encoder("select");
-        if r.table.is_none() || r.table_version != r.version.positions {
-            r.table = Some(GpuHashTable::record(
-                gpu,
-                &mut encoder,
-                &r.vertices.positions,
-                &r.vertices.flags,
-                r.vertices.count,
-                1.0 / cell,
-                table_size_for(r.vertices.count),
-            )?);
-            r.table_version = r.version.positions;
-        }
-        let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
-        let active = gpu.storage_buffer("active layers", &active, false);
-        let Some(table) = r.table.as_ref() else {
+        let Some(hashed) = r.hashed.as_ref() else {
             return Ok(Vec::new());
         };
+        let active = gpu.storage_buffer("active layers", &active, false);
+        let mut encoder = gpu.encoder("select");
         record_select(
             gpu,
             &mut encoder,
             &r.vertices,
             &active,
             state.active.len(),
-            table,
+            &HashedVertices {
+                table: &hashed.table,
+                positions: &hashed.positions,
+                drift: hashed.drift,
+            },
             &BrushSphere {
                 center: dab.frame.center,
                 radius: dab.brush.radius,
@@ -184,26 +281,31 @@ impl GpuKernels {
 
     fn gpu_deform(
         &mut self,
+        state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
         selection: &[(u32, f32)],
     ) -> Result<Vec<Vec3>, GpuError> {
-        self.check_injected_failure()?;
-        self.sync(mesh)?;
         if selection.is_empty() {
             return Ok(Vec::new());
         }
-        let gpu = &self.gpu;
-        let Some(r) = self.resident.as_ref() else {
+        self.prepare(mesh, cell_size(state))?;
+        let (gpu, step) = (&self.gpu, &mut self.step);
+        let Some(r) = self.resident.as_mut() else {
             return Ok(Vec::new());
         };
         let entries: Vec<SelectedVertex> = selection
             .iter()
             .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
             .collect();
-        let selected = gpu.storage_buffer("selected", &entries, false);
-        let count = gpu.storage_buffer("selection count", &[entries.len() as u32], false);
-        let targets = gpu.output_buffer::<Vec3>("targets", entries.len());
+        step.selected.upload(gpu, &entries)?;
+        gpu.queue.write_buffer(
+            &step.selection_count,
+            0,
+            bytemuck::bytes_of(&(entries.len() as u32)),
+        );
+        let bytes = (entries.len() * std::mem::size_of::<Vec3>()) as u64;
+        step.targets.reserve(gpu, bytes)?;
         let mut encoder = gpu.encoder("deform");
         record_deform(
             gpu,
@@ -211,17 +313,194 @@ impl GpuKernels {
             &DeformBuffers {
                 positions: &r.vertices.positions,
                 normals: &r.normals,
-                selected: &selected,
-                selection_count: &count,
+                selected: step.selected.buffer(),
+                selection_count: &step.selection_count,
                 neighbour_offsets: &r.neighbour_offsets,
                 neighbours: &r.neighbours,
             },
             dab,
             entries.len(),
-            &targets,
+            step.targets.buffer(),
         )?;
-        gpu.queue.submit([encoder.finish()]);
-        gpu.read_buffer::<Vec3>(&targets, entries.len())
+        read_back(
+            gpu,
+            &mut step.readback,
+            encoder,
+            step.targets.buffer(),
+            bytes,
+        )
+    }
+
+    /// The proximity passes of one step on the GPU, as [`clamp_moves`] runs them: targets
+    /// placed, a first pass against every face, then passes against the faces pulled-back
+    /// vertices moved until one pulls nothing (the GPU sizes each pass from the last), the last
+    /// sending what still collides back to its start. Returns the final positions.
+    fn gpu_clamp(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        selection: &[(u32, f32)],
+        targets: &[Vec3],
+        before: &[Vec3],
+    ) -> Result<Vec<Vec3>, GpuError> {
+        if selection.is_empty() {
+            return Ok(Vec::new());
+        }
+        self.prepare(mesh, cell_size(state))?;
+        let (gpu, step) = (&self.gpu, &mut self.step);
+        let Some(r) = self.resident.as_mut() else {
+            return Ok(Vec::new());
+        };
+        if r.topology.is_none() {
+            let packed = PackedTopology::of(mesh);
+            r.topology = Some((packed.upload(gpu)?, packed.vertex_faces_base));
+        }
+        let (Some((topology, vertex_faces_base)), Some(hashed)) = (&r.topology, &r.hashed) else {
+            return Ok(Vec::new());
+        };
+        let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+        let (moving, rings) = moving_vertices(mesh, &vertices, before, state.ring);
+        let count = moving.len();
+        step.moving.upload(gpu, &moving)?;
+        step.rings.upload(gpu, &rings)?;
+        step.targets.upload(gpu, targets)?;
+        // Zeroed: every pass folds its amounts into zeros (`apply_moves` consumes them).
+        step.pulls.upload(gpu, &vec![0u32; count])?;
+        let bytes = (count * std::mem::size_of::<Vec3>()) as u64;
+        step.finals.reserve(gpu, bytes)?;
+
+        let step_move = before
+            .iter()
+            .zip(targets)
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0f32, f32::max);
+        let (cell_reach, vertex_reach) = proximity_reaches(
+            state.collision_distance,
+            state.max_edge,
+            hashed.drift + step_move,
+        );
+        let inv_cell_size = hashed.table.inv_cell_size;
+        let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
+        let params = |all_faces: bool| ProximityParams {
+            distance: state.collision_distance,
+            cell_reach,
+            vertex_reach,
+            inv_cell_size,
+            table_mask: hashed.table.table_size - 1,
+            count: count as u32,
+            vertex_faces_base: *vertex_faces_base,
+            all_faces: all_faces as u32,
+            span,
+            cells_per_entry: cells,
+        };
+        check_invocations(&params(true))?;
+        let invocations = count * cells as usize;
+        let proximity = ProximityBuffers {
+            positions: &r.vertices.positions,
+            offsets: &hashed.table.offsets,
+            entries: &hashed.table.entries,
+            topology,
+            moving: step.moving.buffer(),
+            rings: step.rings.buffer(),
+            marks: &r.marks,
+        };
+        let apply = ApplyMovesBuffers {
+            moving: step.moving.buffer(),
+            targets: step.targets.buffer(),
+            pulls: step.pulls.buffer(),
+            positions: &r.vertices.positions,
+            marks: &r.marks,
+            next_count: &step.next_count,
+            finals: step.finals.buffer(),
+        };
+        let pulls = step.pulls.buffer();
+        let apply_params = |mode| ApplyParams {
+            next_invocations: invocations as u32,
+            ..ApplyParams::new(count, mode)
+        };
+        let mut encoder = gpu.encoder("clamp");
+        record_apply_moves(
+            gpu,
+            &mut encoder,
+            &apply,
+            &ApplyParams::new(count, ApplyMode::Place),
+            None,
+        )?;
+        for pass in 0..MAX_PASSES {
+            // The first pass is sized by the host; later ones by the pass before, so that
+            // they shrink to nothing once a pass pulls nothing back.
+            let (sized, apply_sized) = if pass > 0 {
+                (Some(&step.pass_args), Some(&step.apply_args))
+            } else {
+                (None, None)
+            };
+            record_proximity(
+                gpu,
+                &mut encoder,
+                &proximity,
+                &params(pass == 0),
+                pulls,
+                sized,
+            )?;
+            encoder.clear_buffer(&step.next_count, 0, None);
+            let mode = if pass + 1 == MAX_PASSES {
+                ApplyMode::PullLast
+            } else {
+                ApplyMode::Pull
+            };
+            record_apply_moves(gpu, &mut encoder, &apply, &apply_params(mode), apply_sized)?;
+            // Both sizes from the one count: all invocations, or none after a quiet pass.
+            record_dispatch_args(
+                gpu,
+                &mut encoder,
+                &step.next_count,
+                invocations,
+                PROXIMITY_WORKGROUP_SIZE,
+                &step.pass_args,
+            )?;
+            record_dispatch_args(
+                gpu,
+                &mut encoder,
+                &step.next_count,
+                count,
+                APPLY_WORKGROUP_SIZE,
+                &step.apply_args,
+            )?;
+        }
+        record_apply_moves(
+            gpu,
+            &mut encoder,
+            &apply,
+            &ApplyParams::new(count, ApplyMode::Gather),
+            None,
+        )?;
+        read_back(
+            gpu,
+            &mut step.readback,
+            encoder,
+            step.finals.buffer(),
+            bytes,
+        )
+    }
+
+    /// Sends the rows the pipeline changed, and notes how far they may have drifted.
+    fn gpu_moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {
+        let Some(r) = self.resident.as_mut() else {
+            return;
+        };
+        let mut rows = vertices.to_vec();
+        rows.sort_unstable();
+        upload_rows(&self.gpu, &r.vertices.positions, mesh.positions(), &rows);
+        if let Some(h) = r.hashed.as_mut() {
+            h.drift += max_move;
+        }
+        r.version.positions = mesh.version().positions;
+    }
+
+    fn gpu_normals_changed(&mut self, mesh: &Mesh, vertices: &[u32]) {
+        if let Some(r) = self.resident.as_ref() {
+            upload_rows(&self.gpu, &r.normals, mesh.normals(), vertices);
+        }
     }
 
     /// Gives the GPU up for good, keeping why (the pipeline reports it).
@@ -229,6 +508,26 @@ impl GpuKernels {
         self.failed = Some(error.to_string());
         self.resident = None;
     }
+}
+
+/// The cell size the pipeline's grid uses (the table is built with the same).
+fn cell_size(state: &StrokeState<'_>) -> f32 {
+    state.grid.map_or(state.max_edge, |g| g.cell_size())
+}
+
+/// Submits `encoder` with a copy of `bytes` of `source` into `staging`, and reads them back.
+fn read_back<T: bytemuck::Pod>(
+    gpu: &GpuContext,
+    staging: &mut ReusableBuffer,
+    mut encoder: wgpu::CommandEncoder,
+    source: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<T>, GpuError> {
+    staging.reserve(gpu, bytes)?;
+    encoder.copy_buffer_to_buffer(source, 0, staging.buffer(), 0, bytes);
+    gpu.queue.submit([encoder.finish()]);
+    let data = gpu.map_read(staging.buffer())?;
+    Ok(bytemuck::pod_collect_to_vec(&data[..bytes as usize]))
 }
 
 /// The vertex flags as the kernels read them, one `u32` each.
@@ -263,11 +562,48 @@ impl StepKernels for GpuKernels {
         selection: &[(u32, f32)],
     ) -> Vec<Vec3> {
         if self.failed.is_none() {
-            match self.gpu_deform(mesh, dab, selection) {
+            match self.gpu_deform(state, mesh, dab, selection) {
                 Ok(targets) => return targets,
                 Err(error) => self.give_up(error),
             }
         }
         CpuKernels.deform(state, mesh, dab, selection)
+    }
+
+    fn clamp(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &Region,
+        mesh: &mut Mesh,
+        selection: &[(u32, f32)],
+        targets: &[Vec3],
+        before: &[Vec3],
+    ) {
+        if self.failed.is_none() {
+            let result = self.gpu_clamp(state, mesh, selection, targets, before);
+            match result {
+                Ok(finals) => {
+                    let positions = mesh.positions_mut();
+                    for (&(v, _), p) in selection.iter().zip(finals) {
+                        positions[v as usize] = p;
+                    }
+                    return;
+                }
+                Err(error) => self.give_up(error),
+            }
+        }
+        clamp_moves(state, region, mesh, selection, targets, before);
+    }
+
+    fn moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {
+        if self.failed.is_none() {
+            self.gpu_moved(mesh, vertices, max_move);
+        }
+    }
+
+    fn normals_changed(&mut self, mesh: &Mesh, vertices: &[u32]) {
+        if self.failed.is_none() {
+            self.gpu_normals_changed(mesh, vertices);
+        }
     }
 }

@@ -55,7 +55,8 @@ pub struct SelectParams {
     pub blend_n: u32,
     pub capacity: u32,
     pub layer_count: u32,
-    pub _pad0: u32,
+    /// How far any vertex may have moved since the table was built.
+    pub drift: f32,
     pub _pad1: u32,
 }
 
@@ -114,9 +115,50 @@ pub struct ProximityParams {
     pub vertex_faces_base: u32,
     /// 1 to test every face, 0 to test only faces with a marked vertex.
     pub all_faces: u32,
+    /// Cells searched per entry (x, y, z), from the cell of x − `cell_reach`.
+    pub span: [u32; 3],
+    pub cells_per_entry: u32,
 }
 
-/// `MovingVertex` in `wgsl/proximity.wgsl`: one entry of a step's selection.
+/// `ApplyParams` in `wgsl/apply_moves.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ApplyParams {
+    /// Entries in the moving list.
+    pub count: u32,
+    /// One of [`ApplyMode`]'s codes.
+    pub mode: u32,
+    /// What a pull stores as the next proximity pass's invocation count.
+    pub next_invocations: u32,
+    pub _pad: u32,
+}
+
+/// The `MODE_*` codes of `wgsl/apply_moves.wgsl`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ApplyMode {
+    /// Every entry to its brush target.
+    Place = 0,
+    /// Pulled entries to where the pass pulled them, marked.
+    Pull = 1,
+    /// Pulled entries back to their start (the last pass).
+    PullLast = 2,
+    /// Final positions out, marks cleared.
+    Gather = 3,
+}
+
+impl ApplyParams {
+    pub fn new(count: usize, mode: ApplyMode) -> Self {
+        ApplyParams {
+            count: count as u32,
+            mode: mode as u32,
+            next_invocations: count as u32,
+            _pad: 0,
+        }
+    }
+}
+
+/// `MovingVertex` in `wgsl/shared/moves.wgsl`: one entry of a step's selection.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
 pub struct MovingVertex {
@@ -130,7 +172,8 @@ pub struct MovingVertex {
     pub _pad: u32,
 }
 
-/// `PulledVertex` in `wgsl/proximity.wgsl`: one entry's verdict.
+/// One entry's verdict after a proximity pass, on the host (the kernel keeps pull-back amounts;
+/// [`crate::gpu::verdicts`] turns them into these).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
 pub struct PulledVertex {

@@ -1,6 +1,7 @@
 //! The GPU path: adapter choice, shader loading and the compute kernels' host side (DESIGN §6).
 //! Each kernel in `wgsl/` has a CPU mirror of the same name in [`crate::cpu`].
 
+mod apply_moves;
 mod cell_keys;
 mod context;
 mod deform;
@@ -9,6 +10,7 @@ mod hash_table;
 mod kernels;
 mod layout;
 mod proximity;
+mod reusable;
 mod scan;
 mod select;
 pub mod shaders;
@@ -16,6 +18,9 @@ mod topology;
 mod vertex_normals;
 mod vertices;
 
+pub use apply_moves::{
+    APPLY_WORKGROUP_SIZE, AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves,
+};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adapters};
 pub use deform::{
@@ -27,16 +32,18 @@ pub use hash_table::{
 };
 pub use kernels::GpuKernels;
 pub use layout::{
-    CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex, NormalParams,
-    ProximityParams, PulledVertex, SelectParams, SelectedVertex,
+    ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
+    NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
 pub use proximity::{
-    ProximityBuffers, ProximityQuery, moving_vertices, proximity_params, proximity_reaches,
-    record_proximity, run_proximity,
+    PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,
+    moving_vertices, proximity_params, proximity_reaches, record_proximity, run_proximity,
+    verdicts,
 };
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
-    BrushSphere, GpuSelection, falloff_code, record_select, run_select, select_params,
+    BrushSphere, GpuSelection, HashedVertices, falloff_code, record_select, run_select,
+    select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology};
 pub use vertex_normals::{record_vertex_normals, run_vertex_normals};

@@ -1,5 +1,7 @@
 //! Host side of `wgsl/proximity.wgsl`: one Jacobi pass of vertex–triangle proximity and
-//! clamping over a step's selection, as `pipeline::step::pull_back` does it on the CPU.
+//! clamping over a step's selection, as `pipeline::step::pull_back` does it on the CPU. The
+//! kernel leaves a pull-back amount per entry; [`verdicts`] turns amounts into positions as
+//! `apply_moves` does on the GPU.
 //!
 //! What a GPU backend keeps between passes: the moving list and rings (built once per step on
 //! the CPU: rings are connectivity, which only remeshing changes), the per-vertex marks (a
@@ -15,7 +17,7 @@ use super::{
 use crate::collide::neighbourhood::ring_vertices;
 use crate::mesh::Mesh;
 
-const WORKGROUP_SIZE: u32 = 64;
+pub const PROXIMITY_WORKGROUP_SIZE: u32 = 64;
 
 /// Margin on the broad phase's reaches so that rounding never drops a face exact arithmetic
 /// keeps; extra candidates cost time, never results.
@@ -69,6 +71,38 @@ pub fn proximity_reaches(distance: f32, max_edge: f32, max_move: f32) -> (f32, f
     )
 }
 
+/// Invocations per entry and their box of cells (x, y, z) for a search `cell_reach` around
+/// the tentative position, with cells of `1 / inv_cell_size`: enough for any position.
+pub fn cells_per_entry(cell_reach: f32, inv_cell_size: f32) -> ([u32; 3], u32) {
+    let side = (2.0 * cell_reach * inv_cell_size).floor() as u32 + 2;
+    ([side; 3], side * side * side)
+}
+
+/// The pulled-back position of each entry from the amounts a pass left (65536 − 65536·t, zero
+/// when not pulled), `positions` the packed positions the pass saw: as `apply_moves` computes
+/// them, and `pull_back` (`start + (x − start)·t`).
+pub fn verdicts(moving: &[MovingVertex], positions: &[f32], pulls: &[u32]) -> Vec<PulledVertex> {
+    moving
+        .iter()
+        .zip(pulls)
+        .map(|(entry, &pull)| {
+            let x = crate::cpu::packed_position(positions, entry.vertex);
+            if pull == 0 {
+                return PulledVertex {
+                    position: x.to_array(),
+                    pulled: 0,
+                };
+            }
+            let start = Vec3::from_array(entry.start);
+            let t = (65536 - pull) as f32 / crate::cpu::PULL_SCALE;
+            PulledVertex {
+                position: (start + (x - start) * t).to_array(),
+                pulled: 1,
+            }
+        })
+        .collect()
+}
+
 /// Buffers `proximity` binds besides its parameters and output.
 pub struct ProximityBuffers<'a> {
     /// Current packed positions (targets written in).
@@ -84,34 +118,59 @@ pub struct ProximityBuffers<'a> {
     pub marks: &'a wgpu::Buffer,
 }
 
-/// Records one pass writing `pulled[i]` for each of the `params.count` moving entries.
+/// Records one pass folding into `pulls[i]` (zero beforehand) the pull-back amount of each of
+/// the `params.count` moving entries; `params.count · params.cells_per_entry` invocations,
+/// sized on the host, or by the GPU from `indirect` (three workgroup counts) when given.
 pub fn record_proximity(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     inputs: &ProximityBuffers<'_>,
     params: &ProximityParams,
-    pulled: &wgpu::Buffer,
+    pulls: &wgpu::Buffer,
+    indirect: Option<&wgpu::Buffer>,
 ) -> Result<(), GpuError> {
     let pipeline = gpu.compute_pipeline("proximity")?;
     let uniform = gpu.uniform_buffer("proximity params", params);
-    gpu.record_dispatch(
-        encoder,
-        &pipeline,
-        "proximity",
-        &[
-            &uniform,
-            inputs.positions,
-            inputs.offsets,
-            inputs.entries,
-            inputs.topology,
-            inputs.moving,
-            inputs.rings,
-            inputs.marks,
-            pulled,
-        ],
-        params.count as usize,
-        WORKGROUP_SIZE,
-    );
+    let resources = [
+        &uniform,
+        inputs.positions,
+        inputs.offsets,
+        inputs.entries,
+        inputs.topology,
+        inputs.moving,
+        inputs.rings,
+        inputs.marks,
+        pulls,
+    ];
+    match indirect {
+        Some(args) => {
+            gpu.record_dispatch_indirect(encoder, &pipeline, "proximity", &resources, args)
+        }
+        None => gpu.record_dispatch(
+            encoder,
+            &pipeline,
+            "proximity",
+            &resources,
+            params.count as usize * params.cells_per_entry as usize,
+            PROXIMITY_WORKGROUP_SIZE,
+        ),
+    }
+    Ok(())
+}
+
+/// Fails clearly when a pass would need more invocations than a `u32` counts.
+pub fn check_invocations(params: &ProximityParams) -> Result<(), GpuError> {
+    let invocations = params.count as u64 * params.cells_per_entry as u64;
+    if invocations > u32::MAX as u64 {
+        return Err(GpuError::TooLarge {
+            what: format!(
+                "a proximity pass ({} moving vertices × {} cells)",
+                params.count, params.cells_per_entry
+            ),
+            bytes: invocations,
+            limit: u32::MAX as u64,
+        });
+    }
     Ok(())
 }
 
@@ -145,15 +204,19 @@ pub fn proximity_params(
         .map(|&v| positions[v as usize].distance(query.current[v as usize]))
         .fold(0.0f32, f32::max);
     let (cell_reach, vertex_reach) = proximity_reaches(query.distance, query.max_edge, max_move);
+    let inv_cell_size = 1.0 / query.cell_size;
+    let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
     ProximityParams {
         distance: query.distance,
         cell_reach,
         vertex_reach,
-        inv_cell_size: 1.0 / query.cell_size,
+        inv_cell_size,
         table_mask: table_size - 1,
         count: query.selection.len() as u32,
         vertex_faces_base,
         all_faces: query.marks.is_none() as u32,
+        span,
+        cells_per_entry: cells,
     }
 }
 
@@ -177,6 +240,7 @@ pub fn run_proximity(
     let topology = PackedTopology::of(mesh);
     let table_size = table_size_for(mesh.vertex_count());
     let params = proximity_params(query, topology.vertex_faces_base, table_size);
+    check_invocations(&params)?;
     gpu.check_binding::<u32>("exclusion rings", rings.len())?;
     let hashed = super::VertexBuffers::upload(
         gpu,
@@ -186,10 +250,11 @@ pub fn run_proximity(
     )?;
     let current = gpu.storage_buffer("current positions", query.current, false);
     let topology = topology.upload(gpu)?;
-    let moving = gpu.storage_buffer("moving", &moving, false);
+    let moving_list = moving;
+    let moving = gpu.storage_buffer("moving", &moving_list, false);
     let rings = gpu.storage_buffer("rings", &rings, false);
     let marks = gpu.storage_buffer("marks", query.marks.unwrap_or(&[]), false);
-    let pulled = gpu.output_buffer::<PulledVertex>("pulled", query.selection.len());
+    let pulls = gpu.output_buffer::<u32>("pulls", query.selection.len());
     let mut encoder = gpu.encoder("proximity");
     let table = super::GpuHashTable::record(
         gpu,
@@ -213,8 +278,14 @@ pub fn run_proximity(
             marks: &marks,
         },
         &params,
-        &pulled,
+        &pulls,
+        None,
     )?;
     gpu.queue.submit([encoder.finish()]);
-    gpu.read_buffer(&pulled, query.selection.len())
+    let pulls: Vec<u32> = gpu.read_buffer(&pulls, query.selection.len())?;
+    Ok(verdicts(
+        &moving_list,
+        bytemuck::cast_slice(query.current),
+        &pulls,
+    ))
 }

@@ -29,17 +29,21 @@ pub fn falloff_code(falloff: Falloff) -> (u32, u32) {
     }
 }
 
-/// The kernel's parameters: one invocation per cell of the brush's box, or per vertex when the
-/// box has more cells than there are vertices (or more than a `u32` counts).
+/// The kernel's parameters: one invocation per cell of the brush's box (grown by `drift`, how
+/// far any vertex has moved since the table was built), or per vertex when the box has more
+/// cells than there are vertices (or more than a `u32` counts).
 pub fn select_params(
     brush: &BrushSphere,
+    drift: f32,
     inv_cell_size: f32,
     table_size: u32,
     vertex_count: usize,
     layer_count: usize,
 ) -> SelectParams {
-    let lo = cell_coordinates(brush.center - brush.radius, inv_cell_size);
-    let hi = cell_coordinates(brush.center + brush.radius, inv_cell_size);
+    // 1 % on the drift so that rounding never leaves a moved vertex's cell out.
+    let reach = brush.radius + 1.01 * drift;
+    let lo = cell_coordinates(brush.center - reach, inv_cell_size);
+    let hi = cell_coordinates(brush.center + reach, inv_cell_size);
     let span = (hi - lo).as_i64vec3() + 1;
     let cells = span.x.max(0) * span.y.max(0) * span.z.max(0);
     let scan_vertices = cells > vertex_count as i64;
@@ -65,7 +69,7 @@ pub fn select_params(
         blend_n,
         capacity: vertex_count as u32,
         layer_count: layer_count as u32,
-        _pad0: 0,
+        drift,
         _pad1: 0,
     }
 }
@@ -96,6 +100,14 @@ impl GpuSelection {
     }
 }
 
+/// A hash table and the positions it was built from, with how far any vertex has moved since.
+pub struct HashedVertices<'a> {
+    pub table: &'a GpuHashTable,
+    /// Packed positions at the build (may be the current positions buffer).
+    pub positions: &'a wgpu::Buffer,
+    pub drift: f32,
+}
+
 /// Records a selection into `selection` (its counter is cleared first).
 #[allow(clippy::too_many_arguments)]
 pub fn record_select(
@@ -104,12 +116,14 @@ pub fn record_select(
     vertices: &VertexBuffers,
     active_layers: &wgpu::Buffer,
     layer_count: usize,
-    table: &GpuHashTable,
+    hashed: &HashedVertices<'_>,
     brush: &BrushSphere,
     selection: &GpuSelection,
 ) -> Result<(), GpuError> {
+    let table = hashed.table;
     let mut params = select_params(
         brush,
+        hashed.drift,
         table.inv_cell_size,
         table.table_size,
         vertices.count,
@@ -133,6 +147,7 @@ pub fn record_select(
             &table.entries,
             &selection.selected,
             &selection.count,
+            hashed.positions,
         ],
         params.candidate_count as usize,
         WORKGROUP_SIZE,
@@ -140,9 +155,12 @@ pub fn record_select(
     Ok(())
 }
 
-/// Builds the hash table (cells of `1 / inv_cell_size`) and selects under `brush`, on the GPU.
+/// Builds the hash table (cells of `1 / inv_cell_size`) of the `hashed` positions and selects
+/// under `brush` at `positions` (vertices may have moved since they were hashed), on the GPU.
+#[allow(clippy::too_many_arguments)]
 pub fn run_select(
     gpu: &GpuContext,
+    hashed: &[Vec3],
     positions: &[Vec3],
     layers: &[u32],
     flags: &[u32],
@@ -150,6 +168,17 @@ pub fn run_select(
     inv_cell_size: f32,
     brush: &BrushSphere,
 ) -> Result<Vec<SelectedVertex>, GpuError> {
+    assert_eq!(
+        hashed.len(),
+        positions.len(),
+        "one hashed position per vertex"
+    );
+    let drift = hashed
+        .iter()
+        .zip(positions)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    let filed = VertexBuffers::upload(gpu, hashed, layers, flags)?;
     let vertices = VertexBuffers::upload(gpu, positions, layers, flags)?;
     let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
     let active_buffer = gpu.storage_buffer("active layers", &active, false);
@@ -158,11 +187,11 @@ pub fn run_select(
     let table = GpuHashTable::record(
         gpu,
         &mut encoder,
-        &vertices.positions,
-        &vertices.flags,
-        vertices.count,
+        &filed.positions,
+        &filed.flags,
+        filed.count,
         inv_cell_size,
-        table_size_for(vertices.count),
+        table_size_for(filed.count),
     )?;
     record_select(
         gpu,
@@ -170,7 +199,11 @@ pub fn run_select(
         &vertices,
         &active_buffer,
         active.len(),
-        &table,
+        &HashedVertices {
+            table: &table,
+            positions: &filed.positions,
+            drift,
+        },
         brush,
         &selection,
     )?;

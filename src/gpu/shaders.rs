@@ -10,6 +10,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/mesh", include_str!("../../wgsl/shared/mesh.wgsl")),
     ("shared/brush", include_str!("../../wgsl/shared/brush.wgsl")),
     ("shared/geom", include_str!("../../wgsl/shared/geom.wgsl")),
+    ("shared/moves", include_str!("../../wgsl/shared/moves.wgsl")),
 ];
 
 /// Compute kernels, by file stem; each has entry point `main`.
@@ -26,6 +27,7 @@ pub const KERNELS: &[(&str, &str)] = &[
         include_str!("../../wgsl/dispatch_args.wgsl"),
     ),
     ("proximity", include_str!("../../wgsl/proximity.wgsl")),
+    ("apply_moves", include_str!("../../wgsl/apply_moves.wgsl")),
     (
         "vertex_normals",
         include_str!("../../wgsl/vertex_normals.wgsl"),

@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::kernels::{CpuKernels, StepKernels};
-use super::step::{Region, StrokeState, collide, paint};
+use super::step::{Region, StrokeState, collide_with, paint};
 use super::{
     PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
     StrokeReport,
@@ -249,7 +249,9 @@ impl SculptPipeline for CpuPipeline {
     fn name(&self) -> String {
         let kernels = self.kernels.name();
         if kernels != "cpu" {
-            return format!("gpu (select, deform on {kernels}; collide, remesh on the cpu)");
+            return format!(
+                "gpu (select, deform, proximity on {kernels}; exact backstop, remesh on the cpu)"
+            );
         }
         match (self.search, self.parallel) {
             (Search::Grid, true) => "cpu".into(),
@@ -420,13 +422,15 @@ impl SculptPipeline for CpuPipeline {
                     .iter()
                     .map(|&(v, _)| mesh.positions()[v as usize])
                     .collect();
-                let outcome = collide(
+                let kernels = &mut self.kernels;
+                let outcome = collide_with(
                     &state,
                     &mut self.region,
                     mesh,
-                    &selection,
-                    &targets,
-                    &target_of,
+                    (&selection, &targets, &target_of),
+                    |region, mesh, before| {
+                        kernels.clamp(&state, region, mesh, &selection, &targets, before)
+                    },
                 );
                 for &(v, _) in &selection {
                     target_of[v as usize] = INVALID;
@@ -438,6 +442,13 @@ impl SculptPipeline for CpuPipeline {
                     .filter(|((_, p), q)| p != q)
                     .map(|((&(v, _), _), _)| v)
                     .collect();
+                let longest_move = before
+                    .iter()
+                    .zip(&outcome.positions)
+                    .map(|(p, q)| p.distance(*q))
+                    .fold(0.0f32, f32::max);
+                let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+                self.kernels.moved(mesh, &selected, longest_move);
                 let mut moved_faces: Vec<u32> =
                     moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
                 moved_faces.sort_unstable();
@@ -473,6 +484,7 @@ impl SculptPipeline for CpuPipeline {
             refresh.sort_unstable();
             refresh.dedup();
             mesh.recompute_normals_at(&refresh);
+            self.kernels.normals_changed(mesh, &refresh);
             times.deformation += millis(started);
 
             // A grab keeps moving the vertices it caught at its first sample, so its region is

@@ -1,13 +1,13 @@
 //! The seam between Algorithm 2's control flow and where its data-parallel steps run. The
-//! pipeline (`CpuPipeline`) owns the loop — samples, steps, collisions, the exact backstop,
-//! remeshing — and asks its kernels to select and deform: on the CPU ([`CpuKernels`]) or through
-//! the WGSL kernels ([`crate::gpu::GpuKernels`]). One loop for both keeps their results
+//! pipeline (`CpuPipeline`) owns the loop — samples, steps, the exact backstop, remeshing — and
+//! asks its kernels to select, deform and clamp moves (the proximity passes): on the CPU
+//! ([`CpuKernels`]) or through the WGSL kernels ([`crate::gpu::GpuKernels`]). One loop for both keeps their results
 //! comparable vertex for vertex, which is what the parity figures of `bench --backend both`
 //! measure.
 
 use glam::Vec3;
 
-use super::step::{StrokeState, deform, select};
+use super::step::{Region, StrokeState, clamp_moves, deform, select};
 use crate::brush::Dab;
 use crate::mesh::Mesh;
 
@@ -29,6 +29,27 @@ pub trait StepKernels: Send {
         dab: &Dab,
         selection: &[(u32, f32)],
     ) -> Vec<Vec3>;
+    /// The collision response's first phase, [`clamp_moves`]: the selection moved to
+    /// `targets`, then pulled back where it comes too close to a face. `before` holds each
+    /// selected vertex's start; `region` is the step's gathered faces. Leaves the positions in
+    /// `mesh`.
+    #[allow(clippy::too_many_arguments)]
+    fn clamp(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &Region,
+        mesh: &mut Mesh,
+        selection: &[(u32, f32)],
+        targets: &[Vec3],
+        before: &[Vec3],
+    ) {
+        clamp_moves(state, region, mesh, selection, targets, before);
+    }
+    /// The pipeline has finished moving `vertices` (each by at most `max_move` since the
+    /// kernels last saw it): kernels that keep a copy of the positions bring it up to date.
+    fn moved(&mut self, _mesh: &Mesh, _vertices: &[u32], _max_move: f32) {}
+    /// The pipeline recomputed the normals of `vertices`.
+    fn normals_changed(&mut self, _mesh: &Mesh, _vertices: &[u32]) {}
 }
 
 /// The CPU's selection (through the spatial hash, or by scanning) and deformation (rayon).

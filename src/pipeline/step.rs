@@ -17,6 +17,14 @@ use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags};
 /// Bisection rounds when clamping a move: 2⁻¹⁶ of a step.
 const CLAMP_ROUNDS: u32 = 16;
 
+/// A vertex already within the collision distance of a face is pulled back when its move
+/// takes it closer by more than this share of the distance. A move along the face (a grab
+/// carrying a patch over another layer) keeps the distance in exact arithmetic, and in floats
+/// changes it by rounding only; without the slack, whether such a vertex is stopped would
+/// depend on the last bits of the arithmetic, which differ between the CPU and a GPU (fused
+/// multiply-adds), and the stop moves it by a whole step. `wgsl/proximity.wgsl` has the same.
+pub const CLAMP_SLACK: f32 = 1.0 / 1024.0;
+
 /// Everything a step reads that lasts for the whole stroke.
 pub struct StrokeState<'a> {
     pub grid: Option<&'a SpatialHash>,
@@ -338,9 +346,10 @@ pub fn pull_back(
         if here >= d {
             continue;
         }
-        // Never closer than the collision distance, nor closer than it already was.
+        // Never closer than the collision distance, nor closer than it already was (give or
+        // take the slack).
         let threshold = d.min(distance(start));
-        if here >= threshold {
+        if here >= threshold - CLAMP_SLACK * d {
             continue;
         }
         // Distance along the move is convex and safe at its start: bisect for the last safe
@@ -373,7 +382,7 @@ pub struct CollisionOutcome {
 
 /// Passes of the proximity test before giving up on converging (each pass only re-tests against
 /// faces that the previous one changed; two passes are the rule).
-const MAX_PASSES: usize = 8;
+pub const MAX_PASSES: usize = 8;
 
 /// Proximity test and clamping (sLayer's narrow phase and response), then the exact backstop.
 /// Leaves the final positions in `mesh`.
@@ -395,63 +404,32 @@ pub fn collide(
     targets: &[Vec3],
     target_of: &[u32],
 ) -> CollisionOutcome {
+    collide_with(
+        state,
+        region,
+        mesh,
+        (selection, targets, target_of),
+        |region, mesh, before| clamp_moves(state, region, mesh, selection, targets, before),
+    )
+}
+
+/// [`collide`] with its first phase — targets written in, proximity passes — done by `clamp`
+/// (given the gathered region, the mesh and each selected vertex's start), which must leave
+/// the positions [`clamp_moves`] would: a GPU backend runs it there.
+pub fn collide_with(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, target_of): (&[(u32, f32)], &[Vec3], &[u32]),
+    clamp: impl FnOnce(&Region, &mut Mesh, &[Vec3]),
+) -> CollisionOutcome {
     region.gather(state, mesh, selection, targets, target_of);
     let region: &Region = region;
     let before: Vec<Vec3> = selection
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
         .collect();
-    {
-        let positions = mesh.positions_mut();
-        for (&(v, _), &q) in selection.iter().zip(targets) {
-            positions[v as usize] = q;
-        }
-    }
-
-    // Per local face: changed by the last pass (the first pass tests every face).
-    let mut changed: Option<Vec<bool>> = None;
-    for pass in 0..MAX_PASSES {
-        let moving: Vec<usize> = (0..selection.len())
-            .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
-            .collect();
-        let mesh_view: &Mesh = mesh;
-        let changed_view = changed.as_deref();
-        let pulled: Vec<Option<Vec3>> = map_with_scratch(state.parallel, &moving, |scratch, &i| {
-            pull_back(
-                state,
-                region,
-                mesh_view,
-                selection[i].0,
-                before[i],
-                changed_view,
-                scratch,
-            )
-        });
-        let last_pass = pass + 1 == MAX_PASSES;
-        let mut moved_back = Vec::new();
-        {
-            let positions = mesh.positions_mut();
-            for (&i, x) in moving.iter().zip(pulled) {
-                let Some(x) = x else { continue };
-                let v = selection[i].0;
-                // Out of passes: what still collides goes back to where it was.
-                positions[v as usize] = if last_pass { before[i] } else { x };
-                moved_back.push(v);
-            }
-        }
-        if moved_back.is_empty() {
-            break;
-        }
-        let mut marks = vec![false; region.faces.len()];
-        for &v in &moved_back {
-            for f in mesh.faces_around(v) {
-                if let Some(local) = region.local(f) {
-                    marks[local] = true;
-                }
-            }
-        }
-        changed = Some(marks);
-    }
+    clamp(region, mesh, &before);
     let clamped_count = selection
         .iter()
         .zip(targets)
@@ -578,5 +556,69 @@ pub fn collide(
         positions,
         clamped: clamped_count,
         reverted,
+    }
+}
+
+/// The first phase of [`collide`] (sLayer's narrow phase and response): the selection moved to
+/// its targets, then Jacobi passes of [`pull_back`] until none pulls a vertex back. `before`
+/// holds each selected vertex's start; the positions are left in `mesh`.
+pub fn clamp_moves(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &mut Mesh,
+    selection: &[(u32, f32)],
+    targets: &[Vec3],
+    before: &[Vec3],
+) {
+    {
+        let positions = mesh.positions_mut();
+        for (&(v, _), &q) in selection.iter().zip(targets) {
+            positions[v as usize] = q;
+        }
+    }
+
+    // Per local face: changed by the last pass (the first pass tests every face).
+    let mut changed: Option<Vec<bool>> = None;
+    for pass in 0..MAX_PASSES {
+        let moving: Vec<usize> = (0..selection.len())
+            .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
+            .collect();
+        let mesh_view: &Mesh = mesh;
+        let changed_view = changed.as_deref();
+        let pulled: Vec<Option<Vec3>> = map_with_scratch(state.parallel, &moving, |scratch, &i| {
+            pull_back(
+                state,
+                region,
+                mesh_view,
+                selection[i].0,
+                before[i],
+                changed_view,
+                scratch,
+            )
+        });
+        let last_pass = pass + 1 == MAX_PASSES;
+        let mut moved_back = Vec::new();
+        {
+            let positions = mesh.positions_mut();
+            for (&i, x) in moving.iter().zip(pulled) {
+                let Some(x) = x else { continue };
+                let v = selection[i].0;
+                // Out of passes: what still collides goes back to where it was.
+                positions[v as usize] = if last_pass { before[i] } else { x };
+                moved_back.push(v);
+            }
+        }
+        if moved_back.is_empty() {
+            break;
+        }
+        let mut marks = vec![false; region.faces.len()];
+        for &v in &moved_back {
+            for f in mesh.faces_around(v) {
+                if let Some(local) = region.local(f) {
+                    marks[local] = true;
+                }
+            }
+        }
+        changed = Some(marks);
     }
 }

@@ -7,61 +7,55 @@ const MIN_POSITIVE_F32: f32 = 1.17549435e-38;
 
 // The point of triangle abc closest to p (Ericson §5.1.5). Degenerate triangles fall through
 // to an edge or vertex region and stay finite.
+//
+// One exit, the regions as an else-if chain: Mesa 22.3's lavapipe miscompiled early returns
+// from this function once it was inlined into the proximity kernel's loops (later faces were
+// skipped). Every quantity is the same expression as on the CPU, so results are unchanged.
 fn closest_point_on_triangle(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;
     let d1 = dot(ab, ap);
     let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
     let bp = p - b;
     let d3 = dot(ab, bp);
     let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return a + ab * v;
-    }
     let cp = p - c;
     let d5 = dot(ab, cp);
     let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
+    let vc = d1 * d4 - d3 * d2;
     let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return a + ac * w;
-    }
     let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return b + (c - b) * w;
-    }
     let denom = va + vb + vc;
-    if abs(denom) <= MIN_POSITIVE_F32 {
+    var closest = a;
+    if d1 <= 0.0 && d2 <= 0.0 {
+        closest = a;
+    } else if d3 >= 0.0 && d4 <= d3 {
+        closest = b;
+    } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        closest = a + ab * (d1 / (d1 - d3));
+    } else if d6 >= 0.0 && d5 <= d6 {
+        closest = c;
+    } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        closest = a + ac * (d2 / (d2 - d6));
+    } else if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        closest = b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    } else if abs(denom) <= MIN_POSITIVE_F32 {
         // Collinear corners that slipped past the edge regions: the nearest corner (the first
         // of equals, as the CPU's `min_by`).
-        var nearest = a;
         var best = dot(a - p, a - p);
         if dot(b - p, b - p) < best {
-            nearest = b;
+            closest = b;
             best = dot(b - p, b - p);
         }
         if dot(c - p, c - p) < best {
-            nearest = c;
+            closest = c;
         }
-        return nearest;
+    } else {
+        let inv = 1.0 / denom;
+        closest = a + ab * (vb * inv) + ac * (vc * inv);
     }
-    let inv = 1.0 / denom;
-    let v = vb * inv;
-    let w = vc * inv;
-    return a + ab * v + ac * w;
+    return closest;
 }
 
 // Distance from p to triangle abc, as glam's `distance` (square root of the dot product).

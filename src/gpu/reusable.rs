@@ -1,0 +1,100 @@
+//! Buffers a backend keeps from step to step: grown (to the next power of two) when a step
+//! needs more, never shrunk, so that steady sculpting allocates nothing on the GPU. Creating
+//! buffers every step was the largest cost of the first GPU backend on lavapipe.
+
+use bytemuck::Pod;
+
+use super::{GpuContext, GpuError};
+
+pub struct ReusableBuffer {
+    label: &'static str,
+    usage: wgpu::BufferUsages,
+    buffer: Option<wgpu::Buffer>,
+}
+
+impl ReusableBuffer {
+    /// A storage buffer the host writes and copies from.
+    pub fn storage(label: &'static str) -> ReusableBuffer {
+        ReusableBuffer::with_usage(
+            label,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        )
+    }
+
+    /// A buffer the host maps to read results back.
+    pub fn readback(label: &'static str) -> ReusableBuffer {
+        ReusableBuffer::with_usage(
+            label,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        )
+    }
+
+    fn with_usage(label: &'static str, usage: wgpu::BufferUsages) -> ReusableBuffer {
+        ReusableBuffer {
+            label,
+            usage,
+            buffer: None,
+        }
+    }
+
+    /// Makes room for `bytes` (at least 4, so that empty steps stay legal); the contents are
+    /// undefined after growing. Fails clearly past one binding's limit.
+    pub fn reserve(&mut self, gpu: &GpuContext, bytes: u64) -> Result<(), GpuError> {
+        let bytes = bytes.max(4);
+        if self.buffer.as_ref().is_some_and(|b| b.size() >= bytes) {
+            return Ok(());
+        }
+        if self.usage.contains(wgpu::BufferUsages::STORAGE) {
+            gpu.check_binding::<u8>(self.label, bytes as usize)?;
+        }
+        let limit = gpu.limits.max_buffer_size;
+        let size = bytes.next_power_of_two().min(limit.max(bytes)).div_ceil(4) * 4;
+        self.buffer = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(self.label),
+            size,
+            usage: self.usage,
+            mapped_at_creation: false,
+        }));
+        Ok(())
+    }
+
+    /// Makes room for `data` and queues its upload (done before the next submission).
+    pub fn upload<T: Pod>(&mut self, gpu: &GpuContext, data: &[T]) -> Result<(), GpuError> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        self.reserve(gpu, bytes.len() as u64)?;
+        if !bytes.is_empty() {
+            gpu.queue.write_buffer(self.buffer(), 0, bytes);
+        }
+        Ok(())
+    }
+
+    /// The buffer; [`ReusableBuffer::reserve`] or [`ReusableBuffer::upload`] first.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        self.buffer
+            .as_ref()
+            .expect("reserve a reusable buffer before using it")
+    }
+}
+
+/// Uploads the rows of `data` listed in `rows` (sorted) into `buffer`, one write per run of
+/// consecutive rows: a step's moved vertices are a few runs of the vertex order.
+pub fn upload_rows<T: Pod>(gpu: &GpuContext, buffer: &wgpu::Buffer, data: &[T], rows: &[u32]) {
+    let size = std::mem::size_of::<T>() as u64;
+    let mut i = 0;
+    while i < rows.len() {
+        let start = rows[i] as usize;
+        let mut end = start + 1;
+        i += 1;
+        while i < rows.len() && rows[i] as usize <= end {
+            end = end.max(rows[i] as usize + 1);
+            i += 1;
+        }
+        gpu.queue.write_buffer(
+            buffer,
+            start as u64 * size,
+            bytemuck::cast_slice(&data[start..end]),
+        );
+    }
+}

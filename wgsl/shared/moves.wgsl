@@ -1,0 +1,13 @@
+// A step's moving vertices, as the collision kernels (`proximity`, `apply_moves`) share them.
+
+// One entry of the step's selection.
+struct MovingVertex {
+    // Position at the start of the step.
+    start: vec3<f32>,
+    vertex: u32,
+    layer: u32,
+    // The vertex's exclusion ring (itself included) is rings[ring_start..ring_end].
+    ring_start: u32,
+    ring_end: u32,
+    _pad: u32,
+}
