@@ -95,12 +95,15 @@ fn safe_fraction(entry: MovingVertex, f: u32, x: vec3<f32>) -> f32 {
     // by construction, not by collision) do not constrain it.
     let unchanged = params.all_faces == 0u && (marks[a] | marks[b] | marks[c]) == 0u;
     let own = a == v || b == v || c == v;
+    let pa = position(a);
+    let pb = position(b);
+    let pc = position(c);
+    let d = params.distance;
+    // A face whose box is farther than d from x on some axis is farther than d: no closest
+    // point needed (most faces the broad phase finds; the CPU filters by box too).
+    let near = all(max(max(pa, pb), pc) >= x - vec3<f32>(d)) && all(min(min(pa, pb), pc) <= x + vec3<f32>(d));
     var t = 1.0;
-    if !unchanged && !own && !(layer == entry.layer && touches_ring(entry, a, b, c)) {
-        let pa = position(a);
-        let pb = position(b);
-        let pc = position(c);
-        let d = params.distance;
+    if near && !unchanged && !own && !(layer == entry.layer && touches_ring(entry, a, b, c)) {
         let here = distance_to_triangle(x, pa, pb, pc);
         // Never closer than the collision distance, nor closer than it already was, give or
         // take the slack (a move along the face must not stop on the arithmetic's last bits).

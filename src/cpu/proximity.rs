@@ -58,6 +58,16 @@ fn safe_fraction(
 ) -> f32 {
     let words = &inputs.topology[4 * f as usize..4 * f as usize + 4];
     let (a, b, c, layer) = (words[0], words[1], words[2], words[3]);
+    let (pa, pb, pc) = (
+        packed_position(inputs.positions, a),
+        packed_position(inputs.positions, b),
+        packed_position(inputs.positions, c),
+    );
+    let d = params.distance;
+    let near = pa.max(pb).max(pc).cmpge(x - d).all() && pa.min(pb).min(pc).cmple(x + d).all();
+    if !near {
+        return 1.0;
+    }
     if params.all_faces == 0
         && (inputs.marks[a as usize] | inputs.marks[b as usize] | inputs.marks[c as usize]) == 0
     {
@@ -70,12 +80,6 @@ fn safe_fraction(
     if layer == entry.layer && touches_ring(inputs, entry, a, b, c) {
         return 1.0;
     }
-    let (pa, pb, pc) = (
-        packed_position(inputs.positions, a),
-        packed_position(inputs.positions, b),
-        packed_position(inputs.positions, c),
-    );
-    let d = params.distance;
     let here = distance_to_triangle(x, pa, pb, pc);
     if here >= d {
         return 1.0;

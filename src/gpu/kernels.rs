@@ -37,9 +37,12 @@ use crate::pipeline::step::{MAX_PASSES, Region, StrokeState, clamp_moves};
 use crate::pipeline::{CpuKernels, StepKernels};
 
 /// The hash table is rebuilt once vertices may have drifted this many cells from where they
-/// were filed: queries grow by the drift, so past a cell or so they walk more buckets than a
-/// rebuild costs.
-const DRIFT_LIMIT_CELLS: f32 = 1.0;
+/// were filed. Queries grow by the drift, and the proximity pass's work grows with the cube of
+/// its reach: on lavapipe (plaster, 20K faces, steps of one edge length) keeping the table for
+/// two steps made the passes 2.6 times dearer (22³ instead of 16³ cells per moving vertex)
+/// while a rebuild is four passes over the vertices. So in practice the table follows every
+/// step that moves vertices by half a cell or more; slow strokes keep it.
+const DRIFT_LIMIT_CELLS: f32 = 0.5;
 
 /// The table and the positions it was built from.
 struct Hashed {
@@ -101,6 +104,8 @@ impl StepBuffers {
 
 pub struct GpuKernels {
     gpu: GpuContext,
+    /// Whether the proximity passes run on the GPU (else on the CPU, `clamp_moves`).
+    proximity_on_gpu: bool,
     resident: Option<Resident>,
     step: StepBuffers,
     /// Set once the GPU failed: why. Everything after runs on the CPU.
@@ -110,14 +115,30 @@ pub struct GpuKernels {
 }
 
 impl GpuKernels {
+    /// Kernels on `gpu`. The proximity passes run there on a hardware GPU; on a software
+    /// adapter (lavapipe) they stay on the CPU unless `SLAYER_GPU_PROXIMITY=1`: the kernel's
+    /// broad phase walks every cell within reach of each moving vertex (reach set by the
+    /// longest edge), which lavapipe runs hundreds of times slower than the CPU's per-step face
+    /// grid. [`GpuKernels::set_proximity_on_gpu`] chooses explicitly.
     pub fn new(gpu: GpuContext) -> GpuKernels {
+        let forced = std::env::var("SLAYER_GPU_PROXIMITY").is_ok_and(|v| v == "1");
         GpuKernels {
+            proximity_on_gpu: forced || !gpu.adapter.software,
             step: StepBuffers::new(&gpu),
             gpu,
             resident: None,
             failed: None,
             fail_after: None,
         }
+    }
+
+    /// Runs the proximity passes on the GPU (`true`) or on the CPU.
+    pub fn set_proximity_on_gpu(&mut self, on: bool) {
+        self.proximity_on_gpu = on;
+    }
+
+    pub fn proximity_on_gpu(&self) -> bool {
+        self.proximity_on_gpu
     }
 
     /// Makes the GPU calls after the next `calls` fail, as a lost device would: for tests of
@@ -540,6 +561,10 @@ impl StepKernels for GpuKernels {
         self.gpu.adapter.name.clone()
     }
 
+    fn collides_on_gpu(&self) -> bool {
+        self.proximity_on_gpu && self.failed.is_none()
+    }
+
     fn failure(&self) -> Option<String> {
         self.failed.clone()
     }
@@ -579,9 +604,8 @@ impl StepKernels for GpuKernels {
         targets: &[Vec3],
         before: &[Vec3],
     ) {
-        if self.failed.is_none() {
-            let result = self.gpu_clamp(state, mesh, selection, targets, before);
-            match result {
+        if self.failed.is_none() && self.proximity_on_gpu {
+            match self.gpu_clamp(state, mesh, selection, targets, before) {
                 Ok(finals) => {
                     let positions = mesh.positions_mut();
                     for (&(v, _), p) in selection.iter().zip(finals) {

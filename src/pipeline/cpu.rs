@@ -249,9 +249,13 @@ impl SculptPipeline for CpuPipeline {
     fn name(&self) -> String {
         let kernels = self.kernels.name();
         if kernels != "cpu" {
-            return format!(
-                "gpu (select, deform, proximity on {kernels}; exact backstop, remesh on the cpu)"
-            );
+            return if self.kernels.collides_on_gpu() {
+                format!(
+                    "gpu (select, deform, proximity on {kernels}; exact backstop, remesh on the cpu)"
+                )
+            } else {
+                format!("gpu (select, deform on {kernels}; collide, remesh on the cpu)")
+            };
         }
         match (self.search, self.parallel) {
             (Search::Grid, true) => "cpu".into(),

@@ -15,6 +15,10 @@ use crate::mesh::Mesh;
 pub trait StepKernels: Send {
     /// For reports: "cpu", or the GPU adapter's name.
     fn name(&self) -> String;
+    /// Whether [`StepKernels::clamp`] runs off the CPU (for reports).
+    fn collides_on_gpu(&self) -> bool {
+        false
+    }
     /// Why these kernels gave up and fell back to the CPU, if they did.
     fn failure(&self) -> Option<String> {
         None
