@@ -1,6 +1,6 @@
-//! The pipeline with the GPU's selection and deformation (lavapipe in CI, never skipped) against
-//! the CPU pipeline on the same strokes: positions, collision counts, soundness, and the fallback
-//! to the CPU when the GPU is lost mid-stroke.
+//! The pipeline with the GPU's selection, deformation and proximity passes (lavapipe in CI, never
+//! skipped) against the CPU pipeline on the same strokes: positions, collision counts,
+//! soundness, and the fallback to the CPU when the GPU is lost mid-stroke.
 
 use slayer::bench::{ScriptSpec, generate_script};
 use slayer::collide::find_intersections;

@@ -6,8 +6,8 @@ use slayer::pipeline::{CpuPipeline, PipelineSettings};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Backend {
     Cpu,
-    /// The GPU's selection and deformation (collisions and remeshing on the CPU); any adapter,
-    /// lavapipe included — asking for it by name is asking for it.
+    /// The GPU's selection, deformation and proximity passes (the exact backstop and remeshing
+    /// on the CPU); any adapter, lavapipe included — asking for it by name is asking for it.
     Gpu,
     /// A hardware GPU if there is one, else the CPU.
     Auto,

@@ -193,7 +193,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         println!("{}", paper_table(&scenes));
     }
     if !gpu_scenes.is_empty() {
-        println!("the same strokes with the GPU's selection and deformation ({adapter}):");
+        println!("the same strokes on the GPU path ({adapter}):");
         println!("{}", paper_table(&gpu_scenes));
         for (name, p) in &parities {
             println!(

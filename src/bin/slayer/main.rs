@@ -136,7 +136,7 @@ enum Command {
             default_value = "250000,500000,1000000,2000000,4000000"
         )]
         scaling_sizes: Vec<usize>,
-        /// cpu; gpu (the GPU's selection and deformation, any adapter including lavapipe);
+        /// cpu; gpu (the GPU's selection, deformation and proximity passes, any adapter including lavapipe);
         /// auto (a hardware GPU if there is one, else the CPU); both (the same strokes on each,
         /// compared).
         #[arg(long, default_value = "cpu", value_name = "cpu|gpu|auto|both")]
