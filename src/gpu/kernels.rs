@@ -104,6 +104,8 @@ impl StepBuffers {
 
 pub struct GpuKernels {
     gpu: GpuContext,
+    /// Size of the last selection: how much of the list to read back with its count.
+    last_selection: usize,
     /// Whether the proximity passes run on the GPU (else on the CPU, `clamp_moves`).
     proximity_on_gpu: bool,
     resident: Option<Resident>,
@@ -123,6 +125,7 @@ impl GpuKernels {
     pub fn new(gpu: GpuContext) -> GpuKernels {
         let forced = std::env::var("SLAYER_GPU_PROXIMITY").is_ok_and(|v| v == "1");
         GpuKernels {
+            last_selection: 0,
             proximity_on_gpu: forced || !gpu.adapter.software,
             step: StepBuffers::new(&gpu),
             gpu,
@@ -287,13 +290,34 @@ impl GpuKernels {
             },
             &r.selection,
         )?;
+        // The count and a guess of the list in one read-back (twice the last selection: brushes
+        // change size slowly); the rest, if the guess was short, in a second.
+        let entry = std::mem::size_of::<SelectedVertex>() as u64;
+        let guess = (2 * self.last_selection).clamp(256, r.selection.capacity);
+        let staging = &mut self.step.readback;
+        staging.reserve(gpu, entry * (guess as u64 + 1))?;
+        encoder.copy_buffer_to_buffer(&r.selection.count, 0, staging.buffer(), 0, 4);
+        encoder.copy_buffer_to_buffer(
+            &r.selection.selected,
+            0,
+            staging.buffer(),
+            entry,
+            entry * guess as u64,
+        );
         gpu.queue.submit([encoder.finish()]);
-        let mut selected: Vec<(u32, f32)> = r
-            .selection
-            .read(gpu)?
-            .into_iter()
-            .map(|s| (s.vertex, s.weight))
-            .collect();
+        let bytes = gpu.map_read(staging.buffer())?;
+        let count = (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize)
+            .min(r.selection.capacity);
+        let head = count.min(guess);
+        let mut list: Vec<SelectedVertex> =
+            bytemuck::pod_collect_to_vec(&bytes[entry as usize..entry as usize * (head + 1)]);
+        if count > head {
+            let all: Vec<SelectedVertex> = gpu.read_buffer(&r.selection.selected, count)?;
+            list.extend_from_slice(&all[head..]);
+        }
+        self.last_selection = count;
+        let mut selected: Vec<(u32, f32)> =
+            list.into_iter().map(|s| (s.vertex, s.weight)).collect();
         // The kernel appends in whatever order its threads ran; the pipeline sums in vertex
         // order so that every backend gets the same bits.
         selected.sort_unstable_by_key(|&(v, _)| v);
