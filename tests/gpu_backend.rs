@@ -131,3 +131,28 @@ fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
         .fold(0.0f32, f32::max);
     assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
 }
+
+/// A mesh over our own GPU memory budget is not uploaded: the kernels say why, and the strokes
+/// run on the CPU with the CPU's result.
+#[test]
+fn a_mesh_over_the_gpu_budget_runs_on_the_cpu() {
+    let (start, strokes) = plaster_and_strokes(1);
+    let settings = PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    };
+    let mut on_cpu = start.clone();
+    run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut gpu = gpu();
+    let needed = slayer::gpu::resident_bytes(&start);
+    assert!(needed > 100_000, "{needed} bytes");
+    gpu.budget_bytes = needed / 2;
+    let mut kernels = GpuKernels::new(gpu);
+    kernels.set_proximity_on_gpu(true);
+    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut mesh = start.clone();
+    run(&mut pipeline, &mut mesh, &strokes);
+    let failure = pipeline.kernel_failure().expect("the budget is reported");
+    assert!(failure.contains("budget"), "{failure}");
+    assert_eq!(mesh.positions(), on_cpu.positions());
+}

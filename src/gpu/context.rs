@@ -25,6 +25,11 @@ pub enum GpuError {
     #[error(transparent)]
     Shader(#[from] super::shaders::ShaderError),
     #[error(
+        "the mesh needs about {needed_mib} MiB on the GPU, over the budget of {budget_mib} MiB \
+         (SLAYER_GPU_BUDGET_MIB raises it)"
+    )]
+    OverBudget { needed_mib: u64, budget_mib: u64 },
+    #[error(
         "{what} needs {bytes} bytes in one storage binding; the adapter allows {limit} \
          (chunking large meshes is not implemented yet)"
     )]
@@ -120,12 +125,22 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
         .collect()
 }
 
+/// The resident-memory budget when `SLAYER_GPU_BUDGET_MIB` is not set: room for a 16M-face mesh
+/// (about 1.3 GB resident, `resident_bytes`) with margin, well within an H100; a desktop GPU with
+/// less memory should set its own.
+pub const DEFAULT_GPU_BUDGET_MIB: u64 = 8192;
+
 /// A device and queue on the chosen adapter.
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter: AdapterSummary,
     pub limits: wgpu::Limits,
+    /// How much GPU memory a backend may keep resident, in bytes: our own budget, because
+    /// lavapipe never reports running out (it takes host memory until the process dies) and
+    /// wgpu does not say how much a device has. `SLAYER_GPU_BUDGET_MIB` sets it; the default is
+    /// [`DEFAULT_GPU_BUDGET_MIB`].
+    pub budget_bytes: u64,
     /// Compiled kernels by name: validating and compiling a kernel takes milliseconds, and a
     /// backend records the same few kernels for every step of every stroke.
     pipelines: std::sync::Mutex<std::collections::HashMap<String, wgpu::ComputePipeline>>,
@@ -165,11 +180,16 @@ impl GpuContext {
                 required_limits: limits.clone(),
                 ..Default::default()
             }))?;
+        let budget_mib = std::env::var("SLAYER_GPU_BUDGET_MIB")
+            .ok()
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .unwrap_or(DEFAULT_GPU_BUDGET_MIB);
         Ok(GpuContext {
             device,
             queue,
             adapter: summary,
             limits,
+            budget_bytes: budget_mib << 20,
             pipelines: Default::default(),
         })
     }
@@ -309,6 +329,18 @@ impl GpuContext {
             .to_vec();
         buffer.unmap();
         Ok(bytes)
+    }
+
+    /// Fails clearly when keeping `bytes` resident would pass the budget; checked before
+    /// anything is allocated.
+    pub fn check_budget(&self, bytes: u64) -> Result<(), GpuError> {
+        if bytes > self.budget_bytes {
+            return Err(GpuError::OverBudget {
+                needed_mib: bytes.div_ceil(1 << 20),
+                budget_mib: self.budget_bytes >> 20,
+            });
+        }
+        Ok(())
     }
 
     /// Fails clearly when `count` elements of `T` would not fit one storage binding (lavapipe

@@ -190,6 +190,7 @@ impl GpuKernels {
                 r.version = version;
             }
             _ => {
+                gpu.check_budget(resident_bytes(mesh))?;
                 let layers = mesh.vertex_layers().to_vec();
                 let vertices =
                     VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
@@ -553,6 +554,16 @@ impl GpuKernels {
         self.failed = Some(error.to_string());
         self.resident = None;
     }
+}
+
+/// What a mesh keeps resident on the GPU, in bytes (per-step buffers, a selection's worth, are
+/// not counted): per vertex positions, hashed positions and normals (12 bytes each), layer,
+/// flags, marks, selection entry (8), hash keys and entries, two table slots, smoothing
+/// neighbours (about 7 words with their offsets); per face the packed topology (4 words, and
+/// 3 in the vertex→faces rows).
+pub fn resident_bytes(mesh: &Mesh) -> u64 {
+    let (v, f) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
+    v * (3 * 12 + 4 + 4 + 4 + 8 + 4 + 4 + 2 * 4 + 7 * 4) + f * 7 * 4
 }
 
 /// The cell size the pipeline's grid uses (the table is built with the same).

@@ -22,7 +22,9 @@ pub use apply_moves::{
     APPLY_WORKGROUP_SIZE, AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves,
 };
 pub use cell_keys::{record_cell_keys, run_cell_keys};
-pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, list_adapters};
+pub use context::{
+    AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, list_adapters,
+};
 pub use deform::{
     DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
 };
@@ -30,7 +32,7 @@ pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch
 pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
-pub use kernels::GpuKernels;
+pub use kernels::{GpuKernels, resident_bytes};
 pub use layout::{
     ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
     NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
