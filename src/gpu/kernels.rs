@@ -8,16 +8,17 @@
 //!   a step only the rows the pipeline reports (`moved`, `normals_changed`) are sent;
 //! - connectivity (packed topology, smoothing neighbours), layers, flags: when the topology
 //!   (remeshing) or the flags changed;
-//! - the hash table: rebuilt only when the vertices have drifted more than a cell since it was
-//!   built — queries grow their reach by the drift instead (`select`, `proximity`);
+//! - the hash table: rebuilt only when the vertices have drifted more than half a cell since it
+//!   was built — queries grow their reach by the drift instead (`select`, `proximity`);
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
 //!
-//! A step is three submissions, each with one blocking read-back: the selection, the targets,
-//! and the whole Jacobi loop of proximity passes (targets placed, passes sized by the GPU
-//! through indirect dispatch, final positions gathered).
+//! A step is three submissions, each with one blocking read-back: the selection (its count and
+//! a guessed head of the list together), the targets, and the whole Jacobi loop of proximity
+//! passes (targets placed, passes sized by the GPU through indirect dispatch, final positions
+//! gathered). The proximity passes run here on hardware adapters; see [`GpuKernels::new`].
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
-//! adapter's limits) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
+//! adapter's limits, a mesh past our memory budget) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
 //! which the CPU writes — is untouched by the failure.
 
 use glam::Vec3;
