@@ -395,11 +395,7 @@ fn cpu_select(
 ) -> Vec<SelectedVertex> {
     let table_size = table_size_for(positions.len());
     let table = slayer::cpu::hash_table(hashed, flags, inv_cell_size, table_size);
-    let drift = hashed
-        .iter()
-        .zip(positions)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
+    let drift = slayer::geom::largest_move(hashed, positions);
     let params = select_params(
         brush,
         drift,

@@ -14,6 +14,16 @@ pub use tri_tri::{neighbours_overlap, triangles_intersect};
 
 use glam::Vec3;
 
+/// The farthest any point moves from `from[i]` to `to[i]` (0 for none): the drift and step
+/// bounds the broad phases grow their reach by.
+pub fn largest_move(from: &[Vec3], to: &[Vec3]) -> f32 {
+    debug_assert_eq!(from.len(), to.len(), "one destination per point");
+    from.iter()
+        .zip(to)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max)
+}
+
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aabb {

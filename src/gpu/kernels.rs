@@ -27,8 +27,8 @@ use super::reusable::{ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BrushSphere, DeformBuffers,
     GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, PROXIMITY_WORKGROUP_SIZE,
-    PackedTopology, ProximityBuffers, ProximityParams, SelectedVertex, VertexBuffers,
-    cells_per_entry, check_invocations, indirect_args_buffer, moving_vertices, proximity_reaches,
+    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
+    VertexBuffers, check_invocations, indirect_args_buffer, moving_vertices, pass_params,
     record_apply_moves, record_deform, record_dispatch_args, record_proximity, record_select,
     smoothing_neighbours, table_size_for,
 };
@@ -67,6 +67,37 @@ struct Resident {
     marks: wgpu::Buffer,
     hashed: Option<Hashed>,
     layer_count: usize,
+}
+
+impl Resident {
+    /// Everything uploaded afresh (within our memory budget); the hash table and topology
+    /// follow when first needed.
+    fn upload(gpu: &GpuContext, mesh: &Mesh) -> Result<Resident, GpuError> {
+        gpu.check_budget(resident_bytes(mesh))?;
+        let layers = mesh.vertex_layers().to_vec();
+        let vertices = VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
+        let (offsets, neighbours) = smoothing_neighbours(mesh);
+        gpu.check_binding::<u32>("smoothing neighbours", neighbours.len())?;
+        Ok(Resident {
+            version: mesh.version(),
+            normals: gpu.storage_buffer("normals", mesh.normals(), true),
+            neighbour_offsets: gpu.storage_buffer("neighbour offsets", &offsets, false),
+            neighbours: gpu.storage_buffer("neighbours", &neighbours, false),
+            selection: GpuSelection::new(gpu, mesh.vertex_count().max(1))?,
+            topology: None,
+            marks: gpu.output_buffer::<u32>("proximity marks", mesh.vertex_count()),
+            hashed: None,
+            layer_count: mesh.layer_count(),
+            vertices,
+        })
+    }
+
+    /// The hash table; [`GpuKernels::prepare`] builds it.
+    fn hashed(&self) -> &Hashed {
+        self.hashed
+            .as_ref()
+            .expect("GpuKernels::prepare builds the hash table")
+    }
 }
 
 /// Per-step buffers, reused from step to step.
@@ -162,67 +193,16 @@ impl GpuKernels {
         }
     }
 
-    /// Brings the GPU copy up to date with `mesh`.
-    fn sync(&mut self, mesh: &Mesh) -> Result<(), GpuError> {
-        let version = mesh.version();
-        let gpu = &self.gpu;
-        match &mut self.resident {
-            Some(r)
-                if r.version.topology == version.topology
-                    && r.vertices.count == mesh.vertex_count()
-                    && r.layer_count == mesh.layer_count() =>
-            {
-                if r.version.positions != version.positions {
-                    // Moved by something that did not say what: send everything, and file
-                    // the vertices anew (how far they went is unknown).
-                    let positions = bytemuck::cast_slice(mesh.positions());
-                    gpu.queue.write_buffer(&r.vertices.positions, 0, positions);
-                    gpu.queue
-                        .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
-                    r.hashed = None;
-                }
-                if r.version.attributes != version.attributes {
-                    gpu.queue.write_buffer(
-                        &r.vertices.flags,
-                        0,
-                        bytemuck::cast_slice(&flag_bits(mesh)),
-                    );
-                }
-                r.version = version;
-            }
-            _ => {
-                gpu.check_budget(resident_bytes(mesh))?;
-                let layers = mesh.vertex_layers().to_vec();
-                let vertices =
-                    VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
-                let (offsets, neighbours) = smoothing_neighbours(mesh);
-                gpu.check_binding::<u32>("smoothing neighbours", neighbours.len())?;
-                self.resident = Some(Resident {
-                    version,
-                    normals: gpu.storage_buffer("normals", mesh.normals(), true),
-                    neighbour_offsets: gpu.storage_buffer("neighbour offsets", &offsets, false),
-                    neighbours: gpu.storage_buffer("neighbours", &neighbours, false),
-                    selection: GpuSelection::new(gpu, mesh.vertex_count().max(1))?,
-                    topology: None,
-                    marks: gpu.output_buffer::<u32>("proximity marks", mesh.vertex_count()),
-                    hashed: None,
-                    layer_count: mesh.layer_count(),
-                    vertices,
-                });
-            }
-        }
-        Ok(())
-    }
-
-    /// Syncs the resident mesh with `mesh` and makes its hash table fresh enough for `cell`
-    /// sized cells (rebuilt when missing or drifted too far).
-    fn prepare(&mut self, mesh: &Mesh, cell: f32) -> Result<(), GpuError> {
-        self.check_injected_failure()?;
-        self.sync(mesh)?;
-        let gpu = &self.gpu;
-        let Some(r) = self.resident.as_mut() else {
-            return Ok(());
-        };
+    /// Brings the GPU copy up to date with `mesh` and makes its hash table fresh enough for
+    /// `cell` sized cells (rebuilt when missing or drifted too far). A free function of the
+    /// fields it needs, so that callers keep the step buffers borrowed beside what it returns.
+    fn prepare<'a>(
+        gpu: &GpuContext,
+        resident: &'a mut Option<Resident>,
+        mesh: &Mesh,
+        cell: f32,
+    ) -> Result<&'a mut Resident, GpuError> {
+        let r = GpuKernels::sync(gpu, resident, mesh)?;
         let stale = r.hashed.as_ref().is_none_or(|h| {
             h.drift > DRIFT_LIMIT_CELLS * cell || h.table.inv_cell_size != 1.0 / cell
         });
@@ -253,7 +233,43 @@ impl GpuKernels {
                 drift: 0.0,
             });
         }
-        Ok(())
+        Ok(r)
+    }
+
+    /// Brings the GPU copy up to date with `mesh`.
+    fn sync<'a>(
+        gpu: &GpuContext,
+        resident: &'a mut Option<Resident>,
+        mesh: &Mesh,
+    ) -> Result<&'a mut Resident, GpuError> {
+        let version = mesh.version();
+        let fits = resident.as_ref().is_some_and(|r| {
+            r.version.topology == version.topology
+                && r.vertices.count == mesh.vertex_count()
+                && r.layer_count == mesh.layer_count()
+        });
+        if !fits {
+            let fresh = Resident::upload(gpu, mesh)?;
+            return Ok(resident.insert(fresh));
+        }
+        let Some(r) = resident.as_mut() else {
+            unreachable!("a mesh that fits is resident");
+        };
+        if r.version.positions != version.positions {
+            // Moved by something that did not say what: send everything, and file the
+            // vertices anew (how far they went is unknown).
+            let positions = bytemuck::cast_slice(mesh.positions());
+            gpu.queue.write_buffer(&r.vertices.positions, 0, positions);
+            gpu.queue
+                .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
+            r.hashed = None;
+        }
+        if r.version.attributes != version.attributes {
+            gpu.queue
+                .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(&flag_bits(mesh)));
+        }
+        r.version = version;
+        Ok(r)
     }
 
     fn gpu_select(
@@ -262,16 +278,11 @@ impl GpuKernels {
         mesh: &Mesh,
         dab: &Dab,
     ) -> Result<Vec<(u32, f32)>, GpuError> {
-        let cell = cell_size(state);
-        let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
-        self.prepare(mesh, cell)?;
+        self.check_injected_failure()?;
         let gpu = &self.gpu;
-        let Some(r) = self.resident.as_mut() else {
-            return Ok(Vec::new());
-        };
-        let Some(hashed) = r.hashed.as_ref() else {
-            return Ok(Vec::new());
-        };
+        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
+        let hashed = r.hashed();
+        let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
         let active = gpu.storage_buffer("active layers", &active, false);
         let mut encoder = gpu.encoder("select");
         record_select(
@@ -292,32 +303,12 @@ impl GpuKernels {
             },
             &r.selection,
         )?;
-        // The count and a guess of the list in one read-back (twice the last selection: brushes
-        // change size slowly); the rest, if the guess was short, in a second.
-        let entry = std::mem::size_of::<SelectedVertex>() as u64;
-        let guess = (2 * self.last_selection).clamp(256, r.selection.capacity);
-        let staging = &mut self.step.readback;
-        staging.reserve(gpu, entry * (guess as u64 + 1))?;
-        encoder.copy_buffer_to_buffer(&r.selection.count, 0, staging.buffer(), 0, 4);
-        encoder.copy_buffer_to_buffer(
-            &r.selection.selected,
-            0,
-            staging.buffer(),
-            entry,
-            entry * guess as u64,
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = gpu.map_read(staging.buffer())?;
-        let count = (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize)
-            .min(r.selection.capacity);
-        let head = count.min(guess);
-        let mut list: Vec<SelectedVertex> =
-            bytemuck::pod_collect_to_vec(&bytes[entry as usize..entry as usize * (head + 1)]);
-        if count > head {
-            let all: Vec<SelectedVertex> = gpu.read_buffer(&r.selection.selected, count)?;
-            list.extend_from_slice(&all[head..]);
-        }
-        self.last_selection = count;
+        // Twice the last selection: brushes change size slowly.
+        let guess = (2 * self.last_selection).max(SELECTION_GUESS);
+        let list = r
+            .selection
+            .submit_and_read(gpu, encoder, &mut self.step.readback, guess)?;
+        self.last_selection = list.len();
         let mut selected: Vec<(u32, f32)> =
             list.into_iter().map(|s| (s.vertex, s.weight)).collect();
         // The kernel appends in whatever order its threads ran; the pipeline sums in vertex
@@ -336,11 +327,9 @@ impl GpuKernels {
         if selection.is_empty() {
             return Ok(Vec::new());
         }
-        self.prepare(mesh, cell_size(state))?;
+        self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
-        let Some(r) = self.resident.as_mut() else {
-            return Ok(Vec::new());
-        };
+        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
         let entries: Vec<SelectedVertex> = selection
             .iter()
             .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
@@ -393,17 +382,16 @@ impl GpuKernels {
         if selection.is_empty() {
             return Ok(Vec::new());
         }
-        self.prepare(mesh, cell_size(state))?;
+        self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
-        let Some(r) = self.resident.as_mut() else {
-            return Ok(Vec::new());
-        };
+        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
         if r.topology.is_none() {
             let packed = PackedTopology::of(mesh);
             r.topology = Some((packed.upload(gpu)?, packed.vertex_faces_base));
         }
-        let (Some((topology, vertex_faces_base)), Some(hashed)) = (&r.topology, &r.hashed) else {
-            return Ok(Vec::new());
+        let hashed = r.hashed();
+        let Some((topology, vertex_faces_base)) = &r.topology else {
+            unreachable!("uploaded just above");
         };
         let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         let (moving, rings) = moving_vertices(mesh, &vertices, before, state.ring);
@@ -411,37 +399,30 @@ impl GpuKernels {
         step.moving.upload(gpu, &moving)?;
         step.rings.upload(gpu, &rings)?;
         step.targets.upload(gpu, targets)?;
-        // Zeroed: every pass folds its amounts into zeros (`apply_moves` consumes them).
-        step.pulls.upload(gpu, &vec![0u32; count])?;
+        // No upload: `apply_moves` zeroes each entry's amount when it places the targets.
+        step.pulls
+            .reserve(gpu, (count * std::mem::size_of::<u32>()) as u64)?;
         let bytes = (count * std::mem::size_of::<Vec3>()) as u64;
         step.finals.reserve(gpu, bytes)?;
 
-        let step_move = before
-            .iter()
-            .zip(targets)
-            .map(|(p, q)| p.distance(*q))
-            .fold(0.0f32, f32::max);
-        let (cell_reach, vertex_reach) = proximity_reaches(
-            state.collision_distance,
-            state.max_edge,
-            hashed.drift + step_move,
+        let step_move = crate::geom::largest_move(before, targets);
+        let first = pass_params(
+            (
+                state.collision_distance,
+                state.max_edge,
+                hashed.drift + step_move,
+            ),
+            hashed.table.inv_cell_size,
+            hashed.table.table_size,
+            count,
+            *vertex_faces_base,
         );
-        let inv_cell_size = hashed.table.inv_cell_size;
-        let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
         let params = |all_faces: bool| ProximityParams {
-            distance: state.collision_distance,
-            cell_reach,
-            vertex_reach,
-            inv_cell_size,
-            table_mask: hashed.table.table_size - 1,
-            count: count as u32,
-            vertex_faces_base: *vertex_faces_base,
             all_faces: all_faces as u32,
-            span,
-            cells_per_entry: cells,
+            ..first
         };
         check_invocations(&params(true))?;
-        let invocations = count * cells as usize;
+        let invocations = count * first.cells_per_entry as usize;
         let proximity = ProximityBuffers {
             positions: &r.vertices.positions,
             offsets: &hashed.table.offsets,
@@ -535,9 +516,7 @@ impl GpuKernels {
         let Some(r) = self.resident.as_mut() else {
             return;
         };
-        let mut rows = vertices.to_vec();
-        rows.sort_unstable();
-        upload_rows(&self.gpu, &r.vertices.positions, mesh.positions(), &rows);
+        upload_rows(&self.gpu, &r.vertices.positions, mesh.positions(), vertices);
         if let Some(h) = r.hashed.as_mut() {
             h.drift += max_move;
         }

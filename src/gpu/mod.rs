@@ -39,13 +39,13 @@ pub use layout::{
 };
 pub use proximity::{
     PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,
-    moving_vertices, proximity_params, proximity_reaches, record_proximity, run_proximity,
-    verdicts,
+    moving_vertices, pass_params, proximity_params, proximity_reaches, record_proximity,
+    run_proximity, verdicts,
 };
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
-    BrushSphere, GpuSelection, HashedVertices, falloff_code, record_select, run_select,
-    select_params,
+    BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, falloff_code, record_select,
+    run_select, select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology};
 pub use vertex_normals::{record_vertex_normals, run_vertex_normals};

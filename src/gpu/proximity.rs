@@ -203,18 +203,40 @@ pub fn proximity_params(
         .iter()
         .map(|&v| positions[v as usize].distance(query.current[v as usize]))
         .fold(0.0f32, f32::max);
-    let (cell_reach, vertex_reach) = proximity_reaches(query.distance, query.max_edge, max_move);
-    let inv_cell_size = 1.0 / query.cell_size;
+    ProximityParams {
+        all_faces: query.marks.is_none() as u32,
+        ..pass_params(
+            (query.distance, query.max_edge, max_move),
+            1.0 / query.cell_size,
+            table_size,
+            query.selection.len(),
+            vertex_faces_base,
+        )
+    }
+}
+
+/// The parameters of a first pass (every face) over `count` entries, for collision distance,
+/// edge bound and move bound `(distance, max_edge, max_move)` as [`proximity_reaches`] takes
+/// them, a table of `table_size` buckets of `1 / inv_cell_size` cells, and topology rows from
+/// `vertex_faces_base`.
+pub fn pass_params(
+    (distance, max_edge, max_move): (f32, f32, f32),
+    inv_cell_size: f32,
+    table_size: u32,
+    count: usize,
+    vertex_faces_base: u32,
+) -> ProximityParams {
+    let (cell_reach, vertex_reach) = proximity_reaches(distance, max_edge, max_move);
     let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
     ProximityParams {
-        distance: query.distance,
+        distance,
         cell_reach,
         vertex_reach,
         inv_cell_size,
         table_mask: table_size - 1,
-        count: query.selection.len() as u32,
+        count: count as u32,
         vertex_faces_base,
-        all_faces: query.marks.is_none() as u32,
+        all_faces: 1,
         span,
         cells_per_entry: cells,
     }

@@ -78,8 +78,9 @@ impl ReusableBuffer {
     }
 }
 
-/// Uploads the rows of `data` listed in `rows` (sorted) into `buffer`, one write per run of
-/// consecutive rows: a step's moved vertices are a few runs of the vertex order.
+/// Uploads the rows of `data` listed in `rows` into `buffer`, one write per run of consecutive
+/// rows: a step's moved vertices, listed in ascending order, are a few runs of the vertex order.
+/// Unsorted rows are uploaded all the same, in more writes.
 pub fn upload_rows<T: Pod>(gpu: &GpuContext, buffer: &wgpu::Buffer, data: &[T], rows: &[u32]) {
     let size = std::mem::size_of::<T>() as u64;
     let mut i = 0;
@@ -87,7 +88,7 @@ pub fn upload_rows<T: Pod>(gpu: &GpuContext, buffer: &wgpu::Buffer, data: &[T], 
         let start = rows[i] as usize;
         let mut end = start + 1;
         i += 1;
-        while i < rows.len() && rows[i] as usize <= end {
+        while i < rows.len() && (start..=end).contains(&(rows[i] as usize)) {
             end = end.max(rows[i] as usize + 1);
             i += 1;
         }

@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::reusable::ReusableBuffer;
 use super::{
     GpuContext, GpuError, GpuHashTable, SelectParams, SelectedVertex, VertexBuffers, table_size_for,
 };
@@ -10,6 +11,9 @@ use crate::brush::Falloff;
 use crate::grid::cell_coordinates;
 
 const WORKGROUP_SIZE: u32 = 64;
+
+/// Entries read back with the count when nothing better is known.
+pub const SELECTION_GUESS: usize = 256;
 
 /// Where a brush is and how its effect fades: all selection needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,10 +97,41 @@ impl GpuSelection {
         })
     }
 
-    /// The selected vertices, in the order the kernel appended them.
-    pub fn read(&self, gpu: &GpuContext) -> Result<Vec<SelectedVertex>, GpuError> {
-        let count = gpu.read_buffer::<u32>(&self.count, 1)?[0] as usize;
-        gpu.read_buffer(&self.selected, count.min(self.capacity))
+    /// Submits `encoder`, which recorded a selection into these buffers, with copies of the
+    /// count and the first `guess` entries into `staging`, and reads them back in one map; a
+    /// longer list costs a second read. Each blocking read-back is milliseconds on lavapipe:
+    /// reading the count, then the list, was most of the GPU path's selection time.
+    /// The entries come in the order the kernel appended them.
+    pub fn submit_and_read(
+        &self,
+        gpu: &GpuContext,
+        mut encoder: wgpu::CommandEncoder,
+        staging: &mut ReusableBuffer,
+        guess: usize,
+    ) -> Result<Vec<SelectedVertex>, GpuError> {
+        let entry = std::mem::size_of::<SelectedVertex>() as u64;
+        let guess = guess.min(self.capacity);
+        staging.reserve(gpu, entry * (guess as u64 + 1))?;
+        encoder.copy_buffer_to_buffer(&self.count, 0, staging.buffer(), 0, 4);
+        encoder.copy_buffer_to_buffer(
+            &self.selected,
+            0,
+            staging.buffer(),
+            entry,
+            entry * guess as u64,
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = gpu.map_read(staging.buffer())?;
+        let count = (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize)
+            .min(self.capacity);
+        let head = count.min(guess);
+        let mut list: Vec<SelectedVertex> =
+            bytemuck::pod_collect_to_vec(&bytes[entry as usize..entry as usize * (head + 1)]);
+        if count > head {
+            let all: Vec<SelectedVertex> = gpu.read_buffer(&self.selected, count)?;
+            list.extend_from_slice(&all[head..]);
+        }
+        Ok(list)
     }
 }
 
@@ -173,11 +208,7 @@ pub fn run_select(
         positions.len(),
         "one hashed position per vertex"
     );
-    let drift = hashed
-        .iter()
-        .zip(positions)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
+    let drift = crate::geom::largest_move(hashed, positions);
     let filed = VertexBuffers::upload(gpu, hashed, layers, flags)?;
     let vertices = VertexBuffers::upload(gpu, positions, layers, flags)?;
     let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
@@ -207,6 +238,6 @@ pub fn run_select(
         brush,
         &selection,
     )?;
-    gpu.queue.submit([encoder.finish()]);
-    selection.read(gpu)
+    let mut staging = ReusableBuffer::readback("selection read-back");
+    selection.submit_and_read(gpu, encoder, &mut staging, SELECTION_GUESS)
 }

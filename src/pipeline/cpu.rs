@@ -14,6 +14,7 @@ use super::{
 };
 use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
+use crate::geom::largest_move;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, MeshVersion};
 use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
@@ -446,13 +447,9 @@ impl SculptPipeline for CpuPipeline {
                     .filter(|((_, p), q)| p != q)
                     .map(|((&(v, _), _), _)| v)
                     .collect();
-                let longest_move = before
-                    .iter()
-                    .zip(&outcome.positions)
-                    .map(|(p, q)| p.distance(*q))
-                    .fold(0.0f32, f32::max);
                 let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
-                self.kernels.moved(mesh, &selected, longest_move);
+                let step_move = largest_move(&before, &outcome.positions);
+                self.kernels.moved(mesh, &selected, step_move);
                 let mut moved_faces: Vec<u32> =
                     moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
                 moved_faces.sort_unstable();

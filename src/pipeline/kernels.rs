@@ -49,10 +49,10 @@ pub trait StepKernels: Send {
     ) {
         clamp_moves(state, region, mesh, selection, targets, before);
     }
-    /// The pipeline has finished moving `vertices` (each by at most `max_move` since the
-    /// kernels last saw it): kernels that keep a copy of the positions bring it up to date.
+    /// The pipeline has finished moving `vertices` (ascending; each by at most `max_move` since
+    /// the kernels last saw it): kernels that keep a copy of the positions bring it up to date.
     fn moved(&mut self, _mesh: &Mesh, _vertices: &[u32], _max_move: f32) {}
-    /// The pipeline recomputed the normals of `vertices`.
+    /// The pipeline recomputed the normals of `vertices` (ascending).
     fn normals_changed(&mut self, _mesh: &Mesh, _vertices: &[u32]) {}
 }
 
