@@ -156,3 +156,61 @@ fn a_mesh_over_the_gpu_budget_runs_on_the_cpu() {
     assert!(failure.contains("budget"), "{failure}");
     assert_eq!(mesh.positions(), on_cpu.positions());
 }
+
+/// An adapter whose storage bindings are a few KiB: the packed topology and the smoothing
+/// neighbours are bound as several pages, and the strokes give the CPU's result.
+#[test]
+fn arrays_past_the_binding_limit_are_split_into_pages() {
+    let (start, strokes) = plaster_and_strokes(2);
+    let settings = PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    };
+    let vertices = start.vertex_count() as u64;
+    let topology = 4 * slayer::gpu::PackedTopology::of(&start).words.len() as u64;
+    let neighbours = 4 * slayer::gpu::smoothing_neighbours(&start).1.len() as u64;
+    // Large enough for every array bound whole (12 bytes a vertex at most, and the hash
+    // table's offsets) and for the paged ones in four pages.
+    let whole =
+        (12 * vertices).max(4 * (slayer::gpu::table_size_for(start.vertex_count()) as u64 + 1));
+    let limit = whole
+        .max(topology.div_ceil(slayer::gpu::PAGE_COUNT))
+        .next_power_of_two();
+    let gpu = GpuContext::with_limits(
+        AdapterChoice {
+            allow_software: true,
+        },
+        |limits| limits.max_storage_buffer_binding_size = limit,
+    )
+    .unwrap();
+    let (topology_pages, neighbour_pages) = (
+        gpu.pages_for(topology as usize / 4),
+        gpu.pages_for(neighbours as usize / 4),
+    );
+    eprintln!(
+        "binding limit {limit} bytes: topology {topology} bytes in {topology_pages} pages, \
+         neighbours {neighbours} bytes in {neighbour_pages}"
+    );
+    assert!(
+        topology_pages >= 2 && neighbour_pages >= 1,
+        "paging is exercised"
+    );
+
+    let mut on_cpu = start.clone();
+    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut kernels = GpuKernels::new(gpu);
+    kernels.set_proximity_on_gpu(true);
+    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut mesh = start.clone();
+    let gpu_collisions = run(&mut pipeline, &mut mesh, &strokes);
+    assert_eq!(pipeline.kernel_failure(), None);
+    let deviation = on_cpu
+        .positions()
+        .iter()
+        .zip(mesh.positions())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
+    assert_eq!(cpu_collisions, gpu_collisions);
+    assert!(cpu_collisions > 0, "the strokes collide");
+}

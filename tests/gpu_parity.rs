@@ -24,6 +24,37 @@ fn gpu() -> GpuContext {
     gpu
 }
 
+/// An adapter whose device enforces storage bindings of `bytes` at most, so that the arrays
+/// the kernels page (topology, smoothing neighbours) span several bindings.
+fn gpu_with_binding_limit(bytes: u64) -> GpuContext {
+    let gpu = GpuContext::with_limits(
+        AdapterChoice {
+            allow_software: true,
+        },
+        |limits| limits.max_storage_buffer_binding_size = bytes,
+    )
+    .unwrap_or_else(|e| panic!("GPU tests need an adapter (run tools/test.sh): {e}"));
+    assert_eq!(gpu.page_bytes(), bytes, "a power of two is its own page");
+    gpu
+}
+
+/// The smallest power-of-two binding limit that holds `unpaged` bytes (the largest array bound
+/// whole) and each of `paged` in four pages, checked to split the first over two or more.
+fn binding_limit_paging(unpaged: u64, paged: &[u64]) -> u64 {
+    let largest = paged.iter().copied().max().unwrap_or(0);
+    let limit = unpaged
+        .max(largest.div_ceil(slayer::gpu::PAGE_COUNT))
+        .next_power_of_two()
+        .max(256);
+    let pages: Vec<u64> = paged.iter().map(|bytes| bytes.div_ceil(limit)).collect();
+    assert!(
+        pages[0] >= 2,
+        "{paged:?} bytes in pages of {limit}: {pages:?} pages"
+    );
+    eprintln!("binding limit {limit} bytes: {paged:?} bytes paged over {pages:?} bindings");
+    limit
+}
+
 /// Awkward sizes around the 64-wide workgroup, plus a large odd one.
 const SIZES: [usize; 7] = [0, 1, 63, 64, 65, 1000, 512 * 16 + 123];
 
@@ -689,11 +720,28 @@ fn worst_relative(a: &[Vec3], b: &[Vec3], radius: f32) -> f32 {
 
 #[test]
 fn deform_matches_cpu_mirror_and_the_brush_fields() {
+    check_deform(Binding::Whole);
+}
+
+#[test]
+fn deform_reads_neighbours_split_over_several_bindings() {
+    check_deform(Binding::Paged);
+}
+
+fn check_deform(binding: Binding) {
     // Every deforming brush, alternately inverted, over the falloffs; each on the full
     // selection (a large odd size) and on a prefix of an awkward size. The mirror is checked
     // against `pipeline::step::deform` (src/brush/field.rs), the GPU against the mirror.
-    let mut gpu = gpu();
     let mesh = bumpy_sheets();
+    let mut gpu = match binding {
+        Binding::Whole => gpu(),
+        Binding::Paged => {
+            // Whole: positions, normals and targets, 12 bytes a vertex at most.
+            let unpaged = 12 * mesh.vertex_count() as u64;
+            let neighbours = smoothing_neighbours(&mesh).1.len() as u64 * 4;
+            gpu_with_binding_limit(binding_limit_paging(unpaged, &[neighbours]))
+        }
+    };
     let grid = SpatialHash::build(&mesh, 0.05).unwrap();
     let active = [true, false, true];
     let state = slayer::pipeline::step::StrokeState {
@@ -1019,13 +1067,46 @@ fn compare_pulled(
 /// Both Jacobi passes of proximity on `scene` at awkward selection sizes (the largest folds its
 /// dispatch into two dimensions): the mirror against `pull_back`, the GPU against the mirror;
 /// then a second pass that tests only the faces of the vertices the first pulled back.
-fn check_proximity(scene: ProximityScene) {
-    let mut gpu = gpu();
+/// How a proximity check binds the packed topology.
+#[derive(Clone, Copy, PartialEq)]
+enum Binding {
+    /// Whole, as the adapter's limits allow.
+    Whole,
+    /// Split over several bindings by a lowered binding limit.
+    Paged,
+}
+
+fn check_proximity(scene: ProximityScene, binding: Binding) {
     let (distance, ring) = (0.05, 2);
     let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);
     let all = scene.order.len();
     let large_odd = if all >= 4001 { 4001 } else { all | 1 };
     let sizes = [0, 1, 63, 64, 65, 1000.min(all), large_odd.min(all)];
+    let mut gpu = match binding {
+        Binding::Whole => gpu(),
+        Binding::Paged => {
+            // Whole: positions, the hash table, the largest selection's entries. Paged: the
+            // topology and the exclusion rings.
+            let largest = &scene.order[..sizes[sizes.len() - 1]];
+            let starts: Vec<Vec3> = largest
+                .iter()
+                .map(|&v| scene.mesh.positions()[v as usize])
+                .collect();
+            let (moving, rings) = slayer::gpu::moving_vertices(&scene.mesh, largest, &starts, ring);
+            let vertices = scene.mesh.vertex_count() as u64;
+            let unpaged = [
+                12 * vertices,
+                4 * (table_size_for(scene.mesh.vertex_count()) as u64 + 1),
+                std::mem::size_of_val(moving.as_slice()) as u64,
+            ];
+            let topology = slayer::gpu::PackedTopology::of(&scene.mesh).words.len() as u64 * 4;
+            let limit = binding_limit_paging(
+                unpaged.into_iter().max().unwrap(),
+                &[topology, 4 * rings.len() as u64],
+            );
+            gpu_with_binding_limit(limit)
+        }
+    };
     for (k, &size) in sizes.iter().enumerate() {
         let label = format!("{} at size {size}", scene.name);
         gpu.limits.max_compute_workgroups_per_dimension =
@@ -1101,19 +1182,29 @@ fn check_proximity(scene: ProximityScene) {
         ));
     }
     eprintln!(
-        "proximity, {}: largest deviation mirror vs pull_back {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× edge)",
-        scene.name
+        "proximity, {}{}: largest deviation mirror vs pull_back {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× edge)",
+        scene.name,
+        if binding == Binding::Paged {
+            ", topology paged"
+        } else {
+            ""
+        }
     );
 }
 
 #[test]
 fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_pressed_sheets() {
-    check_proximity(pressed_sheets());
+    check_proximity(pressed_sheets(), Binding::Whole);
 }
 
 #[test]
 fn proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_a_folded_sheet() {
-    check_proximity(folded_sheet());
+    check_proximity(folded_sheet(), Binding::Whole);
+}
+
+#[test]
+fn proximity_reads_a_topology_split_over_several_bindings() {
+    check_proximity(pressed_sheets(), Binding::Paged);
 }
 
 /// Normals may differ by this much (unit vectors): the GPU may fuse the cross products'
@@ -1122,12 +1213,29 @@ const NORMAL_TOLERANCE: f32 = 1e-6;
 
 #[test]
 fn vertex_normals_match_cpu_mirror_and_the_mesh() {
+    check_vertex_normals(Binding::Whole);
+}
+
+#[test]
+fn vertex_normals_read_a_topology_split_over_several_bindings() {
+    check_vertex_normals(Binding::Paged);
+}
+
+fn check_vertex_normals(binding: Binding) {
     // Bumpy sheets (boundaries included) with their positions moved after the normals were
     // last computed; a seeded shuffle of the vertices at awkward sizes, the largest folded
     // into two dimensions. The mirror against `Mesh::recompute_normals_at`, the GPU against
     // the mirror; unlisted normals must stay as they were.
-    let mut gpu = gpu();
     let mut mesh = bumpy_sheets();
+    let mut gpu = match binding {
+        Binding::Whole => gpu(),
+        Binding::Paged => {
+            // Whole: positions and normals, 12 bytes a vertex.
+            let unpaged = 12 * mesh.vertex_count() as u64;
+            let topology = slayer::gpu::PackedTopology::of(&mesh).words.len() as u64 * 4;
+            gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
+        }
+    };
     let mut rng = ChaCha8Rng::seed_from_u64(600);
     for p in mesh.positions_mut() {
         p.z += rng.random_range(-0.01..0.01);

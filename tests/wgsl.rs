@@ -398,3 +398,69 @@ fn proximity_and_normal_structs_match_naga_layout() {
         }
     );
 }
+
+#[test]
+fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
+    // A kernel with paged arrays has PAGE_COUNT read-only bindings in each bind group past 0
+    // (the host binds that many per array, groups 1, 2, … in order) and the override the host
+    // sets when it compiles the kernel.
+    let expected_groups = [("proximity", 2), ("vertex_normals", 1), ("deform", 1)];
+    for (kernel, _) in KERNELS {
+        let source = kernel_source(kernel).unwrap();
+        let (module, _) = validate(kernel, &source).unwrap();
+        let mut pages: Vec<(u32, u32)> = module
+            .global_variables
+            .iter()
+            .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b, g.space)))
+            .filter(|(b, _)| b.group > 0)
+            .map(|(b, space)| {
+                assert_eq!(
+                    space,
+                    naga::AddressSpace::Storage {
+                        access: naga::StorageAccess::LOAD
+                    },
+                    "{kernel}: pages are read-only storage"
+                );
+                (b.group, b.binding)
+            })
+            .collect();
+        pages.sort();
+        let overrides: Vec<&str> = module
+            .overrides
+            .iter()
+            .filter_map(|(_, o)| o.name.as_deref())
+            .collect();
+        let groups = expected_groups
+            .iter()
+            .find(|(k, _)| k == kernel)
+            .map_or(0, |&(_, g)| g);
+        let expected: Vec<(u32, u32)> = (1..=groups)
+            .flat_map(|g| (0..slayer::gpu::PAGE_COUNT as u32).map(move |b| (g, b)))
+            .collect();
+        assert_eq!(pages, expected, "{kernel}: page bindings");
+        if groups > 0 {
+            assert_eq!(overrides, [slayer::gpu::PAGE_SHIFT_CONSTANT], "{kernel}");
+        } else {
+            assert!(overrides.is_empty(), "{kernel}: {overrides:?}");
+        }
+    }
+}
+
+#[test]
+fn paged_declarations_are_checked() {
+    for bad in [
+        "#paged",
+        "#paged name",
+        "#paged name 0",
+        "#paged 9name 1",
+        "#paged a b 1",
+    ] {
+        let error = expand_imports("x", bad).unwrap_err();
+        assert!(
+            error.to_string().contains("#paged NAME GROUP"),
+            "{bad}: {error}"
+        );
+    }
+    let error = expand_imports("x", "#import shared/paged_array").unwrap_err();
+    assert!(error.to_string().contains("#paged"), "{error}");
+}

@@ -6,6 +6,8 @@
 
 #import shared/grid
 #import shared/brush
+#import shared/pages
+#paged neighbour 1
 
 struct DeformParams {
     center: vec3<f32>,
@@ -40,12 +42,14 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(2) var<storage, read> normals: array<f32>;
 @group(0) @binding(3) var<storage, read> selected: array<SelectedVertex>;
 @group(0) @binding(4) var<storage, read> selection_count: u32;
-// Smooth's neighbours, CSR: vertex v averages neighbours[neighbour_offsets[v]..[v + 1]] (its
-// one-ring in fan order; on a boundary only its two boundary neighbours).
+// Smooth's neighbours, CSR: vertex v averages neighbour(j) for j in
+// neighbour_offsets[v]..[v + 1] (its one-ring in fan order; on a boundary only its two
+// boundary neighbours).
 @group(0) @binding(5) var<storage, read> neighbour_offsets: array<u32>;
-@group(0) @binding(6) var<storage, read> neighbours: array<u32>;
 // Packed x, y, z per selection entry.
-@group(0) @binding(7) var<storage, read_write> targets: array<f32>;
+@group(0) @binding(6) var<storage, read_write> targets: array<f32>;
+// Paged (shared/pages.wgsl), group 1: `neighbour(j)`, the neighbour lists (about six words a
+// vertex: the largest per-vertex array).
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -59,7 +63,7 @@ fn ring_centroid(v: u32, p: vec3<f32>) -> vec3<f32> {
     }
     var sum = vec3<f32>(0.0);
     for (var j = start; j < end; j++) {
-        sum += position(neighbours[j]);
+        sum += position(neighbour(j));
     }
     return sum / f32(end - start);
 }

@@ -20,6 +20,9 @@
 #import shared/grid
 #import shared/geom
 #import shared/moves
+#import shared/pages
+#paged topology 1
+#paged ring_vertex 2
 
 struct ProximityParams {
     // Collision distance d.
@@ -56,16 +59,17 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
 @group(0) @binding(2) var<storage, read> offsets: array<u32>;
 @group(0) @binding(3) var<storage, read> entries: array<u32>;
-// Faces first, four words each (a, b, c, layer); then from vertex_faces_base the vertex→faces
-// rows: vertex_count + 1 absolute starts into this buffer, then the face ids.
-@group(0) @binding(4) var<storage, read> topology: array<u32>;
-@group(0) @binding(5) var<storage, read> moving: array<MovingVertex>;
-@group(0) @binding(6) var<storage, read> rings: array<u32>;
+@group(0) @binding(4) var<storage, read> moving: array<MovingVertex>;
 // Per vertex: nonzero when it was pulled back in the last pass, so that its faces changed
 // (the CPU's `changed` marks the faces around exactly those vertices).
-@group(0) @binding(7) var<storage, read> marks: array<u32>;
+@group(0) @binding(5) var<storage, read> marks: array<u32>;
 // Per entry: the largest pull-back amount found, 65536 − 65536·t; zero when not pulled.
-@group(0) @binding(8) var<storage, read_write> pulls: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> pulls: array<atomic<u32>>;
+// Paged (shared/pages.wgsl), group 1: `topology(i)`, the packed topology
+// (src/gpu/topology.rs): faces first, four words each (a, b, c, layer); then from
+// vertex_faces_base the vertex→faces rows: vertex_count + 1 absolute starts into the same
+// array, then the face ids. Group 2: `ring_vertex(r)`, the exclusion rings of the entries, one
+// after another (a moving vertex's ring can be some forty words: the largest per-entry array).
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -77,7 +81,7 @@ fn position(v: u32) -> vec3<f32> {
 fn touches_ring(entry: MovingVertex, a: u32, b: u32, c: u32) -> bool {
     var touches = false;
     for (var r = entry.ring_start; r < entry.ring_end; r++) {
-        let w = rings[r];
+        let w = ring_vertex(r);
         touches = touches || w == a || w == b || w == c;
     }
     return touches;
@@ -86,10 +90,10 @@ fn touches_ring(entry: MovingVertex, a: u32, b: u32, c: u32) -> bool {
 // The last safe fraction of the move against face f, or 1 when f does not constrain it.
 // One exit (no early returns): see `touches_ring` and shared/geom.wgsl.
 fn safe_fraction(entry: MovingVertex, f: u32, x: vec3<f32>) -> f32 {
-    let a = topology[4u * f];
-    let b = topology[4u * f + 1u];
-    let c = topology[4u * f + 2u];
-    let layer = topology[4u * f + 3u];
+    let a = topology(4u * f);
+    let b = topology(4u * f + 1u);
+    let c = topology(4u * f + 2u);
+    let layer = topology(4u * f + 3u);
     let v = entry.vertex;
     // Faces the last pass left alone, the vertex's own faces, and its own neighbourhood (near
     // by construction, not by collision) do not constrain it.
@@ -157,9 +161,9 @@ fn main(
             let u = entries[j];
             if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
                 let row = params.vertex_faces_base + u;
-                let last = topology[row + 1u];
-                for (var k = topology[row]; k < last; k++) {
-                    t = min(t, safe_fraction(entry, topology[k], x));
+                let last = topology(row + 1u);
+                for (var k = topology(row); k < last; k++) {
+                    t = min(t, safe_fraction(entry, topology(k), x));
                 }
             }
         }

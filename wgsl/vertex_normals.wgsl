@@ -6,6 +6,8 @@
 // CPU mirror: src/cpu/vertex_normals.rs.
 
 #import shared/grid
+#import shared/pages
+#paged topology 1
 
 struct NormalParams {
     // Vertices listed.
@@ -22,11 +24,11 @@ const MAX_F32: f32 = 3.40282347e38;
 
 @group(0) @binding(0) var<uniform> params: NormalParams;
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
-// src/gpu/topology.rs: faces as (a, b, c, layer), then the vertex→faces rows.
-@group(0) @binding(2) var<storage, read> topology: array<u32>;
-@group(0) @binding(3) var<storage, read> vertices: array<u32>;
+@group(0) @binding(2) var<storage, read> vertices: array<u32>;
 // Packed x, y, z per vertex of the mesh; only the listed ones are written.
-@group(0) @binding(4) var<storage, read_write> normals: array<f32>;
+@group(0) @binding(3) var<storage, read_write> normals: array<f32>;
+// Paged (shared/pages.wgsl), group 1: `topology(i)`, src/gpu/topology.rs: faces as
+// (a, b, c, layer), then the vertex→faces rows.
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -43,13 +45,13 @@ fn main(
     }
     let v = vertices[i];
     let row = params.vertex_faces_base + v;
-    let last = topology[row + 1u];
+    let last = topology(row + 1u);
     var sum = vec3<f32>(0.0);
-    for (var k = topology[row]; k < last; k++) {
-        let f = topology[k];
-        let a = position(topology[4u * f]);
-        let b = position(topology[4u * f + 1u]);
-        let c = position(topology[4u * f + 2u]);
+    for (var k = topology(row); k < last; k++) {
+        let f = topology(k);
+        let a = position(topology(4u * f));
+        let b = position(topology(4u * f + 1u));
+        let c = position(topology(4u * f + 2u));
         sum += cross(b - a, c - a);
     }
     // glam's try_normalize: the reciprocal of sqrt(dot) must be finite and positive.

@@ -31,13 +31,25 @@ pub enum GpuError {
     OverBudget { needed_mib: u64, budget_mib: u64 },
     #[error(
         "{what} needs {bytes} bytes in one storage binding; the adapter allows {limit} \
-         (chunking large meshes is not implemented yet)"
+         (the mesh is too large for this adapter's limits)"
     )]
     TooLarge {
         what: String,
         bytes: u64,
         limit: u64,
     },
+}
+
+/// How many workgroups a dispatch runs.
+#[derive(Debug, Clone, Copy)]
+pub enum Workgroups<'a> {
+    /// Enough to cover `invocations` threads (none for zero).
+    Cover {
+        invocations: usize,
+        workgroup_size: u32,
+    },
+    /// Read by the GPU from three `u32`s an earlier pass wrote (see `dispatch_args`).
+    Indirect(&'a wgpu::Buffer),
 }
 
 /// Which adapters may be used.
@@ -147,8 +159,20 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// Opens the best adapter allowed by `choice` (and by `WGPU_ADAPTER_NAME`, if set).
+    /// Opens the best adapter allowed by `choice` (and by `WGPU_ADAPTER_NAME`, if set), with
+    /// every limit the adapter offers.
     pub fn new(choice: AdapterChoice) -> Result<GpuContext, GpuError> {
+        GpuContext::with_limits(choice, |_| {})
+    }
+
+    /// As [`GpuContext::new`], with the device's limits lowered by `lower` first: the device
+    /// then enforces them, which is how tests check that large buffers are split to fit (say,
+    /// a storage binding of a few KiB instead of lavapipe's 128 MiB). Raising a limit past the
+    /// adapter's fails as `RequestDevice`.
+    pub fn with_limits(
+        choice: AdapterChoice,
+        lower: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<GpuContext, GpuError> {
         let instance = instance();
         let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         let pinned = std::env::var("WGPU_ADAPTER_NAME")
@@ -172,7 +196,8 @@ impl GpuContext {
         if summary.software && !choice.allow_software {
             return Err(GpuError::OnlySoftware(summary.to_string()));
         }
-        let limits = adapter.limits();
+        let mut limits = adapter.limits();
+        lower(&mut limits);
         let (device, queue) =
             pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("slayer"),
@@ -195,25 +220,33 @@ impl GpuContext {
     }
 
     /// A compute pipeline for kernel `name` (entry point `main`, layout from the shader),
-    /// compiled on first use and kept.
+    /// compiled on first use and kept. Kernels with a paged array (`shared/pages`) are
+    /// compiled for the page size the limits give now, and kept per page size.
     pub fn compute_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
+        let key = format!("{name}@{}", self.page_shift());
         let cached = self
             .pipelines
             .lock()
             .ok()
-            .and_then(|p| p.get(name).cloned());
+            .and_then(|p| p.get(&key).cloned());
         if let Some(pipeline) = cached {
             return Ok(pipeline);
         }
         let pipeline = self.compile_pipeline(name)?;
         if let Ok(mut pipelines) = self.pipelines.lock() {
-            pipelines.insert(name.to_string(), pipeline.clone());
+            pipelines.insert(key, pipeline.clone());
         }
         Ok(pipeline)
     }
 
     fn compile_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
         let source = super::shaders::kernel_source(name)?;
+        let page_shift = [(super::pages::PAGE_SHIFT_CONSTANT, self.page_shift() as f64)];
+        let constants: &[(&str, f64)] = if source.contains(super::pages::PAGE_SHIFT_CONSTANT) {
+            &page_shift
+        } else {
+            &[]
+        };
         // Validate with naga first: its messages carry source locations.
         super::shaders::validate(name, &source)?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -230,7 +263,10 @@ impl GpuContext {
                 layout: None,
                 module: &module,
                 entry_point: Some("main"),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
                 cache: None,
             });
         if let Some(error) = pollster::block_on(scope.pop()) {
@@ -377,7 +413,7 @@ impl GpuContext {
             return;
         }
         let (x, y) = self.dispatch_size(invocations, workgroup_size);
-        self.record_pass(encoder, pipeline, label, resources, |pass| {
+        self.record_pass(encoder, pipeline, label, resources, &[], |pass| {
             pass.dispatch_workgroups(x, y, 1)
         });
     }
@@ -392,9 +428,46 @@ impl GpuContext {
         resources: &[&wgpu::Buffer],
         args: &wgpu::Buffer,
     ) {
-        self.record_pass(encoder, pipeline, label, resources, |pass| {
+        self.record_pass(encoder, pipeline, label, resources, &[], |pass| {
             pass.dispatch_workgroups_indirect(args, 0)
         });
+    }
+
+    /// As [`GpuContext::record_dispatch`] (or `_indirect`) for a kernel with paged arrays
+    /// (see [`super::pages`]): `paged[k]` is bound page by page as bind group `k + 1`.
+    pub fn record_paged_dispatch(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        label: &str,
+        resources: &[&wgpu::Buffer],
+        paged: &[&wgpu::Buffer],
+        workgroups: Workgroups<'_>,
+    ) {
+        let pages: Vec<wgpu::BindGroup> = paged
+            .iter()
+            .enumerate()
+            .map(|(k, buffer)| self.page_bind_group(pipeline, k as u32 + 1, label, buffer))
+            .collect();
+        match workgroups {
+            Workgroups::Cover {
+                invocations,
+                workgroup_size,
+            } => {
+                if invocations == 0 {
+                    return;
+                }
+                let (x, y) = self.dispatch_size(invocations, workgroup_size);
+                self.record_pass(encoder, pipeline, label, resources, &pages, |pass| {
+                    pass.dispatch_workgroups(x, y, 1)
+                });
+            }
+            Workgroups::Indirect(args) => {
+                self.record_pass(encoder, pipeline, label, resources, &pages, |pass| {
+                    pass.dispatch_workgroups_indirect(args, 0)
+                });
+            }
+        }
     }
 
     fn record_pass(
@@ -403,6 +476,7 @@ impl GpuContext {
         pipeline: &wgpu::ComputePipeline,
         label: &str,
         resources: &[&wgpu::Buffer],
+        pages: &[wgpu::BindGroup],
         dispatch: impl FnOnce(&mut wgpu::ComputePass<'_>),
     ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
@@ -424,6 +498,9 @@ impl GpuContext {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
+        for (k, group) in pages.iter().enumerate() {
+            pass.set_bind_group(k as u32 + 1, group, &[]);
+        }
         dispatch(&mut pass);
     }
 

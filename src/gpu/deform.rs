@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::{DeformParams, GpuContext, GpuError, SelectedVertex};
+use super::{DeformParams, GpuContext, GpuError, SelectedVertex, Workgroups};
 use crate::brush::{BrushKind, Dab};
 use crate::mesh::{INVALID, Mesh, next};
 
@@ -75,6 +75,7 @@ pub struct DeformBuffers<'a> {
     /// One `u32`: the selection count (`GpuSelection::count`).
     pub selection_count: &'a wgpu::Buffer,
     pub neighbour_offsets: &'a wgpu::Buffer,
+    /// Paged.
     pub neighbours: &'a wgpu::Buffer,
 }
 
@@ -92,7 +93,7 @@ pub fn record_deform(
     let params = deform_params(dab, capacity);
     let pipeline = gpu.compute_pipeline("deform")?;
     let uniform = gpu.uniform_buffer("deform params", &params);
-    gpu.record_dispatch(
+    gpu.record_paged_dispatch(
         encoder,
         &pipeline,
         "deform",
@@ -103,11 +104,13 @@ pub fn record_deform(
             inputs.selected,
             inputs.selection_count,
             inputs.neighbour_offsets,
-            inputs.neighbours,
             targets,
         ],
-        capacity,
-        WORKGROUP_SIZE,
+        &[inputs.neighbours],
+        Workgroups::Cover {
+            invocations: capacity,
+            workgroup_size: WORKGROUP_SIZE,
+        },
     );
     Ok(())
 }
@@ -121,7 +124,7 @@ pub fn run_deform(
 ) -> Result<Vec<Vec3>, GpuError> {
     gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
     let (offsets, neighbours) = smoothing_neighbours(mesh);
-    gpu.check_binding::<u32>("smoothing neighbours", neighbours.len())?;
+    gpu.check_paged("smoothing neighbours", neighbours.len())?;
     let positions = gpu.storage_buffer("positions", mesh.positions(), false);
     let normals = gpu.storage_buffer("normals", mesh.normals(), false);
     let selected = gpu.storage_buffer("selected", selection, false);

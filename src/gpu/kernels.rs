@@ -77,7 +77,7 @@ impl Resident {
         let layers = mesh.vertex_layers().to_vec();
         let vertices = VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
         let (offsets, neighbours) = smoothing_neighbours(mesh);
-        gpu.check_binding::<u32>("smoothing neighbours", neighbours.len())?;
+        gpu.check_paged("smoothing neighbours", neighbours.len())?;
         Ok(Resident {
             version: mesh.version(),
             normals: gpu.storage_buffer("normals", mesh.normals(), true),
@@ -123,7 +123,7 @@ impl StepBuffers {
             selection_count: gpu.output_buffer::<u32>("selection count", 1),
             targets: ReusableBuffer::storage("targets"),
             moving: ReusableBuffer::storage("moving"),
-            rings: ReusableBuffer::storage("exclusion rings"),
+            rings: ReusableBuffer::paged("exclusion rings"),
             pulls: ReusableBuffer::storage("pull-back amounts"),
             finals: ReusableBuffer::storage("finals"),
             next_count: gpu.output_buffer::<u32>("next pass count", 1),

@@ -9,6 +9,7 @@ mod dispatch_args;
 mod hash_table;
 mod kernels;
 mod layout;
+mod pages;
 mod proximity;
 mod reusable;
 mod scan;
@@ -23,7 +24,8 @@ pub use apply_moves::{
 };
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{
-    AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, list_adapters,
+    AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, Workgroups,
+    list_adapters,
 };
 pub use deform::{
     DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
@@ -37,6 +39,7 @@ pub use layout::{
     ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
     NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
+pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};
 pub use proximity::{
     PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,
     moving_vertices, pass_params, proximity_params, proximity_reaches, record_proximity,

@@ -11,7 +11,7 @@
 use glam::Vec3;
 
 use super::{
-    GpuContext, GpuError, MovingVertex, PackedTopology, ProximityParams, PulledVertex,
+    GpuContext, GpuError, MovingVertex, PackedTopology, ProximityParams, PulledVertex, Workgroups,
     table_size_for,
 };
 use crate::collide::neighbourhood::ring_vertices;
@@ -110,9 +110,10 @@ pub struct ProximityBuffers<'a> {
     /// The hash table's `offsets` and `entries` (`GpuHashTable`).
     pub offsets: &'a wgpu::Buffer,
     pub entries: &'a wgpu::Buffer,
-    /// [`PackedTopology`] words.
+    /// [`PackedTopology`] words (paged).
     pub topology: &'a wgpu::Buffer,
     pub moving: &'a wgpu::Buffer,
+    /// Paged.
     pub rings: &'a wgpu::Buffer,
     /// Per-vertex marks; any buffer when `params.all_faces` is 1.
     pub marks: &'a wgpu::Buffer,
@@ -136,25 +137,25 @@ pub fn record_proximity(
         inputs.positions,
         inputs.offsets,
         inputs.entries,
-        inputs.topology,
         inputs.moving,
-        inputs.rings,
         inputs.marks,
         pulls,
     ];
-    match indirect {
-        Some(args) => {
-            gpu.record_dispatch_indirect(encoder, &pipeline, "proximity", &resources, args)
-        }
-        None => gpu.record_dispatch(
-            encoder,
-            &pipeline,
-            "proximity",
-            &resources,
-            params.count as usize * params.cells_per_entry as usize,
-            PROXIMITY_WORKGROUP_SIZE,
-        ),
-    }
+    let workgroups = match indirect {
+        Some(args) => Workgroups::Indirect(args),
+        None => Workgroups::Cover {
+            invocations: params.count as usize * params.cells_per_entry as usize,
+            workgroup_size: PROXIMITY_WORKGROUP_SIZE,
+        },
+    };
+    gpu.record_paged_dispatch(
+        encoder,
+        &pipeline,
+        "proximity",
+        &resources,
+        &[inputs.topology, inputs.rings],
+        workgroups,
+    );
     Ok(())
 }
 
@@ -263,7 +264,7 @@ pub fn run_proximity(
     let table_size = table_size_for(mesh.vertex_count());
     let params = proximity_params(query, topology.vertex_faces_base, table_size);
     check_invocations(&params)?;
-    gpu.check_binding::<u32>("exclusion rings", rings.len())?;
+    gpu.check_paged("exclusion rings", rings.len())?;
     let hashed = super::VertexBuffers::upload(
         gpu,
         mesh.positions(),

@@ -9,6 +9,8 @@ use super::{GpuContext, GpuError};
 pub struct ReusableBuffer {
     label: &'static str,
     usage: wgpu::BufferUsages,
+    /// Bound page by page (`super::pages`) rather than whole.
+    paged: bool,
     buffer: Option<wgpu::Buffer>,
 }
 
@@ -23,6 +25,14 @@ impl ReusableBuffer {
         )
     }
 
+    /// A storage buffer of `u32` words that kernels bind page by page (`super::pages`).
+    pub fn paged(label: &'static str) -> ReusableBuffer {
+        ReusableBuffer {
+            paged: true,
+            ..ReusableBuffer::storage(label)
+        }
+    }
+
     /// A buffer the host maps to read results back.
     pub fn readback(label: &'static str) -> ReusableBuffer {
         ReusableBuffer::with_usage(
@@ -35,6 +45,7 @@ impl ReusableBuffer {
         ReusableBuffer {
             label,
             usage,
+            paged: false,
             buffer: None,
         }
     }
@@ -46,11 +57,20 @@ impl ReusableBuffer {
         if self.buffer.as_ref().is_some_and(|b| b.size() >= bytes) {
             return Ok(());
         }
-        if self.usage.contains(wgpu::BufferUsages::STORAGE) {
+        let mut limit = gpu.limits.max_buffer_size;
+        if self.paged {
+            gpu.check_paged(self.label, bytes.div_ceil(4) as usize)?;
+        } else if self.usage.contains(wgpu::BufferUsages::STORAGE) {
             gpu.check_binding::<u8>(self.label, bytes as usize)?;
+            // It is bound whole: rounding up must not pass a binding's limit either.
+            limit = limit.min(gpu.limits.max_storage_buffer_binding_size);
         }
-        let limit = gpu.limits.max_buffer_size;
-        let size = bytes.next_power_of_two().min(limit.max(bytes)).div_ceil(4) * 4;
+        let size = bytes
+            .next_power_of_two()
+            .min(limit & !3)
+            .max(bytes)
+            .div_ceil(4)
+            * 4;
         self.buffer = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(self.label),
             size,

@@ -1,5 +1,8 @@
 //! WGSL sources, embedded in the binary. A line `#import shared/NAME` is replaced by
 //! `wgsl/shared/NAME.wgsl` (WGSL has no includes); sizes stay in WGSL `const`s, never pasted in.
+//! A line `#paged NAME GROUP` declares an array split over the bindings of bind group GROUP,
+//! read as `NAME(i)`: `wgsl/shared/paged_array.wgsl` with the name and group filled in (WGSL
+//! has no generics either; see `super::pages`).
 
 use thiserror::Error;
 
@@ -11,7 +14,15 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/brush", include_str!("../../wgsl/shared/brush.wgsl")),
     ("shared/geom", include_str!("../../wgsl/shared/geom.wgsl")),
     ("shared/moves", include_str!("../../wgsl/shared/moves.wgsl")),
+    ("shared/pages", include_str!("../../wgsl/shared/pages.wgsl")),
+    (
+        PAGED_ARRAY,
+        include_str!("../../wgsl/shared/paged_array.wgsl"),
+    ),
 ];
+
+/// The template `#paged` lines expand; not imported directly.
+const PAGED_ARRAY: &str = "shared/paged_array";
 
 /// Compute kernels, by file stem; each has entry point `main`.
 pub const KERNELS: &[(&str, &str)] = &[
@@ -51,6 +62,8 @@ pub enum ShaderError {
     UnknownRenderShader(String),
     #[error("{file}: unknown import `{import}`")]
     UnknownImport { file: String, import: String },
+    #[error("{file}: `{line}` should read `#paged NAME GROUP` (a WGSL name, a bind group above 0)")]
+    BadPaged { file: String, line: String },
     #[error("{file}: WGSL does not validate:\n{message}")]
     Invalid { file: String, message: String },
 }
@@ -73,12 +86,23 @@ pub fn render_source(name: &str) -> Result<String, ShaderError> {
     expand_imports(&format!("render/{name}"), text)
 }
 
-/// Replaces `#import` lines by the shared snippet they name (one level; snippets import nothing).
+/// Replaces `#import` lines by the shared snippet they name (one level; snippets import
+/// nothing), and `#paged` lines by the paged-array template filled in.
 pub fn expand_imports(file: &str, text: &str) -> Result<String, ShaderError> {
     let mut out = String::with_capacity(text.len() + 1024);
     for line in text.lines() {
-        if let Some(import) = line.trim().strip_prefix("#import ") {
+        let directive = line.split_whitespace().next();
+        if directive == Some("#paged") {
+            let declaration = line.trim().trim_start_matches("#paged");
+            out.push_str(&paged_array(file, declaration)?);
+        } else if let Some(import) = line.trim().strip_prefix("#import ") {
             let import = import.trim();
+            if import == PAGED_ARRAY {
+                return Err(ShaderError::UnknownImport {
+                    file: file.to_string(),
+                    import: format!("{import} (declare paged arrays with `#paged NAME GROUP`)"),
+                });
+            }
             let (_, snippet) = SHARED.iter().find(|(n, _)| *n == import).ok_or_else(|| {
                 ShaderError::UnknownImport {
                     file: file.to_string(),
@@ -92,6 +116,28 @@ pub fn expand_imports(file: &str, text: &str) -> Result<String, ShaderError> {
         out.push('\n');
     }
     Ok(out)
+}
+
+/// The template of `#paged NAME GROUP`, filled in.
+fn paged_array(file: &str, declaration: &str) -> Result<String, ShaderError> {
+    let bad = || ShaderError::BadPaged {
+        file: file.to_string(),
+        line: format!("#paged {declaration}"),
+    };
+    let mut words = declaration.split_whitespace();
+    let (Some(name), Some(group), None) = (words.next(), words.next(), words.next()) else {
+        return Err(bad());
+    };
+    let named = name.starts_with(|c: char| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !named || group.parse::<u32>().map_or(true, |g| g == 0) {
+        return Err(bad());
+    }
+    let (_, template) = SHARED
+        .iter()
+        .find(|(n, _)| *n == PAGED_ARRAY)
+        .expect("the template is registered");
+    Ok(template.replace("PAGE_GROUP", group).replace("PAGED", name))
 }
 
 /// Parses and validates WGSL with naga, reporting every error with its source location.

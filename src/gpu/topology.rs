@@ -1,7 +1,8 @@
 //! The mesh's connectivity packed into one `u32` buffer, the form the proximity and normal
-//! kernels read. One buffer rather than two or three keeps those kernels within the default
-//! eight storage buffers per stage, and the connectivity changes only when remeshing does, so
-//! it is uploaded once per stroke.
+//! kernels read. One buffer rather than two or three keeps those kernels within few storage
+//! bindings, and it is the one array those kernels page (`super::pages`) when it passes a
+//! binding's limit. The connectivity changes only when remeshing does, so it is uploaded once
+//! per stroke.
 //!
 //! Layout: face `f` is words `4f..4f + 4` = (a, b, c, layer), dead faces included so that face
 //! ids index directly. From `vertex_faces_base` on, the vertex→faces rows in CSR form:
@@ -51,9 +52,9 @@ impl PackedTopology {
         &self.words[self.words[row] as usize..self.words[row + 1] as usize]
     }
 
-    /// A read-only storage buffer of the words.
+    /// A read-only storage buffer of the words, bound page by page.
     pub fn upload(&self, gpu: &GpuContext) -> Result<wgpu::Buffer, GpuError> {
-        gpu.check_binding::<u32>("mesh topology", self.words.len())?;
+        gpu.check_paged("mesh topology", self.words.len())?;
         Ok(gpu.storage_buffer("mesh topology", &self.words, false))
     }
 }

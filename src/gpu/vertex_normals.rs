@@ -4,13 +4,13 @@
 
 use glam::Vec3;
 
-use super::{GpuContext, GpuError, NormalParams, PackedTopology};
+use super::{GpuContext, GpuError, NormalParams, PackedTopology, Workgroups};
 use crate::mesh::Mesh;
 
 const WORKGROUP_SIZE: u32 = 64;
 
 /// Records the pass rewriting the normals (packed x, y, z per vertex) of the first `count`
-/// entries of `vertices`, from `positions` and the packed topology.
+/// entries of `vertices`, from `positions` and the packed topology (paged).
 #[allow(clippy::too_many_arguments)]
 pub fn record_vertex_normals(
     gpu: &GpuContext,
@@ -30,13 +30,16 @@ pub fn record_vertex_normals(
     };
     let pipeline = gpu.compute_pipeline("vertex_normals")?;
     let uniform = gpu.uniform_buffer("vertex_normals params", &params);
-    gpu.record_dispatch(
+    gpu.record_paged_dispatch(
         encoder,
         &pipeline,
         "vertex_normals",
-        &[&uniform, positions, topology, vertices, normals],
-        count,
-        WORKGROUP_SIZE,
+        &[&uniform, positions, vertices, normals],
+        &[topology],
+        Workgroups::Cover {
+            invocations: count,
+            workgroup_size: WORKGROUP_SIZE,
+        },
     );
     Ok(())
 }

@@ -6,7 +6,7 @@ struct MovingVertex {
     start: vec3<f32>,
     vertex: u32,
     layer: u32,
-    // The vertex's exclusion ring (itself included) is rings[ring_start..ring_end].
+    // The vertex's exclusion ring (itself included) is words ring_start..ring_end of the rings array.
     ring_start: u32,
     ring_end: u32,
     _pad: u32,
