@@ -37,13 +37,43 @@ use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{MAX_PASSES, Region, StrokeState, clamp_moves};
 use crate::pipeline::{CpuKernels, StepKernels};
 
-/// The hash table is rebuilt once vertices may have drifted this many cells from where they
-/// were filed. Queries grow by the drift, and the proximity pass's work grows with the cube of
-/// its reach: on lavapipe (plaster, 20K faces, steps of one edge length) keeping the table for
-/// two steps made the passes 2.6 times dearer (22³ instead of 16³ cells per moving vertex)
-/// while a rebuild is four passes over the vertices. So in practice the table follows every
-/// step that moves vertices by half a cell or more; slow strokes keep it.
+/// The proximity passes rebuild the hash table once vertices may have drifted this many cells
+/// from where they were filed. Queries grow by the drift, and the passes' work grows with the
+/// cube of their reach: on lavapipe (plaster, 20K faces, steps of one edge length) keeping the
+/// table for two steps made the passes 2.6 times dearer (22³ instead of 16³ cells per moving
+/// vertex) while a rebuild is four passes over the vertices. So with the passes on the GPU the
+/// table follows every step that moves vertices by half a cell or more.
 const DRIFT_LIMIT_CELLS: f32 = 0.5;
+
+/// Selection alone tolerates a drift of this share of the brush radius: its box grows by at
+/// most half on each side (about twice the cells), while a rebuild passes over every vertex.
+/// Plaster at 16M faces on lavapipe, selection and deformation on the GPU: rebuilding at every
+/// half cell took 2,021 ms a sample (1.6 s a rebuild, nearly every step); without per-step
+/// rebuilds, 312 ms.
+const SELECT_DRIFT_SHARE: f32 = 0.25;
+
+/// How the caller uses the hash table, and so how stale it may be.
+#[derive(Debug, Clone, Copy)]
+enum TableUse {
+    /// Not at all (deformation): whatever table there is stays, stale or not.
+    None,
+    /// Brush selection with this radius.
+    Select { radius: f32 },
+    /// The proximity passes.
+    Proximity,
+}
+
+impl TableUse {
+    /// The drift (world units) past which the table is rebuilt first.
+    fn drift_limit(self, cell: f32) -> f32 {
+        let least = DRIFT_LIMIT_CELLS * cell;
+        match self {
+            TableUse::None => f32::INFINITY,
+            TableUse::Select { radius } => (SELECT_DRIFT_SHARE * radius).max(least),
+            TableUse::Proximity => least,
+        }
+    }
+}
 
 /// The table and the positions it was built from.
 struct Hashed {
@@ -193,19 +223,25 @@ impl GpuKernels {
         }
     }
 
-    /// Brings the GPU copy up to date with `mesh` and makes its hash table fresh enough for
-    /// `cell` sized cells (rebuilt when missing or drifted too far). A free function of the
-    /// fields it needs, so that callers keep the step buffers borrowed beside what it returns.
+    /// Brings the GPU copy up to date with `mesh` and makes its hash table, of `cell` sized
+    /// cells, fresh enough for `table_use` (rebuilt when missing or drifted too far). A free
+    /// function of the fields it needs, so that callers keep the step buffers borrowed beside
+    /// what it returns.
     fn prepare<'a>(
         gpu: &GpuContext,
         resident: &'a mut Option<Resident>,
         mesh: &Mesh,
         cell: f32,
+        table_use: TableUse,
     ) -> Result<&'a mut Resident, GpuError> {
         let r = GpuKernels::sync(gpu, resident, mesh)?;
-        let stale = r.hashed.as_ref().is_none_or(|h| {
-            h.drift > DRIFT_LIMIT_CELLS * cell || h.table.inv_cell_size != 1.0 / cell
-        });
+        let stale = match (&r.hashed, table_use) {
+            (_, TableUse::None) => false,
+            (None, _) => true,
+            (Some(h), _) => {
+                h.drift > table_use.drift_limit(cell) || h.table.inv_cell_size != 1.0 / cell
+            }
+        };
         if stale {
             let count = r.vertices.count;
             let positions = gpu.output_buffer::<Vec3>("hashed positions", count);
@@ -280,7 +316,15 @@ impl GpuKernels {
     ) -> Result<Vec<(u32, f32)>, GpuError> {
         self.check_injected_failure()?;
         let gpu = &self.gpu;
-        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
+        let r = GpuKernels::prepare(
+            gpu,
+            &mut self.resident,
+            mesh,
+            cell_size(state),
+            TableUse::Select {
+                radius: dab.brush.radius,
+            },
+        )?;
         let hashed = r.hashed();
         let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
         let active = gpu.storage_buffer("active layers", &active, false);
@@ -329,7 +373,13 @@ impl GpuKernels {
         }
         self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
-        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
+        let r = GpuKernels::prepare(
+            gpu,
+            &mut self.resident,
+            mesh,
+            cell_size(state),
+            TableUse::None,
+        )?;
         let entries: Vec<SelectedVertex> = selection
             .iter()
             .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
@@ -384,7 +434,13 @@ impl GpuKernels {
         }
         self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
-        let r = GpuKernels::prepare(gpu, &mut self.resident, mesh, cell_size(state))?;
+        let r = GpuKernels::prepare(
+            gpu,
+            &mut self.resident,
+            mesh,
+            cell_size(state),
+            TableUse::Proximity,
+        )?;
         if r.topology.is_none() {
             let packed = PackedTopology::of(mesh);
             r.topology = Some((packed.upload(gpu)?, packed.vertex_faces_base));

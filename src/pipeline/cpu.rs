@@ -386,7 +386,7 @@ impl SculptPipeline for CpuPipeline {
             // Split the sample's motion into steps of at most `max_step` edge lengths.
             let started = Instant::now();
             let whole = Dab { frame, ..probe };
-            let full = self.kernels.deform(&state, mesh, &whole, &first_selection);
+            let mut full = self.kernels.deform(&state, mesh, &whole, &first_selection);
             let longest_move = first_selection
                 .iter()
                 .zip(&full)
@@ -416,7 +416,13 @@ impl SculptPipeline for CpuPipeline {
                 times.selection += millis(started);
 
                 let started = Instant::now();
-                let targets = self.kernels.deform(&state, mesh, &dab, &selection);
+                // A sample taken in one step moves the selection exactly as its whole motion
+                // did (same vertices, share 1): its targets are already known.
+                let targets = if steps == 1 {
+                    std::mem::take(&mut full)
+                } else {
+                    self.kernels.deform(&state, mesh, &dab, &selection)
+                };
                 times.deformation += millis(started);
 
                 let started = Instant::now();
