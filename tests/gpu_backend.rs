@@ -56,6 +56,15 @@ fn run(pipeline: &mut CpuPipeline, mesh: &mut Mesh, strokes: &[slayer::brush::St
         .sum()
 }
 
+/// The largest distance between the same vertex of two meshes.
+fn largest_deviation(a: &Mesh, b: &Mesh) -> f32 {
+    a.positions()
+        .iter()
+        .zip(b.positions())
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max)
+}
+
 #[test]
 fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     let (start, strokes) = plaster_and_strokes(5);
@@ -70,12 +79,7 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     let mut gpu_pipeline = CpuPipeline::with_kernels(settings, Box::new(all_on_gpu()));
     let gpu_collisions = run(&mut gpu_pipeline, &mut on_gpu, &strokes);
     assert_eq!(gpu_pipeline.kernel_failure(), None);
-    let deviation = on_cpu
-        .positions()
-        .iter()
-        .zip(on_gpu.positions())
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
+    let deviation = largest_deviation(&on_cpu, &on_gpu);
     eprintln!(
         "max deviation {deviation:e} ({:.2e} L), collisions cpu {cpu_collisions} gpu {gpu_collisions}",
         deviation / edge
@@ -123,12 +127,7 @@ fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
     assert!(failure.contains("device lost"), "{failure}");
     mesh.validate().unwrap();
     assert_eq!(find_intersections(&mesh).total(), 0);
-    let deviation = on_cpu
-        .positions()
-        .iter()
-        .zip(mesh.positions())
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
+    let deviation = largest_deviation(&on_cpu, &mesh);
     assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
 }
 
@@ -204,12 +203,7 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
     let mut mesh = start.clone();
     let gpu_collisions = run(&mut pipeline, &mut mesh, &strokes);
     assert_eq!(pipeline.kernel_failure(), None);
-    let deviation = on_cpu
-        .positions()
-        .iter()
-        .zip(mesh.positions())
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
+    let deviation = largest_deviation(&on_cpu, &mesh);
     assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
     assert_eq!(cpu_collisions, gpu_collisions);
     assert!(cpu_collisions > 0, "the strokes collide");

@@ -40,6 +40,18 @@ pub enum GpuError {
     },
 }
 
+/// Fails clearly when `bytes` pass `limit`.
+pub(super) fn check_fits(what: &str, bytes: u64, limit: u64) -> Result<(), GpuError> {
+    if bytes > limit {
+        return Err(GpuError::TooLarge {
+            what: what.to_string(),
+            bytes,
+            limit,
+        });
+    }
+    Ok(())
+}
+
 /// How many workgroups a dispatch runs.
 #[derive(Debug, Clone, Copy)]
 pub enum Workgroups<'a> {
@@ -387,14 +399,7 @@ impl GpuContext {
             .limits
             .max_storage_buffer_binding_size
             .min(self.limits.max_buffer_size);
-        if bytes > limit {
-            return Err(GpuError::TooLarge {
-                what: what.to_string(),
-                bytes,
-                limit,
-            });
-        }
-        Ok(())
+        check_fits(what, bytes, limit)
     }
 
     /// Records one dispatch of `pipeline` covering `invocations` threads, its bind group 0
@@ -409,13 +414,11 @@ impl GpuContext {
         invocations: usize,
         workgroup_size: u32,
     ) {
-        if invocations == 0 {
-            return;
-        }
-        let (x, y) = self.dispatch_size(invocations, workgroup_size);
-        self.record_pass(encoder, pipeline, label, resources, &[], |pass| {
-            pass.dispatch_workgroups(x, y, 1)
-        });
+        let workgroups = Workgroups::Cover {
+            invocations,
+            workgroup_size,
+        };
+        self.record_paged_dispatch(encoder, pipeline, label, resources, &[], workgroups);
     }
 
     /// As [`GpuContext::record_dispatch`], with the workgroup counts read by the GPU from
@@ -428,9 +431,8 @@ impl GpuContext {
         resources: &[&wgpu::Buffer],
         args: &wgpu::Buffer,
     ) {
-        self.record_pass(encoder, pipeline, label, resources, &[], |pass| {
-            pass.dispatch_workgroups_indirect(args, 0)
-        });
+        let workgroups = Workgroups::Indirect(args);
+        self.record_paged_dispatch(encoder, pipeline, label, resources, &[], workgroups);
     }
 
     /// As [`GpuContext::record_dispatch`] (or `_indirect`) for a kernel with paged arrays
@@ -444,41 +446,14 @@ impl GpuContext {
         paged: &[&wgpu::Buffer],
         workgroups: Workgroups<'_>,
     ) {
+        if let Workgroups::Cover { invocations: 0, .. } = workgroups {
+            return;
+        }
         let pages: Vec<wgpu::BindGroup> = paged
             .iter()
             .enumerate()
             .map(|(k, buffer)| self.page_bind_group(pipeline, k as u32 + 1, label, buffer))
             .collect();
-        match workgroups {
-            Workgroups::Cover {
-                invocations,
-                workgroup_size,
-            } => {
-                if invocations == 0 {
-                    return;
-                }
-                let (x, y) = self.dispatch_size(invocations, workgroup_size);
-                self.record_pass(encoder, pipeline, label, resources, &pages, |pass| {
-                    pass.dispatch_workgroups(x, y, 1)
-                });
-            }
-            Workgroups::Indirect(args) => {
-                self.record_pass(encoder, pipeline, label, resources, &pages, |pass| {
-                    pass.dispatch_workgroups_indirect(args, 0)
-                });
-            }
-        }
-    }
-
-    fn record_pass(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        pipeline: &wgpu::ComputePipeline,
-        label: &str,
-        resources: &[&wgpu::Buffer],
-        pages: &[wgpu::BindGroup],
-        dispatch: impl FnOnce(&mut wgpu::ComputePass<'_>),
-    ) {
         let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
             .iter()
             .enumerate()
@@ -501,7 +476,16 @@ impl GpuContext {
         for (k, group) in pages.iter().enumerate() {
             pass.set_bind_group(k as u32 + 1, group, &[]);
         }
-        dispatch(&mut pass);
+        match workgroups {
+            Workgroups::Cover {
+                invocations,
+                workgroup_size,
+            } => {
+                let (x, y) = self.dispatch_size(invocations, workgroup_size);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            Workgroups::Indirect(args) => pass.dispatch_workgroups_indirect(args, 0),
+        }
     }
 
     pub fn encoder(&self, label: &str) -> wgpu::CommandEncoder {

@@ -13,6 +13,7 @@
 //! bytes a moving vertex at most) up to 4M moving vertices; past that the kernels report
 //! `TooLarge` and the strokes run on the CPU.
 
+use super::context::check_fits;
 use super::{GpuContext, GpuError};
 
 /// Bindings a paged array may span (the kernel declares this many in bind group 1).
@@ -56,14 +57,7 @@ impl GpuContext {
     pub fn check_paged(&self, what: &str, words: usize) -> Result<(), GpuError> {
         let bytes = words as u64 * WORD;
         let limit = (PAGE_COUNT * self.page_bytes()).min(self.limits.max_buffer_size);
-        if bytes > limit {
-            return Err(GpuError::TooLarge {
-                what: what.to_string(),
-                bytes,
-                limit,
-            });
-        }
-        Ok(())
+        check_fits(what, bytes, limit)
     }
 
     /// Bind group `group` of `pipeline`: `buffer` page by page. Pages past the end of the
