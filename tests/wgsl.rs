@@ -463,4 +463,8 @@ fn paged_declarations_are_checked() {
     }
     let error = expand_imports("x", "#import shared/paged_array").unwrap_err();
     assert!(error.to_string().contains("#paged"), "{error}");
+    let expanded = expand_imports("x", "#paged rows 3").unwrap();
+    assert!(expanded.contains("fn rows(i: u32) -> u32"), "{expanded}");
+    assert!(expanded.contains("@group(3) @binding(3)"), "{expanded}");
+    assert!(!expanded.contains("PAGED") && !expanded.contains("PAGE_GROUP"));
 }

@@ -137,7 +137,15 @@ fn paged_array(file: &str, declaration: &str) -> Result<String, ShaderError> {
         .iter()
         .find(|(n, _)| *n == PAGED_ARRAY)
         .expect("the template is registered");
-    Ok(template.replace("PAGE_GROUP", group).replace("PAGED", name))
+    // The template's opening comment speaks of the placeholders themselves: left out.
+    let body: Vec<&str> = template
+        .lines()
+        .skip_while(|line| line.starts_with("//"))
+        .collect();
+    Ok(body
+        .join("\n")
+        .replace("PAGE_GROUP", group)
+        .replace("PAGED", name))
 }
 
 /// Parses and validates WGSL with naga, reporting every error with its source location.
