@@ -64,13 +64,14 @@ enum TableUse {
 }
 
 impl TableUse {
-    /// The drift (world units) past which the table is rebuilt first.
-    fn drift_limit(self, cell: f32) -> f32 {
+    /// The drift (world units) past which the table is rebuilt first; `None` when the caller
+    /// does not read the table.
+    fn drift_limit(self, cell: f32) -> Option<f32> {
         let least = DRIFT_LIMIT_CELLS * cell;
         match self {
-            TableUse::None => f32::INFINITY,
-            TableUse::Select { radius } => (SELECT_DRIFT_SHARE * radius).max(least),
-            TableUse::Proximity => least,
+            TableUse::None => None,
+            TableUse::Select { radius } => Some((SELECT_DRIFT_SHARE * radius).max(least)),
+            TableUse::Proximity => Some(least),
         }
     }
 }
@@ -235,13 +236,11 @@ impl GpuKernels {
         table_use: TableUse,
     ) -> Result<&'a mut Resident, GpuError> {
         let r = GpuKernels::sync(gpu, resident, mesh)?;
-        let stale = match (&r.hashed, table_use) {
-            (_, TableUse::None) => false,
-            (None, _) => true,
-            (Some(h), _) => {
-                h.drift > table_use.drift_limit(cell) || h.table.inv_cell_size != 1.0 / cell
-            }
-        };
+        let stale = table_use.drift_limit(cell).is_some_and(|limit| {
+            r.hashed
+                .as_ref()
+                .is_none_or(|h| h.drift > limit || h.table.inv_cell_size != 1.0 / cell)
+        });
         if stale {
             let count = r.vertices.count;
             let positions = gpu.output_buffer::<Vec3>("hashed positions", count);
@@ -585,6 +584,15 @@ impl GpuKernels {
         }
     }
 
+    /// `run`'s result, unless the GPU was given up before or fails now (then given up for
+    /// good): the caller falls back to the CPU on `None`.
+    fn on_gpu<T>(&mut self, run: impl FnOnce(&mut GpuKernels) -> Result<T, GpuError>) -> Option<T> {
+        if self.failed.is_some() {
+            return None;
+        }
+        run(self).map_err(|error| self.give_up(error)).ok()
+    }
+
     /// Gives the GPU up for good, keeping why (the pipeline reports it).
     fn give_up(&mut self, error: GpuError) {
         self.failed = Some(error.to_string());
@@ -641,13 +649,8 @@ impl StepKernels for GpuKernels {
     }
 
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
-        if self.failed.is_none() {
-            match self.gpu_select(state, mesh, dab) {
-                Ok(selection) => return selection,
-                Err(error) => self.give_up(error),
-            }
-        }
-        CpuKernels.select(state, mesh, dab)
+        self.on_gpu(|k| k.gpu_select(state, mesh, dab))
+            .unwrap_or_else(|| CpuKernels.select(state, mesh, dab))
     }
 
     fn deform(
@@ -657,13 +660,8 @@ impl StepKernels for GpuKernels {
         dab: &Dab,
         selection: &[(u32, f32)],
     ) -> Vec<Vec3> {
-        if self.failed.is_none() {
-            match self.gpu_deform(state, mesh, dab, selection) {
-                Ok(targets) => return targets,
-                Err(error) => self.give_up(error),
-            }
-        }
-        CpuKernels.deform(state, mesh, dab, selection)
+        self.on_gpu(|k| k.gpu_deform(state, mesh, dab, selection))
+            .unwrap_or_else(|| CpuKernels.deform(state, mesh, dab, selection))
     }
 
     fn clamp(
@@ -675,17 +673,15 @@ impl StepKernels for GpuKernels {
         targets: &[Vec3],
         before: &[Vec3],
     ) {
-        if self.failed.is_none() && self.proximity_on_gpu {
-            match self.gpu_clamp(state, mesh, selection, targets, before) {
-                Ok(finals) => {
-                    let positions = mesh.positions_mut();
-                    for (&(v, _), p) in selection.iter().zip(finals) {
-                        positions[v as usize] = p;
-                    }
-                    return;
-                }
-                Err(error) => self.give_up(error),
+        if self.proximity_on_gpu
+            && let Some(finals) =
+                self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
+        {
+            let positions = mesh.positions_mut();
+            for (&(v, _), p) in selection.iter().zip(finals) {
+                positions[v as usize] = p;
             }
+            return;
         }
         clamp_moves(state, region, mesh, selection, targets, before);
     }
