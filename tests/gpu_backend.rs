@@ -4,9 +4,9 @@
 
 use slayer::bench::{ScriptSpec, generate_script};
 use slayer::collide::find_intersections;
-use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels};
+use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels, PackedTopology};
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline, Uploads};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 fn gpu() -> GpuContext {
@@ -94,13 +94,43 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     }
 }
 
+/// With remeshing after every stroke the GPU's copy is patched where remeshing changed the mesh
+/// (rows of changed vertices, their neighbours and faces), never sent whole again, and after
+/// every stroke it is the mesh row for row; the strokes give what the CPU pipeline gives.
 #[test]
-fn gpu_kernels_with_remeshing_keep_the_mesh_sound() {
-    let (mut mesh, strokes) = plaster_and_strokes(3);
-    let mut pipeline =
-        CpuPipeline::with_kernels(PipelineSettings::default(), Box::new(all_on_gpu()));
-    run(&mut pipeline, &mut mesh, &strokes);
+fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
+    let (start, strokes) = plaster_and_strokes(3);
+    let settings = PipelineSettings::default();
+    let mut on_cpu = start.clone();
+    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut mesh = start.clone();
+    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(all_on_gpu()));
+    let mut gpu_collisions = 0;
+    for stroke in &strokes {
+        let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+        assert!(
+            report.remesh.splits + report.remesh.collapses > 0,
+            "remeshing edits"
+        );
+        gpu_collisions += report.clamped;
+        pipeline.check_kernel_copy(&mesh).unwrap();
+    }
     assert_eq!(pipeline.kernel_failure(), None);
+    assert_eq!(
+        pipeline.uploads(),
+        Some(Uploads {
+            whole: 1,
+            patched: strokes.len()
+        })
+    );
+    assert!(
+        mesh.vertex_count() > start.vertex_count(),
+        "remeshing added vertices"
+    );
+    assert_eq!(mesh.vertex_count(), on_cpu.vertex_count());
+    let deviation = largest_deviation(&on_cpu, &mesh);
+    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
+    assert_eq!(cpu_collisions, gpu_collisions);
     mesh.validate().unwrap();
     assert_eq!(find_intersections(&mesh).total(), 0);
 }
@@ -165,13 +195,19 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
     };
-    let vertices = start.vertex_count() as u64;
-    let topology = 4 * slayer::gpu::PackedTopology::of(&start).words.len() as u64;
-    let neighbours = 4 * slayer::gpu::smoothing_neighbours(&start).1.len() as u64;
+    // As the backend keeps them: with room for what remeshing adds.
+    let capacity = slayer::gpu::vertex_capacity(start.vertex_count());
+    let faces = slayer::gpu::face_capacity(start.face_count());
+    let topology = 4 * PackedTopology::with_room(&start, faces, capacity)
+        .words
+        .len() as u64;
+    let neighbours = 4 * slayer::gpu::smoothing_neighbours(&start, capacity)
+        .words
+        .len() as u64;
     // Large enough for every array bound whole (12 bytes a vertex at most, and the hash
     // table's offsets) and for the paged ones in four pages.
-    let whole =
-        (12 * vertices).max(4 * (slayer::gpu::table_size_for(start.vertex_count()) as u64 + 1));
+    let whole = (12 * capacity as u64)
+        .max(4 * (slayer::gpu::table_size_for(start.vertex_count()) as u64 + 1));
     let limit = whole
         .max(topology.div_ceil(slayer::gpu::PAGE_COUNT))
         .next_power_of_two();

@@ -738,7 +738,7 @@ fn check_deform(binding: Binding) {
         Binding::Paged => {
             // Whole: positions, normals and targets, 12 bytes a vertex at most.
             let unpaged = 12 * mesh.vertex_count() as u64;
-            let neighbours = smoothing_neighbours(&mesh).1.len() as u64 * 4;
+            let neighbours = smoothing_neighbours(&mesh, 0).words.len() as u64 * 4;
             gpu_with_binding_limit(binding_limit_paging(unpaged, &[neighbours]))
         }
     };
@@ -752,7 +752,7 @@ fn check_deform(binding: Binding) {
         ring: 2,
         max_edge: 0.08,
     };
-    let (neighbour_offsets, neighbours) = smoothing_neighbours(&mesh);
+    let neighbours = smoothing_neighbours(&mesh, 0);
     let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);
     for (k, &kind) in BrushKind::DEFORMING.iter().enumerate() {
         let falloff = FALLOFFS[k % FALLOFFS.len()];
@@ -793,8 +793,8 @@ fn check_deform(binding: Binding) {
                 normals: mesh.normals(),
                 selected: &entries,
                 selection_count: entries.len() as u32,
-                neighbour_offsets: &neighbour_offsets,
-                neighbours: &neighbours,
+                neighbour_rows: &neighbours.rows.table,
+                neighbours: &neighbours.words,
             };
             let mut mirror = vec![Vec3::ZERO; entries.len()];
             slayer::cpu::deform(&params, &inputs, &mut mirror);
@@ -965,7 +965,7 @@ fn cpu_proximity(
     let (moving, rings) = slayer::gpu::moving_vertices(mesh, query.selection, &starts, query.ring);
     let topology = slayer::gpu::PackedTopology::of(mesh);
     let table_size = table_size_for(mesh.vertex_count());
-    let params = slayer::gpu::proximity_params(query, topology.vertex_faces_base, table_size);
+    let params = slayer::gpu::proximity_params(query, topology.layout.vertex_rows_base, table_size);
     let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
     let table = slayer::cpu::hash_table(mesh.positions(), &flags, params.inv_cell_size, table_size);
     let flat: Vec<f32> = query.current.iter().flat_map(|p| p.to_array()).collect();
@@ -1254,7 +1254,7 @@ fn check_vertex_normals(binding: Binding) {
         let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
         let params = slayer::gpu::NormalParams {
             count: size as u32,
-            vertex_faces_base: topology.vertex_faces_base,
+            vertex_rows_base: topology.layout.vertex_rows_base,
             _pad0: 0,
             _pad1: 0,
         };

@@ -350,7 +350,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
             inv_cell_size,
             table_mask,
             count,
-            vertex_faces_base,
+            vertex_rows_base,
             all_faces,
             span,
             cells_per_entry
@@ -392,7 +392,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
         "vertex_normals",
         NormalParams {
             count,
-            vertex_faces_base,
+            vertex_rows_base,
             _pad0,
             _pad1
         }

@@ -42,10 +42,10 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(2) var<storage, read> normals: array<f32>;
 @group(0) @binding(3) var<storage, read> selected: array<SelectedVertex>;
 @group(0) @binding(4) var<storage, read> selection_count: u32;
-// Smooth's neighbours, CSR: vertex v averages neighbour(j) for j in
-// neighbour_offsets[v]..[v + 1] (its one-ring in fan order; on a boundary only its two
-// boundary neighbours).
-@group(0) @binding(5) var<storage, read> neighbour_offsets: array<u32>;
+// Smooth's neighbours (src/gpu/rows.rs): vertex v averages neighbour(j) for the
+// neighbour_rows[2v + 1] words j from neighbour_rows[2v] (its one-ring in fan order; on a
+// boundary only its two boundary neighbours).
+@group(0) @binding(5) var<storage, read> neighbour_rows: array<u32>;
 // Packed x, y, z per selection entry.
 @group(0) @binding(6) var<storage, read_write> targets: array<f32>;
 // Paged (shared/pages.wgsl), group 1: `neighbour(j)`, the neighbour lists (about six words a
@@ -56,8 +56,8 @@ fn position(v: u32) -> vec3<f32> {
 }
 
 fn ring_centroid(v: u32, p: vec3<f32>) -> vec3<f32> {
-    let start = neighbour_offsets[v];
-    let end = neighbour_offsets[v + 1u];
+    let start = neighbour_rows[2u * v];
+    let end = start + neighbour_rows[2u * v + 1u];
     if end == start {
         return p;
     }

@@ -40,7 +40,7 @@ struct ProximityParams {
     // Entries in `moving`.
     count: u32,
     // Where the vertex→faces rows start in `topology`.
-    vertex_faces_base: u32,
+    vertex_rows_base: u32,
     // 1: test every face (the first pass); 0: only faces with a vertex marked in `marks`.
     all_faces: u32,
     // Cells per entry, from the cell of x − cell_reach: enough for any x (the host sizes it).
@@ -67,8 +67,8 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(6) var<storage, read_write> pulls: array<atomic<u32>>;
 // Paged (shared/pages.wgsl), group 1: `topology(i)`, the packed topology
 // (src/gpu/topology.rs): faces first, four words each (a, b, c, layer); then from
-// vertex_faces_base the vertex→faces rows: vertex_count + 1 absolute starts into the same
-// array, then the face ids. Group 2: `ring_vertex(r)`, the exclusion rings of the entries, one
+// vertex_rows_base per vertex the absolute start and length of its row of face ids
+// (src/gpu/rows.rs), then the rows. Group 2: `ring_vertex(r)`, the exclusion rings of the entries, one
 // after another (a moving vertex's ring can be some forty words: the largest per-entry array).
 
 fn position(v: u32) -> vec3<f32> {
@@ -160,9 +160,10 @@ fn main(
         for (var j = offsets[bucket]; j < end; j++) {
             let u = entries[j];
             if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
-                let row = params.vertex_faces_base + u;
-                let last = topology(row + 1u);
-                for (var k = topology(row); k < last; k++) {
+                let row = params.vertex_rows_base + 2u * u;
+                let first = topology(row);
+                let last = first + topology(row + 1u);
+                for (var k = first; k < last; k++) {
                     t = min(t, safe_fraction(entry, topology(k), x));
                 }
             }

@@ -12,8 +12,9 @@
 struct NormalParams {
     // Vertices listed.
     count: u32,
-    // Where the vertex→faces rows start in `topology`.
-    vertex_faces_base: u32,
+    // Where the per-vertex (start, length) entries of the vertex→faces rows begin in
+    // `topology`.
+    vertex_rows_base: u32,
     _pad0: u32,
     _pad1: u32,
 }
@@ -28,7 +29,7 @@ const MAX_F32: f32 = 3.40282347e38;
 // Packed x, y, z per vertex of the mesh; only the listed ones are written.
 @group(0) @binding(3) var<storage, read_write> normals: array<f32>;
 // Paged (shared/pages.wgsl), group 1: `topology(i)`, src/gpu/topology.rs: faces as
-// (a, b, c, layer), then the vertex→faces rows.
+// (a, b, c, layer), then the vertex→faces rows' (start, length) entries and the rows.
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -44,10 +45,11 @@ fn main(
         return;
     }
     let v = vertices[i];
-    let row = params.vertex_faces_base + v;
-    let last = topology(row + 1u);
+    let row = params.vertex_rows_base + 2u * v;
+    let first = topology(row);
+    let last = first + topology(row + 1u);
     var sum = vec3<f32>(0.0);
-    for (var k = topology(row); k < last; k++) {
+    for (var k = first; k < last; k++) {
         let f = topology(k);
         let a = position(topology(4u * f));
         let b = position(topology(4u * f + 1u));

@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
-use crate::pipeline::{PhaseTimes, PipelineError, SculptPipeline};
+use crate::pipeline::{PhaseTimes, PipelineError, SculptPipeline, Uploads};
 use crate::remesh::RemeshReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
@@ -99,6 +99,9 @@ pub struct SceneResult {
     pub reverted: usize,
     pub moves: usize,
     pub validation_error: Option<String>,
+    /// GPU backends: how often the mesh was sent to the GPU whole, and how often patched after
+    /// remeshing.
+    pub gpu_uploads: Option<Uploads>,
 }
 
 /// One row of the scaling run.
@@ -193,6 +196,7 @@ pub fn run_strokes(
         collisions,
         reverted,
         moves,
+        gpu_uploads: pipeline.uploads(),
     })
 }
 

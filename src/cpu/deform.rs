@@ -15,13 +15,14 @@ pub struct DeformInputs<'a> {
     pub normals: &'a [Vec3],
     pub selected: &'a [SelectedVertex],
     pub selection_count: u32,
-    pub neighbour_offsets: &'a [u32],
+    /// Per vertex (start, length) of its row in `neighbours`.
+    pub neighbour_rows: &'a [u32],
     pub neighbours: &'a [u32],
 }
 
 fn ring_centroid(inputs: &DeformInputs<'_>, v: u32, p: Vec3) -> Vec3 {
-    let start = inputs.neighbour_offsets[v as usize];
-    let end = inputs.neighbour_offsets[v as usize + 1];
+    let start = inputs.neighbour_rows[2 * v as usize];
+    let end = start + inputs.neighbour_rows[2 * v as usize + 1];
     if end == start {
         return p;
     }

@@ -120,8 +120,9 @@ pub fn proximity(params: &ProximityParams, inputs: &ProximityInputs<'_>, pulls: 
                 let u = inputs.entries[j as usize];
                 let offset = (packed_position(inputs.positions, u) - x).abs();
                 if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
-                    let row = (params.vertex_faces_base + u) as usize;
-                    for k in inputs.topology[row]..inputs.topology[row + 1] {
+                    let row = (params.vertex_rows_base + 2 * u) as usize;
+                    let first = inputs.topology[row];
+                    for k in first..first + inputs.topology[row + 1] {
                         let f = inputs.topology[k as usize];
                         t = t.min(safe_fraction(params, inputs, entry, f, x));
                     }

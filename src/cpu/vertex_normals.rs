@@ -17,10 +17,10 @@ pub fn vertex_normals(
 ) {
     for i in invocations(params.count) {
         let v = vertices[i as usize];
-        let row = (params.vertex_faces_base + v) as usize;
-        let last = topology[row + 1];
+        let row = (params.vertex_rows_base + 2 * v) as usize;
+        let first = topology[row];
         let mut sum = Vec3::ZERO;
-        for k in topology[row]..last {
+        for k in first..first + topology[row + 1] {
             let f = topology[k as usize] as usize;
             let a = packed_position(positions, topology[4 * f]);
             let b = packed_position(positions, topology[4 * f + 1]);

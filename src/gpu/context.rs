@@ -309,6 +309,30 @@ impl GpuContext {
             })
     }
 
+    /// A storage buffer the host writes, with room for `capacity` elements of `T`: the first
+    /// hold `data`, the rest are zero.
+    pub fn storage_buffer_with_room<T: Pod>(
+        &self,
+        label: &str,
+        data: &[T],
+        capacity: usize,
+    ) -> wgpu::Buffer {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let size = (capacity.max(data.len()) * std::mem::size_of::<T>()).max(4);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.next_multiple_of(4) as u64,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        if !bytes.is_empty() {
+            self.queue.write_buffer(&buffer, 0, bytes);
+        }
+        buffer
+    }
+
     /// A zeroed storage buffer for `count` elements of `T`.
     pub fn output_buffer<T: Pod>(&self, label: &str, count: usize) -> wgpu::Buffer {
         self.device.create_buffer(&wgpu::BufferDescriptor {

@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use super::reusable::Patches;
+use super::rows::SlottedRows;
 use super::{DeformParams, GpuContext, GpuError, SelectedVertex, Workgroups};
 use crate::brush::{BrushKind, Dab};
 use crate::mesh::{INVALID, Mesh, next};
@@ -42,29 +44,71 @@ pub fn deform_params(dab: &Dab, capacity: usize) -> DeformParams {
     }
 }
 
-/// Smooth's neighbours as CSR (`offsets` has one entry per vertex plus one): the one-ring in
-/// fan order, or on a boundary its two boundary neighbours, so that the GPU's centroid sums in
-/// the order the CPU pipeline's `ring_centroid` does. Dead and isolated vertices have none.
-pub fn smoothing_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
-    let mut offsets = Vec::with_capacity(mesh.vertex_count() + 1);
-    let mut neighbours = Vec::with_capacity(6 * mesh.vertex_count());
-    offsets.push(0);
-    for v in 0..mesh.vertex_count() as u32 {
-        if mesh.adjacency().vertex_corner[v as usize] == INVALID {
-            // Dead or isolated: nothing to average, the centroid is the vertex itself.
-        } else if mesh.is_boundary_vertex(v) {
-            let ring = mesh.neighbours(v);
-            neighbours.extend([ring[0], ring[ring.len() - 1]]);
-        } else {
-            neighbours.extend(
-                mesh.adjacency()
-                    .corners_around(v)
-                    .map(|c| mesh.corner_vertex(next(c))),
-            );
-        }
-        offsets.push(neighbours.len() as u32);
+/// Smooth's neighbours, one row per vertex (`super::rows`): the one-ring in fan order, or on a
+/// boundary its two boundary neighbours, so that the GPU's centroid sums in the order the CPU
+/// pipeline's `ring_centroid` does. Dead and isolated vertices have none.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SmoothingNeighbours {
+    /// Per vertex: (start, length) in `words`; `2 · vertex_capacity` words on the GPU.
+    pub rows: SlottedRows,
+    pub words: Vec<u32>,
+}
+
+impl SmoothingNeighbours {
+    /// The table as the GPU holds it: room for `vertex_capacity` vertices.
+    pub fn table(&self, vertex_capacity: usize) -> Vec<u32> {
+        let mut table = self.rows.table.clone();
+        table.resize(2 * vertex_capacity.max(self.rows.row_count()), 0);
+        table
     }
-    (offsets, neighbours)
+
+    /// Queues the rows of `changed` (ascending; vertices added since must be among them) into
+    /// `patches`. `false` when they no longer fit the room (lay them out afresh).
+    pub fn patch<'a>(
+        rows: &mut SlottedRows,
+        mesh: &Mesh,
+        changed: &[u32],
+        (table, words): (&'a wgpu::Buffer, &'a wgpu::Buffer),
+        patches: &mut Patches<'a>,
+    ) -> bool {
+        let mut row = Vec::new();
+        for &v in changed {
+            row.clear();
+            neighbour_row(mesh, v, &mut row);
+            let Some(placed) = rows.place(v, row.len() as u32) else {
+                return false;
+            };
+            patches.write(words, placed.start as usize, &row);
+            patches.write(table, 2 * v as usize, &[placed.start, row.len() as u32]);
+        }
+        true
+    }
+}
+
+/// [`SmoothingNeighbours`] of every vertex of `mesh`, with room for rows of vertices up to
+/// `vertex_capacity`.
+pub fn smoothing_neighbours(mesh: &Mesh, vertex_capacity: usize) -> SmoothingNeighbours {
+    let count = mesh.vertex_count();
+    let (rows, words) =
+        SlottedRows::build(count, vertex_capacity.saturating_sub(count), 0, |v, row| {
+            neighbour_row(mesh, v, row)
+        });
+    SmoothingNeighbours { rows, words }
+}
+
+pub(super) fn neighbour_row(mesh: &Mesh, v: u32, row: &mut Vec<u32>) {
+    if mesh.adjacency().vertex_corner[v as usize] == INVALID {
+        // Dead or isolated: nothing to average, the centroid is the vertex itself.
+    } else if mesh.is_boundary_vertex(v) {
+        let ring = mesh.neighbours(v);
+        row.extend([ring[0], ring[ring.len() - 1]]);
+    } else {
+        row.extend(
+            mesh.adjacency()
+                .corners_around(v)
+                .map(|c| mesh.corner_vertex(next(c))),
+        );
+    }
 }
 
 /// Buffers `deform` reads besides the vertex buffers and the selection.
@@ -74,7 +118,8 @@ pub struct DeformBuffers<'a> {
     pub selected: &'a wgpu::Buffer,
     /// One `u32`: the selection count (`GpuSelection::count`).
     pub selection_count: &'a wgpu::Buffer,
-    pub neighbour_offsets: &'a wgpu::Buffer,
+    /// Per vertex (start, length) of its row in `neighbours`.
+    pub neighbour_rows: &'a wgpu::Buffer,
     /// Paged.
     pub neighbours: &'a wgpu::Buffer,
 }
@@ -103,7 +148,7 @@ pub fn record_deform(
             inputs.normals,
             inputs.selected,
             inputs.selection_count,
-            inputs.neighbour_offsets,
+            inputs.neighbour_rows,
             targets,
         ],
         &[inputs.neighbours],
@@ -123,14 +168,14 @@ pub fn run_deform(
     selection: &[SelectedVertex],
 ) -> Result<Vec<Vec3>, GpuError> {
     gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
-    let (offsets, neighbours) = smoothing_neighbours(mesh);
-    gpu.check_paged("smoothing neighbours", neighbours.len())?;
+    let neighbours = smoothing_neighbours(mesh, mesh.vertex_count());
+    gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
     let positions = gpu.storage_buffer("positions", mesh.positions(), false);
     let normals = gpu.storage_buffer("normals", mesh.normals(), false);
     let selected = gpu.storage_buffer("selected", selection, false);
     let count = gpu.storage_buffer("selection count", &[selection.len() as u32], false);
-    let offsets = gpu.storage_buffer("neighbour offsets", &offsets, false);
-    let neighbours = gpu.storage_buffer("neighbours", &neighbours, false);
+    let rows = gpu.storage_buffer("neighbour rows", &neighbours.rows.table, false);
+    let neighbours = gpu.storage_buffer("neighbours", &neighbours.words, false);
     let targets = gpu.output_buffer::<Vec3>("targets", selection.len());
     let mut encoder = gpu.encoder("deform");
     record_deform(
@@ -141,7 +186,7 @@ pub fn run_deform(
             normals: &normals,
             selected: &selected,
             selection_count: &count,
-            neighbour_offsets: &offsets,
+            neighbour_rows: &rows,
             neighbours: &neighbours,
         },
         dab,

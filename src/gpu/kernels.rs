@@ -4,10 +4,15 @@
 //! exact backstop and remeshing on the CPU, and tells the kernels what it changed.
 //!
 //! What stays resident, and when it is refreshed:
-//! - positions, normals: uploaded in full when the mesh changed behind the kernels' back; after
-//!   a step only the rows the pipeline reports (`moved`, `normals_changed`) are sent;
-//! - connectivity (packed topology, smoothing neighbours), layers, flags: when the topology
-//!   (remeshing) or the flags changed;
+//! - everything is uploaded once, with room (an eighth more vertices and faces, a quarter more
+//!   row words), and again only when the mesh changed behind the kernels' back or outgrew the
+//!   room;
+//! - positions, normals: after a step only the rows the pipeline reports (`moved`,
+//!   `normals_changed`) are sent;
+//! - after remeshing (`remeshed`), the rows of the vertices it changed — positions, normals,
+//!   flags, layers, smoothing neighbours, faces and the faces around them — are patched in
+//!   place (`super::rows` keeps variable-length rows patchable), in one upload;
+//! - flags alone: in full when they changed (painting or masking between strokes);
 //! - the hash table: rebuilt only when the vertices have drifted more than half a cell since it
 //!   was built — queries grow their reach by the drift instead (`select`, `proximity`);
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
@@ -23,19 +28,20 @@
 
 use glam::Vec3;
 
-use super::reusable::{ReusableBuffer, upload_rows};
+use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BrushSphere, DeformBuffers,
-    GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, PROXIMITY_WORKGROUP_SIZE,
-    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
-    VertexBuffers, check_invocations, indirect_args_buffer, moving_vertices, pass_params,
-    record_apply_moves, record_deform, record_dispatch_args, record_proximity, record_select,
-    smoothing_neighbours, table_size_for,
+    FACE_WORDS, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
+    PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
+    SelectedVertex, SlottedRows, SmoothingNeighbours, TopologyLayout, VertexBuffers,
+    check_invocations, indirect_args_buffer, moving_vertices, pass_params, record_apply_moves,
+    record_deform, record_dispatch_args, record_proximity, record_select, smoothing_neighbours,
+    table_size_for,
 };
 use crate::brush::Dab;
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{MAX_PASSES, Region, StrokeState, clamp_moves};
-use crate::pipeline::{CpuKernels, StepKernels};
+use crate::pipeline::{CpuKernels, StepKernels, Uploads};
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -84,16 +90,40 @@ struct Hashed {
     drift: f32,
 }
 
+/// Rows every per-vertex buffer holds for a mesh of `count` vertices: an eighth more (and a
+/// few thousand), so that the vertices remeshing adds are written into place; a mesh that
+/// outgrows them is uploaded afresh. Sculpting adds vertices where strokes stretch the surface,
+/// a few thousand a stroke on the benchmark scenes.
+pub fn vertex_capacity(count: usize) -> usize {
+    count + count / 8 + 4096
+}
+
+/// Faces the packed topology has room for, as [`vertex_capacity`] (twice as many faces as
+/// vertices on a closed surface).
+pub fn face_capacity(count: usize) -> usize {
+    count + count / 8 + 8192
+}
+
+/// The packed topology on the GPU and where its parts lie.
+struct ResidentTopology {
+    buffer: wgpu::Buffer,
+    layout: TopologyLayout,
+}
+
 /// What lives on the GPU between steps.
 struct Resident {
     version: MeshVersion,
+    /// Rows of every per-vertex buffer (at least `vertices.count`).
+    capacity: usize,
     vertices: VertexBuffers,
     normals: wgpu::Buffer,
-    neighbour_offsets: wgpu::Buffer,
+    /// Smooth's neighbours: per vertex (start, length), and the rows (paged).
+    neighbour_table: wgpu::Buffer,
     neighbours: wgpu::Buffer,
+    neighbour_rows: SlottedRows,
     selection: GpuSelection,
-    /// Packed topology words and where the vertex→faces rows start; built when first needed.
-    topology: Option<(wgpu::Buffer, u32)>,
+    /// Built when first needed.
+    topology: Option<ResidentTopology>,
     /// Per vertex: pulled back in the last proximity pass (zero between steps).
     marks: wgpu::Buffer,
     hashed: Option<Hashed>,
@@ -101,26 +131,157 @@ struct Resident {
 }
 
 impl Resident {
-    /// Everything uploaded afresh (within our memory budget); the hash table and topology
-    /// follow when first needed.
+    /// Everything uploaded afresh (within our memory budget), with room to grow; the hash
+    /// table and topology follow when first needed.
     fn upload(gpu: &GpuContext, mesh: &Mesh) -> Result<Resident, GpuError> {
         gpu.check_budget(resident_bytes(mesh))?;
+        let count = mesh.vertex_count();
+        // As much room as the bindings allow, and never less than the mesh needs.
+        let fits = (gpu.limits.max_storage_buffer_binding_size / 12) as usize;
+        let capacity = vertex_capacity(count).min(fits).max(count);
         let layers = mesh.vertex_layers().to_vec();
-        let vertices = VertexBuffers::upload(gpu, mesh.positions(), &layers, &flag_bits(mesh))?;
-        let (offsets, neighbours) = smoothing_neighbours(mesh);
-        gpu.check_paged("smoothing neighbours", neighbours.len())?;
+        let vertices =
+            VertexBuffers::with_room(gpu, mesh.positions(), &layers, &flag_bits(mesh), capacity)?;
+        let neighbours = smoothing_neighbours(mesh, capacity);
+        gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
         Ok(Resident {
             version: mesh.version(),
-            normals: gpu.storage_buffer("normals", mesh.normals(), true),
-            neighbour_offsets: gpu.storage_buffer("neighbour offsets", &offsets, false),
-            neighbours: gpu.storage_buffer("neighbours", &neighbours, false),
-            selection: GpuSelection::new(gpu, mesh.vertex_count().max(1))?,
+            capacity,
+            normals: gpu.storage_buffer_with_room("normals", mesh.normals(), capacity),
+            neighbour_table: gpu.storage_buffer_with_room(
+                "neighbour rows",
+                &neighbours.table(capacity),
+                2 * capacity,
+            ),
+            neighbours: gpu.storage_buffer_with_room("neighbours", &neighbours.words, 0),
+            neighbour_rows: neighbours.rows,
+            selection: GpuSelection::new(gpu, capacity.max(1))?,
             topology: None,
-            marks: gpu.output_buffer::<u32>("proximity marks", mesh.vertex_count()),
+            marks: gpu.output_buffer::<u32>("proximity marks", capacity),
             hashed: None,
             layer_count: mesh.layer_count(),
             vertices,
         })
+    }
+
+    /// Sends what remeshing changed — the rows of `changed` (ascending, every vertex added
+    /// since among them) in every per-vertex array, the neighbour and topology rows, the faces
+    /// around them — into room left for it. `false` when the mesh outgrew the room (upload
+    /// afresh). The hash table is dropped: the next use rebuilds it over the new vertices.
+    fn patch(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
+        if mesh.vertex_count() > self.capacity || mesh.layer_count() != self.layer_count {
+            return false;
+        }
+        let mut patches = Patches::default();
+        for &v in changed {
+            let flags = mesh.flags()[v as usize].bits();
+            patches.write(&self.vertices.flags, v as usize, &[flags]);
+        }
+        patches.rows(&self.vertices.layers, mesh.vertex_layers(), changed);
+        patches.rows(&self.vertices.positions, mesh.positions(), changed);
+        patches.rows(&self.normals, mesh.normals(), changed);
+        let buffers = (&self.neighbour_table, &self.neighbours);
+        if !SmoothingNeighbours::patch(
+            &mut self.neighbour_rows,
+            mesh,
+            changed,
+            buffers,
+            &mut patches,
+        ) {
+            return false;
+        }
+        patches.submit(gpu);
+        if let Some(t) = &mut self.topology {
+            let mut topology = Patches::default();
+            let fits = t.layout.patch(mesh, changed, &t.buffer, &mut topology);
+            if fits {
+                topology.submit(gpu);
+            } else {
+                // Packed afresh when next needed.
+                self.topology = None;
+            }
+        }
+        self.vertices.count = mesh.vertex_count();
+        self.hashed = None;
+        true
+    }
+
+    /// Reads the copy back and compares it with `mesh` row by row (positions, normals, flags,
+    /// layers bit for bit; neighbour and face rows; the faces): `Err` names the first
+    /// difference. For tests of the patching; a read-back of everything, so not for the loop.
+    fn check(&self, gpu: &GpuContext, mesh: &Mesh) -> Result<(), String> {
+        let n = mesh.vertex_count();
+        if self.vertices.count != n {
+            return Err(format!(
+                "{} vertices on the GPU, {n} in the mesh",
+                self.vertices.count
+            ));
+        }
+        let read = |buffer: &wgpu::Buffer, count: usize| -> Result<Vec<u32>, String> {
+            gpu.read_buffer::<u32>(buffer, count)
+                .map_err(|e| e.to_string())
+        };
+        let same = |what: &str, gpu: Vec<u32>, mesh: &[u32], per_vertex: usize| match gpu
+            .iter()
+            .zip(mesh)
+            .position(|(a, b)| a != b)
+        {
+            None => Ok(()),
+            Some(i) => Err(format!("{what} of vertex {} differ", i / per_vertex)),
+        };
+        let words = |v: &[glam::Vec3]| bytemuck::cast_slice::<glam::Vec3, u32>(v).to_vec();
+        same(
+            "positions",
+            read(&self.vertices.positions, 3 * n)?,
+            &words(mesh.positions()),
+            3,
+        )?;
+        same(
+            "normals",
+            read(&self.normals, 3 * n)?,
+            &words(mesh.normals()),
+            3,
+        )?;
+        same("flags", read(&self.vertices.flags, n)?, &flag_bits(mesh), 1)?;
+        same(
+            "layers",
+            read(&self.vertices.layers, n)?,
+            mesh.vertex_layers(),
+            1,
+        )?;
+        let table = read(&self.neighbour_table, 2 * n)?;
+        let neighbours = read(&self.neighbours, (self.neighbours.size() / 4) as usize)?;
+        let mut expected = Vec::new();
+        let row = |table: &[u32], words: &[u32], v: usize| -> Vec<u32> {
+            let (start, len) = (table[2 * v] as usize, table[2 * v + 1] as usize);
+            words.get(start..start + len).unwrap_or_default().to_vec()
+        };
+        for v in 0..n {
+            expected.clear();
+            super::deform::neighbour_row(mesh, v as u32, &mut expected);
+            if row(&table, &neighbours, v) != expected {
+                return Err(format!("smoothing neighbours of vertex {v} differ"));
+            }
+        }
+        let Some(topology) = &self.topology else {
+            return Ok(());
+        };
+        let words = read(&topology.buffer, (topology.buffer.size() / 4) as usize)?;
+        for (f, tri) in mesh.faces().iter().enumerate() {
+            let packed = &words[FACE_WORDS * f..FACE_WORDS * f + 3];
+            if !mesh.is_face_dead(f) && packed != tri {
+                return Err(format!("face {f} differs"));
+            }
+        }
+        let base = topology.layout.vertex_rows_base as usize;
+        for v in 0..n {
+            expected.clear();
+            super::topology::faces_row(mesh, v as u32, &mut expected);
+            if row(&words[base..], &words, v) != expected {
+                return Err(format!("faces of vertex {v} differ"));
+            }
+        }
+        Ok(())
     }
 
     /// The hash table; [`GpuKernels::prepare`] builds it.
@@ -177,6 +338,7 @@ pub struct GpuKernels {
     failed: Option<String>,
     /// Test hook: fail as a lost device would after this many more GPU calls.
     fail_after: Option<usize>,
+    uploads: Uploads,
 }
 
 impl GpuKernels {
@@ -195,6 +357,7 @@ impl GpuKernels {
             resident: None,
             failed: None,
             fail_after: None,
+            uploads: Uploads::default(),
         }
     }
 
@@ -230,12 +393,12 @@ impl GpuKernels {
     /// what it returns.
     fn prepare<'a>(
         gpu: &GpuContext,
-        resident: &'a mut Option<Resident>,
+        (resident, uploads): (&'a mut Option<Resident>, &mut Uploads),
         mesh: &Mesh,
         cell: f32,
         table_use: TableUse,
     ) -> Result<&'a mut Resident, GpuError> {
-        let r = GpuKernels::sync(gpu, resident, mesh)?;
+        let r = GpuKernels::sync(gpu, (resident, uploads), mesh)?;
         let stale = table_use.drift_limit(cell).is_some_and(|limit| {
             r.hashed
                 .as_ref()
@@ -274,7 +437,7 @@ impl GpuKernels {
     /// Brings the GPU copy up to date with `mesh`.
     fn sync<'a>(
         gpu: &GpuContext,
-        resident: &'a mut Option<Resident>,
+        (resident, uploads): (&'a mut Option<Resident>, &mut Uploads),
         mesh: &Mesh,
     ) -> Result<&'a mut Resident, GpuError> {
         let version = mesh.version();
@@ -284,6 +447,7 @@ impl GpuKernels {
                 && r.layer_count == mesh.layer_count()
         });
         if !fits {
+            uploads.whole += 1;
             let fresh = Resident::upload(gpu, mesh)?;
             return Ok(resident.insert(fresh));
         }
@@ -317,7 +481,7 @@ impl GpuKernels {
         let gpu = &self.gpu;
         let r = GpuKernels::prepare(
             gpu,
-            &mut self.resident,
+            (&mut self.resident, &mut self.uploads),
             mesh,
             cell_size(state),
             TableUse::Select {
@@ -374,7 +538,7 @@ impl GpuKernels {
         let (gpu, step) = (&self.gpu, &mut self.step);
         let r = GpuKernels::prepare(
             gpu,
-            &mut self.resident,
+            (&mut self.resident, &mut self.uploads),
             mesh,
             cell_size(state),
             TableUse::None,
@@ -400,7 +564,7 @@ impl GpuKernels {
                 normals: &r.normals,
                 selected: step.selected.buffer(),
                 selection_count: &step.selection_count,
-                neighbour_offsets: &r.neighbour_offsets,
+                neighbour_rows: &r.neighbour_table,
                 neighbours: &r.neighbours,
             },
             dab,
@@ -435,17 +599,25 @@ impl GpuKernels {
         let (gpu, step) = (&self.gpu, &mut self.step);
         let r = GpuKernels::prepare(
             gpu,
-            &mut self.resident,
+            (&mut self.resident, &mut self.uploads),
             mesh,
             cell_size(state),
             TableUse::Proximity,
         )?;
         if r.topology.is_none() {
-            let packed = PackedTopology::of(mesh);
-            r.topology = Some((packed.upload(gpu)?, packed.vertex_faces_base));
+            let packed =
+                PackedTopology::with_room(mesh, face_capacity(mesh.face_count()), r.capacity);
+            r.topology = Some(ResidentTopology {
+                buffer: packed.upload(gpu)?,
+                layout: packed.layout,
+            });
         }
         let hashed = r.hashed();
-        let Some((topology, vertex_faces_base)) = &r.topology else {
+        let Some(ResidentTopology {
+            buffer: topology,
+            layout,
+        }) = &r.topology
+        else {
             unreachable!("uploaded just above");
         };
         let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
@@ -470,7 +642,7 @@ impl GpuKernels {
             hashed.table.inv_cell_size,
             hashed.table.table_size,
             count,
-            *vertex_faces_base,
+            layout.vertex_rows_base,
         );
         let params = |all_faces: bool| ProximityParams {
             all_faces: all_faces as u32,
@@ -576,6 +748,27 @@ impl GpuKernels {
             h.drift += max_move;
         }
         r.version.positions = mesh.version().positions;
+    }
+
+    /// Patches the GPU copy after remeshing, when it was current before (`since`); otherwise,
+    /// or when the mesh outgrew the room left, the next call uploads it afresh.
+    fn gpu_remeshed(&mut self, mesh: &Mesh, since: MeshVersion, changed: &[u32]) {
+        let Some(r) = self.resident.as_mut() else {
+            return;
+        };
+        if r.version != since {
+            return;
+        }
+        let mut rows = changed.to_vec();
+        rows.extend(r.vertices.count as u32..mesh.vertex_count() as u32);
+        rows.sort_unstable();
+        rows.dedup();
+        if r.patch(&self.gpu, mesh, &rows) {
+            r.version = mesh.version();
+            self.uploads.patched += 1;
+        } else {
+            self.resident = None;
+        }
     }
 
     fn gpu_normals_changed(&mut self, mesh: &Mesh, vertices: &[u32]) {
@@ -695,6 +888,24 @@ impl StepKernels for GpuKernels {
     fn normals_changed(&mut self, mesh: &Mesh, vertices: &[u32]) {
         if self.failed.is_none() {
             self.gpu_normals_changed(mesh, vertices);
+        }
+    }
+
+    fn remeshed(&mut self, mesh: &Mesh, since: MeshVersion, changed: &[u32]) {
+        if self.failed.is_none() {
+            self.gpu_remeshed(mesh, since, changed);
+        }
+    }
+
+    fn uploads(&self) -> Uploads {
+        self.uploads
+    }
+
+    fn check_copy(&self, mesh: &Mesh) -> Result<(), String> {
+        match &self.resident {
+            Some(r) if r.version == mesh.version() => r.check(&self.gpu, mesh),
+            Some(_) => Err("the GPU copy is behind the mesh".into()),
+            None => Ok(()),
         }
     }
 }

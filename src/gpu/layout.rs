@@ -111,8 +111,9 @@ pub struct ProximityParams {
     pub table_mask: u32,
     /// Entries in the moving list.
     pub count: u32,
-    /// Where the vertex→faces rows start in the packed topology.
-    pub vertex_faces_base: u32,
+    /// Where the per-vertex (start, length) entries of the vertex→faces rows begin in the
+    /// packed topology.
+    pub vertex_rows_base: u32,
     /// 1 to test every face, 0 to test only faces with a marked vertex.
     pub all_faces: u32,
     /// Cells searched per entry (x, y, z), from the cell of x − `cell_reach`.
@@ -188,8 +189,9 @@ pub struct PulledVertex {
 pub struct NormalParams {
     /// Vertices listed.
     pub count: u32,
-    /// Where the vertex→faces rows start in the packed topology.
-    pub vertex_faces_base: u32,
+    /// Where the per-vertex (start, length) entries of the vertex→faces rows begin in the
+    /// packed topology.
+    pub vertex_rows_base: u32,
     pub _pad0: u32,
     pub _pad1: u32,
 }

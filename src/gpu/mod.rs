@@ -12,6 +12,7 @@ mod layout;
 mod pages;
 mod proximity;
 mod reusable;
+mod rows;
 mod scan;
 mod select;
 pub mod shaders;
@@ -28,13 +29,14 @@ pub use context::{
     list_adapters,
 };
 pub use deform::{
-    DeformBuffers, brush_code, deform_params, record_deform, run_deform, smoothing_neighbours,
+    DeformBuffers, SmoothingNeighbours, brush_code, deform_params, record_deform, run_deform,
+    smoothing_neighbours,
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use hash_table::{
     CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
-pub use kernels::{GpuKernels, resident_bytes};
+pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
     ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
     NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
@@ -45,11 +47,12 @@ pub use proximity::{
     moving_vertices, pass_params, proximity_params, proximity_reaches, record_proximity,
     run_proximity, verdicts,
 };
+pub use rows::{Placement, SlottedRows};
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, falloff_code, record_select,
     run_select, select_params,
 };
-pub use topology::{FACE_WORDS, PackedTopology};
+pub use topology::{FACE_WORDS, PackedTopology, TopologyLayout};
 pub use vertex_normals::{record_vertex_normals, run_vertex_normals};
 pub use vertices::VertexBuffers;

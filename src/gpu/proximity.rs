@@ -195,7 +195,7 @@ pub struct ProximityQuery<'a> {
 /// The parameters of `query`'s pass over `count` entries.
 pub fn proximity_params(
     query: &ProximityQuery<'_>,
-    vertex_faces_base: u32,
+    vertex_rows_base: u32,
     table_size: u32,
 ) -> ProximityParams {
     let positions = query.mesh.positions();
@@ -211,7 +211,7 @@ pub fn proximity_params(
             1.0 / query.cell_size,
             table_size,
             query.selection.len(),
-            vertex_faces_base,
+            vertex_rows_base,
         )
     }
 }
@@ -219,13 +219,13 @@ pub fn proximity_params(
 /// The parameters of a first pass (every face) over `count` entries, for collision distance,
 /// edge bound and move bound `(distance, max_edge, max_move)` as [`proximity_reaches`] takes
 /// them, a table of `table_size` buckets of `1 / inv_cell_size` cells, and topology rows from
-/// `vertex_faces_base`.
+/// `vertex_rows_base`.
 pub fn pass_params(
     (distance, max_edge, max_move): (f32, f32, f32),
     inv_cell_size: f32,
     table_size: u32,
     count: usize,
-    vertex_faces_base: u32,
+    vertex_rows_base: u32,
 ) -> ProximityParams {
     let (cell_reach, vertex_reach) = proximity_reaches(distance, max_edge, max_move);
     let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
@@ -236,7 +236,7 @@ pub fn pass_params(
         inv_cell_size,
         table_mask: table_size - 1,
         count: count as u32,
-        vertex_faces_base,
+        vertex_rows_base,
         all_faces: 1,
         span,
         cells_per_entry: cells,
@@ -262,7 +262,7 @@ pub fn run_proximity(
     let (moving, rings) = moving_vertices(mesh, query.selection, &starts, query.ring);
     let topology = PackedTopology::of(mesh);
     let table_size = table_size_for(mesh.vertex_count());
-    let params = proximity_params(query, topology.vertex_faces_base, table_size);
+    let params = proximity_params(query, topology.layout.vertex_rows_base, table_size);
     check_invocations(&params)?;
     gpu.check_paged("exclusion rings", rings.len())?;
     let hashed = super::VertexBuffers::upload(

@@ -98,24 +98,82 @@ impl ReusableBuffer {
     }
 }
 
-/// Uploads the rows of `data` listed in `rows` into `buffer`, one write per run of consecutive
+/// Uploads the rows of `data` listed in `rows` into `buffer`, one copy per run of consecutive
 /// rows: a step's moved vertices, listed in ascending order, are a few runs of the vertex order.
-/// Unsorted rows are uploaded all the same, in more writes.
+/// Unsorted rows are uploaded all the same, in more copies.
 pub fn upload_rows<T: Pod>(gpu: &GpuContext, buffer: &wgpu::Buffer, data: &[T], rows: &[u32]) {
-    let size = std::mem::size_of::<T>() as u64;
-    let mut i = 0;
-    while i < rows.len() {
-        let start = rows[i] as usize;
-        let mut end = start + 1;
-        i += 1;
-        while i < rows.len() && (start..=end).contains(&(rows[i] as usize)) {
-            end = end.max(rows[i] as usize + 1);
-            i += 1;
+    let mut patches = Patches::default();
+    patches.rows(buffer, data, rows);
+    patches.submit(gpu);
+}
+
+/// Writes into GPU buffers gathered into one upload: one staging buffer holding every piece,
+/// and one copy per piece, submitted together. Remeshing rewrites a few thousand scattered rows
+/// a stroke; a `write_buffer` each costs a staging allocation each.
+#[derive(Default)]
+pub struct Patches<'a> {
+    bytes: Vec<u8>,
+    /// Destination, offset there, and the piece's range in `bytes`.
+    pieces: Vec<(&'a wgpu::Buffer, u64, std::ops::Range<usize>)>,
+}
+
+impl<'a> Patches<'a> {
+    /// Queues `data` for `buffer` at element `index` (elements of `T`). Runs that continue the
+    /// last piece join it.
+    pub fn write<T: Pod>(&mut self, buffer: &'a wgpu::Buffer, index: usize, data: &[T]) {
+        let size = std::mem::size_of::<T>() as u64;
+        let piece: &[u8] = bytemuck::cast_slice(data);
+        if piece.is_empty() {
+            return;
         }
-        gpu.queue.write_buffer(
-            buffer,
-            start as u64 * size,
-            bytemuck::cast_slice(&data[start..end]),
-        );
+        let offset = index as u64 * size;
+        let start = self.bytes.len();
+        self.bytes.extend_from_slice(piece);
+        if let Some((last, at, range)) = self.pieces.last_mut()
+            && std::ptr::eq(*last, buffer)
+            && *at + range.len() as u64 == offset
+        {
+            range.end = self.bytes.len();
+            return;
+        }
+        self.pieces.push((buffer, offset, start..self.bytes.len()));
+    }
+
+    /// Queues the rows of `data` listed in `rows` (ascending rows make few pieces).
+    pub fn rows<T: Pod>(&mut self, buffer: &'a wgpu::Buffer, data: &[T], rows: &[u32]) {
+        for &row in rows {
+            let row = row as usize;
+            self.write(buffer, row, &data[row..row + 1]);
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pieces.is_empty()
+    }
+
+    /// Uploads everything queued, ahead of any later submission.
+    pub fn submit(self, gpu: &GpuContext) {
+        if self.pieces.is_empty() {
+            return;
+        }
+        use wgpu::util::DeviceExt;
+        let staging = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("patches"),
+                contents: &self.bytes,
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
+        let mut encoder = gpu.encoder("patches");
+        for (buffer, offset, range) in &self.pieces {
+            encoder.copy_buffer_to_buffer(
+                &staging,
+                range.start as u64,
+                buffer,
+                *offset,
+                range.len() as u64,
+            );
+        }
+        gpu.queue.submit([encoder.finish()]);
     }
 }

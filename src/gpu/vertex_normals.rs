@@ -17,14 +17,14 @@ pub fn record_vertex_normals(
     encoder: &mut wgpu::CommandEncoder,
     positions: &wgpu::Buffer,
     topology: &wgpu::Buffer,
-    vertex_faces_base: u32,
+    vertex_rows_base: u32,
     vertices: &wgpu::Buffer,
     count: usize,
     normals: &wgpu::Buffer,
 ) -> Result<(), GpuError> {
     let params = NormalParams {
         count: count as u32,
-        vertex_faces_base,
+        vertex_rows_base,
         _pad0: 0,
         _pad1: 0,
     };
@@ -62,7 +62,7 @@ pub fn run_vertex_normals(
         &mut encoder,
         &positions,
         &topology_buffer,
-        topology.vertex_faces_base,
+        topology.layout.vertex_rows_base,
         &listed,
         vertices.len(),
         &normals,

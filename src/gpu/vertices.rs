@@ -21,16 +21,29 @@ impl VertexBuffers {
         layers: &[u32],
         flags: &[u32],
     ) -> Result<VertexBuffers, GpuError> {
+        VertexBuffers::with_room(gpu, positions, layers, flags, positions.len())
+    }
+
+    /// Uploaded with rows for `capacity` vertices, so that vertices added later (remeshing) are
+    /// written into place rather than uploaded afresh with everything else.
+    pub fn with_room(
+        gpu: &GpuContext,
+        positions: &[Vec3],
+        layers: &[u32],
+        flags: &[u32],
+        capacity: usize,
+    ) -> Result<VertexBuffers, GpuError> {
         assert!(
             layers.len() == positions.len() && flags.len() == positions.len(),
             "one layer and one flag word per vertex"
         );
-        gpu.check_binding::<Vec3>("vertex positions", positions.len())?;
+        let capacity = capacity.max(positions.len());
+        gpu.check_binding::<Vec3>("vertex positions", capacity)?;
         Ok(VertexBuffers {
             count: positions.len(),
-            positions: gpu.storage_buffer("positions", positions, true),
-            layers: gpu.storage_buffer("vertex layers", layers, false),
-            flags: gpu.storage_buffer("vertex flags", flags, true),
+            positions: gpu.storage_buffer_with_room("positions", positions, capacity),
+            layers: gpu.storage_buffer_with_room("vertex layers", layers, capacity),
+            flags: gpu.storage_buffer_with_room("vertex flags", flags, capacity),
         })
     }
 }

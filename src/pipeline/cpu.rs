@@ -10,7 +10,7 @@ use super::kernels::{CpuKernels, StepKernels};
 use super::step::{Region, StrokeState, collide_with, paint};
 use super::{
     PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
-    StrokeReport,
+    StrokeReport, Uploads,
 };
 use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
@@ -105,6 +105,12 @@ impl CpuPipeline {
         self.kernels.failure()
     }
 
+    /// Compares the kernels' copy of the mesh (the GPU's), if they keep one, with `mesh`;
+    /// `Err` names the first difference. Reads everything back: for tests.
+    pub fn check_kernel_copy(&self, mesh: &Mesh) -> Result<(), String> {
+        self.kernels.check_copy(mesh)
+    }
+
     /// Runs `hook` after every stroke (remeshing).
     pub fn set_hook(&mut self, hook: Box<dyn StrokeHook>) {
         self.hook = Some(hook);
@@ -170,10 +176,10 @@ impl CpuPipeline {
 }
 
 /// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring,
-/// keeping `grid` exact.
+/// keeping `grid` exact, and tells `kernels` what changed.
 fn remesh_touched(
     mesh: &mut Mesh,
-    grid: &mut SpatialHash,
+    (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
     seeds: &[u32],
     (edge, distance, ring): (f32, f32, u32),
 ) -> RemeshReport {
@@ -182,7 +188,10 @@ fn remesh_touched(
         exclusion_ring: ring,
         ..RemeshSettings::new(edge)
     };
-    remesh_region(mesh, grid, seeds, &settings)
+    let since = mesh.version();
+    let (report, changed) = remesh_region(mesh, grid, seeds, &settings);
+    kernels.remeshed(mesh, since, &changed);
+    report
 }
 
 /// Longest edge of the given faces (all live faces when `faces` is `None`).
@@ -245,6 +254,10 @@ fn frame_at(
 impl SculptPipeline for CpuPipeline {
     fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
         self.prepare_state(mesh)
+    }
+
+    fn uploads(&self) -> Option<Uploads> {
+        (self.kernels.name() != "cpu").then(|| self.kernels.uploads())
     }
 
     fn name(&self) -> String {
@@ -498,8 +511,12 @@ impl SculptPipeline for CpuPipeline {
             // remeshed once, after the stroke.
             if self.settings.remeshing == Remeshing::AfterSample && !is_grab {
                 let started = Instant::now();
-                let pass =
-                    remesh_touched(mesh, &mut grid, &moved_in_sample, (edge, distance, ring));
+                let pass = remesh_touched(
+                    mesh,
+                    (&mut grid, self.kernels.as_mut()),
+                    &moved_in_sample,
+                    (edge, distance, ring),
+                );
                 max_edge = max_edge.max(pass.longest_edge);
                 report.remesh.add(&pass);
                 target_of.resize(mesh.vertex_count(), INVALID);
@@ -522,7 +539,12 @@ impl SculptPipeline for CpuPipeline {
         };
         if remesh_now {
             let started = Instant::now();
-            let pass = remesh_touched(mesh, &mut grid, &touched_list, (edge, distance, ring));
+            let pass = remesh_touched(
+                mesh,
+                (&mut grid, self.kernels.as_mut()),
+                &touched_list,
+                (edge, distance, ring),
+            );
             max_edge = max_edge.max(pass.longest_edge);
             report.remesh.add(&pass);
             times.remesh += millis(started);

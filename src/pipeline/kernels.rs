@@ -9,7 +9,8 @@ use glam::Vec3;
 
 use super::step::{Region, StrokeState, clamp_moves, deform, select};
 use crate::brush::Dab;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshVersion};
+use serde::Serialize;
 
 /// Selection and deformation of one brush step.
 pub trait StepKernels: Send {
@@ -54,6 +55,26 @@ pub trait StepKernels: Send {
     fn moved(&mut self, _mesh: &Mesh, _vertices: &[u32], _max_move: f32) {}
     /// The pipeline recomputed the normals of `vertices` (ascending).
     fn normals_changed(&mut self, _mesh: &Mesh, _vertices: &[u32]) {}
+    /// Remeshing changed `mesh` from version `since`: `changed` (ascending) lists every vertex
+    /// whose position, normal, flags, faces or neighbours changed, vertices it added included.
+    fn remeshed(&mut self, _mesh: &Mesh, _since: MeshVersion, _changed: &[u32]) {}
+    /// How the kernels' copy of the mesh was kept up to date (for reports and tests).
+    fn uploads(&self) -> Uploads {
+        Uploads::default()
+    }
+    /// Compares the kernels' copy of the mesh, if they keep one, with `mesh`: `Err` names the
+    /// first difference. Reads everything back: for tests.
+    fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// How often kernels that keep a copy of the mesh (the GPU's) sent it whole, and how often they
+/// patched it after remeshing instead.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Uploads {
+    pub whole: usize,
+    pub patched: usize,
 }
 
 /// The CPU's selection (through the spatial hash, or by scanning) and deformation (rayon).

@@ -13,7 +13,7 @@ mod kernels;
 pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
-pub use kernels::{CpuKernels, StepKernels};
+pub use kernels::{CpuKernels, StepKernels, Uploads};
 
 use serde::Serialize;
 use thiserror::Error;
@@ -173,4 +173,8 @@ pub trait SculptPipeline {
         mesh: &mut Mesh,
         stroke: &Stroke,
     ) -> Result<StrokeReport, PipelineError>;
+    /// Backends that keep a copy of the mesh elsewhere (the GPU): how they kept it current.
+    fn uploads(&self) -> Option<Uploads> {
+        None
+    }
 }

@@ -96,12 +96,15 @@ impl RemeshReport {
 }
 
 /// Remeshes the region around `seeds` (the vertices a stroke moved), keeping `grid` exact.
+/// Returns what it did and every vertex whose position, normal, faces or neighbours it changed
+/// (ascending; the vertices it added and removed included), for copies of the mesh kept
+/// elsewhere (the GPU's) to be patched.
 pub fn remesh_region(
     mesh: &mut Mesh,
     grid: &mut SpatialHash,
     seeds: &[u32],
     settings: &RemeshSettings,
-) -> RemeshReport {
+) -> (RemeshReport, Vec<u32>) {
     remesh(mesh, grid, seeds, settings, Start::OutOfBand)
 }
 
@@ -120,7 +123,7 @@ fn remesh(
     seeds: &[u32],
     settings: &RemeshSettings,
     start: Start,
-) -> RemeshReport {
+) -> (RemeshReport, Vec<u32>) {
     let started = Instant::now();
     let mut remesher = Remesher::new(mesh, grid, seeds, settings, start);
     for round in 0..settings.iterations {
@@ -135,10 +138,10 @@ fn remesh(
         }
         remesher.relax();
     }
-    let mut report = remesher.finish();
+    let (mut report, changed) = remesher.finish();
     report.passes = 1;
     report.millis = started.elapsed().as_secs_f64() * 1e3;
-    report
+    (report, changed)
 }
 
 /// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`).
@@ -152,7 +155,7 @@ pub fn remesh_all(
             !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
         })
         .collect();
-    let report = remesh(
+    let (report, _) = remesh(
         mesh,
         &mut grid,
         &seeds,
@@ -287,7 +290,11 @@ impl<'a> Remesher<'a> {
         self.dirty.get(v as usize).copied().unwrap_or(false)
     }
 
-    fn finish(self) -> RemeshReport {
+    /// Recomputes the normals around the region; returns the report and every vertex whose
+    /// data changed: the region (edits stay within it, relaxation moves only it; removed
+    /// vertices stay listed) and every vertex of a face around it (their faces and one-rings
+    /// change with the region's edges, and their normals are recomputed).
+    fn finish(self) -> (RemeshReport, Vec<u32>) {
         let live: Vec<u32> = self
             .region
             .iter()
@@ -305,6 +312,10 @@ impl<'a> Remesher<'a> {
         refresh.sort_unstable();
         refresh.dedup();
         self.mesh.recompute_normals_at(&refresh);
+        let mut changed = refresh;
+        changed.extend_from_slice(&self.region);
+        changed.sort_unstable();
+        changed.dedup();
         let mut report = self.report;
         report.longest_edge = live
             .iter()
@@ -314,7 +325,7 @@ impl<'a> Remesher<'a> {
                 a.distance(b).max(b.distance(c)).max(c.distance(a))
             })
             .fold(0.0, f32::max);
-        report
+        (report, changed)
     }
 
     fn live(&self, v: u32) -> bool {
