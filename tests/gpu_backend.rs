@@ -6,7 +6,7 @@ use slayer::bench::{ScriptSpec, generate_script};
 use slayer::collide::find_intersections;
 use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels, PackedTopology};
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline, Uploads};
+use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 fn gpu() -> GpuContext {
@@ -96,43 +96,47 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
 
 /// With remeshing after every stroke the GPU's copy is patched where remeshing changed the mesh
 /// (rows of changed vertices, their neighbours and faces), never sent whole again, and after
-/// every stroke it is the mesh row for row; the strokes give what the CPU pipeline gives.
+/// every stroke it is the mesh row for row; the vertices remeshing changed are filed in the
+/// hash table's overlay. The strokes give what the CPU pipeline gives, with the proximity
+/// passes on the GPU (which rebuild the table as vertices drift half a cell) and without (where
+/// selection rebuilds it only after a quarter of the brush radius of drift).
 #[test]
 fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
     let (start, strokes) = plaster_and_strokes(3);
     let settings = PipelineSettings::default();
     let mut on_cpu = start.clone();
     let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
-    let mut mesh = start.clone();
-    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(all_on_gpu()));
-    let mut gpu_collisions = 0;
-    for stroke in &strokes {
-        let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+    for proximity_on_gpu in [true, false] {
+        let mut kernels = all_on_gpu();
+        kernels.set_proximity_on_gpu(proximity_on_gpu);
+        let mut mesh = start.clone();
+        let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+        let mut gpu_collisions = 0;
+        for stroke in &strokes {
+            let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+            assert!(
+                report.remesh.splits + report.remesh.collapses > 0,
+                "remeshing edits"
+            );
+            gpu_collisions += report.clamped;
+            pipeline.check_kernel_copy(&mesh).unwrap();
+        }
+        assert_eq!(pipeline.kernel_failure(), None);
+        let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
+        eprintln!("proximity on the GPU: {proximity_on_gpu}, {uploads:?}");
+        assert_eq!((uploads.whole, uploads.patched), (1, strokes.len()));
+        assert!(uploads.overlay_filings > 0, "the overlay is used");
         assert!(
-            report.remesh.splits + report.remesh.collapses > 0,
-            "remeshing edits"
+            mesh.vertex_count() > start.vertex_count(),
+            "remeshing added vertices"
         );
-        gpu_collisions += report.clamped;
-        pipeline.check_kernel_copy(&mesh).unwrap();
+        assert_eq!(mesh.vertex_count(), on_cpu.vertex_count());
+        let deviation = largest_deviation(&on_cpu, &mesh);
+        assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
+        assert_eq!(cpu_collisions, gpu_collisions);
+        mesh.validate().unwrap();
+        assert_eq!(find_intersections(&mesh).total(), 0);
     }
-    assert_eq!(pipeline.kernel_failure(), None);
-    assert_eq!(
-        pipeline.uploads(),
-        Some(Uploads {
-            whole: 1,
-            patched: strokes.len()
-        })
-    );
-    assert!(
-        mesh.vertex_count() > start.vertex_count(),
-        "remeshing added vertices"
-    );
-    assert_eq!(mesh.vertex_count(), on_cpu.vertex_count());
-    let deviation = largest_deviation(&on_cpu, &mesh);
-    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
-    assert_eq!(cpu_collisions, gpu_collisions);
-    mesh.validate().unwrap();
-    assert_eq!(find_intersections(&mesh).total(), 0);
 }
 
 /// A GPU lost in the middle of a stroke: the stroke finishes on the CPU, the failure is
@@ -243,4 +247,80 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
     assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
     assert_eq!(cpu_collisions, gpu_collisions);
     assert!(cpu_collisions > 0, "the strokes collide");
+}
+
+/// Remeshing files the vertices it changed (new ones among them) in the hash table's overlay
+/// instead of rebuilding the table: selection right after finds them — exactly what the CPU's
+/// selection finds — with the table built once.
+#[test]
+fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
+    use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
+    use slayer::grid::SpatialHash;
+    use slayer::pipeline::step::StrokeState;
+    use slayer::pipeline::{CpuKernels, StepKernels};
+
+    let (mut mesh, _) = plaster_and_strokes(0);
+    let edge = mesh.mean_edge_length();
+    let center = mesh.positions()[mesh.vertex_count() / 2];
+    let dab = Dab {
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius: 3.0 * edge,
+            strength: 0.5,
+            falloff: Falloff::Smooth,
+            invert: false,
+        },
+        frame: DabFrame {
+            center,
+            normal: glam::Vec3::Z,
+            plane_point: center,
+            motion: glam::Vec3::ZERO,
+        },
+        pressure: 1.0,
+        share: 1.0,
+    };
+    let active = vec![true; mesh.layer_count()];
+    fn state_with<'a>(grid: &'a SpatialHash, active: &'a [bool], edge: f32) -> StrokeState<'a> {
+        StrokeState {
+            grid: Some(grid),
+            active,
+            parallel: false,
+            collision_distance: edge,
+            ring: 2,
+            max_edge: 2.0 * edge,
+        }
+    }
+    let mut kernels = all_on_gpu();
+    let mut grid = SpatialHash::build(&mesh, edge).unwrap();
+    let before = kernels.select(&state_with(&grid, &active, edge), &mesh, &dab);
+    assert!(!before.is_empty());
+
+    // Remeshed finer under the brush: every edge there splits.
+    let since = mesh.version();
+    let old_count = mesh.vertex_count();
+    let seeds: Vec<u32> = before.iter().map(|&(v, _)| v).collect();
+    let settings = slayer::remesh::RemeshSettings::new(0.5 * edge);
+    let (report, changed) = slayer::remesh::remesh_region(&mut mesh, &mut grid, &seeds, &settings);
+    assert!(report.splits > 0);
+    kernels.remeshed(&mesh, since, &changed);
+
+    let state = state_with(&grid, &active, edge);
+    let after = kernels.select(&state, &mesh, &dab);
+    let expected = CpuKernels.select(&state, &mesh, &dab);
+    let ids = |s: &[(u32, f32)]| s.iter().map(|&(v, _)| v).collect::<Vec<_>>();
+    assert_eq!(ids(&after), ids(&expected));
+    for (&(v, w), &(_, e)) in after.iter().zip(&expected) {
+        assert!(
+            (w - e).abs() <= 1e-5,
+            "vertex {v}: weight {w}, {e} on the CPU"
+        );
+    }
+    let new = after
+        .iter()
+        .filter(|&&(v, _)| v as usize >= old_count)
+        .count();
+    assert!(new > 0, "new vertices are selected");
+    let uploads = kernels.uploads();
+    assert_eq!((uploads.table_builds, uploads.overlay_filings), (1, 1));
+    assert_eq!(kernels.failure(), None);
 }

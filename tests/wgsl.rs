@@ -184,7 +184,7 @@ fn select_structs_match_naga_layout() {
             capacity,
             layer_count,
             drift,
-            _pad1
+            skip_marked
         }
     );
     assert_layout!("select", SelectedVertex { vertex, weight });

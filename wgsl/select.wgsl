@@ -13,7 +13,9 @@
 // drifted far (a rebuild costs a pass over the whole mesh; a step moves a few thousand
 // vertices). Vertices are found in the cell of the position they were filed at (`hashed`),
 // so the box is grown by `drift`, the farthest any vertex has moved since, and the sphere test
-// reads the current position.
+// reads the current position. Vertices remeshing changed (new ones among them) are filed in a
+// small overlay table instead: the host runs the kernel over the main table with
+// `skip_marked`, then over the overlay (src/gpu/overlay.rs).
 // CPU mirror: src/cpu/select.rs.
 
 #import shared/grid
@@ -38,7 +40,9 @@ struct SelectParams {
     layer_count: u32,
     // How far any vertex may have moved since the table was built (the box includes it).
     drift: f32,
-    _pad1: u32,
+    // Nonzero: leave out vertices with a nonzero `marks` entry (filed in another table, the
+    // overlay of vertices remeshing changed; their entries in this one are stale).
+    skip_marked: u32,
 }
 
 const WORKGROUP_SIZE: u32 = 64u;
@@ -55,6 +59,8 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(8) var<storage, read_write> selection_count: atomic<u32>;
 // The positions the table was built from (packed x, y, z; may be `positions` itself).
 @group(0) @binding(9) var<storage, read> hashed: array<f32>;
+// Per vertex: nonzero when filed in the overlay table (read when `skip_marked` is set).
+@group(0) @binding(10) var<storage, read> marks: array<u32>;
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -104,7 +110,8 @@ fn main(
     for (var j = offsets[bucket]; j < end; j++) {
         let v = entries[j];
         let filed_at = vec3<f32>(hashed[3u * v], hashed[3u * v + 1u], hashed[3u * v + 2u]);
-        if all(cell_of(filed_at, params.inv_cell_size) == cell) {
+        let elsewhere = params.skip_marked != 0u && marks[v] != 0u;
+        if !elsewhere && all(cell_of(filed_at, params.inv_cell_size) == cell) {
             consider(v);
         }
     }

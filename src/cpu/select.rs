@@ -20,6 +20,8 @@ pub struct SelectInputs<'a> {
     pub entries: &'a [u32],
     /// The packed positions the table was built from (may be `positions`).
     pub hashed: &'a [f32],
+    /// Per vertex: nonzero when filed in the overlay table (read when `skip_marked` is set).
+    pub marks: &'a [u32],
 }
 
 fn consider(
@@ -78,7 +80,9 @@ pub fn select(
         let bucket = hash_cell(cell, params.table_mask + 1) as usize;
         for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
             let v = inputs.entries[j as usize];
-            if cell_coordinates(packed_position(inputs.hashed, v), params.inv_cell_size) == cell {
+            let elsewhere = params.skip_marked != 0 && inputs.marks[v as usize] != 0;
+            let filed_at = packed_position(inputs.hashed, v);
+            if !elsewhere && cell_coordinates(filed_at, params.inv_cell_size) == cell {
                 consider(params, inputs, v, selected, selection_count);
             }
         }

@@ -31,12 +31,12 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BrushSphere, DeformBuffers,
-    FACE_WORDS, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
+    FACE_WORDS, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers,
     PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
-    SelectedVertex, SlottedRows, SmoothingNeighbours, TopologyLayout, VertexBuffers,
-    check_invocations, indirect_args_buffer, moving_vertices, pass_params, record_apply_moves,
-    record_deform, record_dispatch_args, record_proximity, record_select, smoothing_neighbours,
-    table_size_for,
+    SelectedVertex, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
+    check_invocations, indirect_args_buffer, moving_vertices, overlay_limit, overlay_table,
+    pass_params, record_apply_moves, record_deform, record_dispatch_args, record_proximity,
+    record_select, smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
 use crate::mesh::{Mesh, MeshVersion};
@@ -85,9 +85,60 @@ impl TableUse {
 /// The table and the positions it was built from.
 struct Hashed {
     table: GpuHashTable,
+    /// Where each vertex was filed: at the build, or for the overlay's members at their filing.
     positions: wgpu::Buffer,
-    /// How far any vertex may have moved since the build.
+    /// How far any vertex may have moved since it was filed.
     drift: f32,
+    /// The vertices remeshing changed since the build, filed apart (`super::overlay`).
+    overlay: Option<Overlay>,
+}
+
+/// The overlay table and its members.
+struct Overlay {
+    /// Ascending vertex ids.
+    members: Vec<u32>,
+    table_size: u32,
+    offsets: ReusableBuffer,
+    entries: ReusableBuffer,
+}
+
+impl Hashed {
+    /// Files `changed` (ascending) in the overlay with its earlier members, all at their
+    /// current positions. `false` when the overlay would pass its limit (or its buffers the
+    /// adapter's): rebuild the main table instead.
+    fn file(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
+        let overlay = self.overlay.get_or_insert_with(|| Overlay {
+            members: Vec::new(),
+            table_size: 0,
+            offsets: ReusableBuffer::storage("overlay offsets"),
+            entries: ReusableBuffer::storage("overlay entries"),
+        });
+        let mut members = Vec::with_capacity(overlay.members.len() + changed.len());
+        members.extend_from_slice(&overlay.members);
+        members.extend_from_slice(changed);
+        members.sort_unstable();
+        members.dedup();
+        if members.len() > overlay_limit(mesh.vertex_count()) {
+            return false;
+        }
+        let table = overlay_table(mesh.positions(), &members, self.table.inv_cell_size);
+        overlay.members = members;
+        overlay.table_size = table.table_size() as u32;
+        overlay.offsets.upload(gpu, &table.offsets).is_ok()
+            && overlay.entries.upload(gpu, &table.entries).is_ok()
+    }
+
+    /// The overlay as queries bind it, with `marks` (per vertex, nonzero for members).
+    fn overlay<'a>(&'a self, marks: &'a wgpu::Buffer) -> Option<OverlayBuffers<'a>> {
+        self.overlay.as_ref().map(|o| OverlayBuffers {
+            table: TableBuffers {
+                table_size: o.table_size,
+                offsets: o.offsets.buffer(),
+                entries: o.entries.buffer(),
+            },
+            marks,
+        })
+    }
 }
 
 /// Rows every per-vertex buffer holds for a mesh of `count` vertices: an eighth more (and a
@@ -127,6 +178,8 @@ struct Resident {
     /// Per vertex: pulled back in the last proximity pass (zero between steps).
     marks: wgpu::Buffer,
     hashed: Option<Hashed>,
+    /// Per vertex: nonzero when filed in the hash table's overlay.
+    overlay_marks: wgpu::Buffer,
     layer_count: usize,
 }
 
@@ -159,6 +212,7 @@ impl Resident {
             topology: None,
             marks: gpu.output_buffer::<u32>("proximity marks", capacity),
             hashed: None,
+            overlay_marks: gpu.output_buffer::<u32>("overlay marks", capacity),
             layer_count: mesh.layer_count(),
             vertices,
         })
@@ -190,6 +244,23 @@ impl Resident {
         ) {
             return false;
         }
+        // What remeshing changed goes into the hash table's overlay; the main table stays.
+        let filed = self
+            .hashed
+            .as_mut()
+            .is_none_or(|h| h.file(gpu, mesh, changed));
+        if !filed {
+            // Rebuilt (and the marks cleared) at the next use.
+            self.hashed = None;
+        }
+        if let Some(h) = &self.hashed {
+            if let Some(overlay) = &h.overlay {
+                patches.rows(&h.positions, mesh.positions(), &overlay.members);
+            }
+            for &v in changed {
+                patches.write(&self.overlay_marks, v as usize, &[1u32]);
+            }
+        }
         patches.submit(gpu);
         if let Some(t) = &mut self.topology {
             let mut topology = Patches::default();
@@ -202,7 +273,6 @@ impl Resident {
             }
         }
         self.vertices.count = mesh.vertex_count();
-        self.hashed = None;
         true
     }
 
@@ -406,8 +476,11 @@ impl GpuKernels {
         });
         if stale {
             let count = r.vertices.count;
-            let positions = gpu.output_buffer::<Vec3>("hashed positions", count);
+            // Rows for every vertex there is room for: the overlay files new ones here.
+            let positions = gpu.output_buffer::<Vec3>("hashed positions", r.capacity);
             let mut encoder = gpu.encoder("hash table");
+            encoder.clear_buffer(&r.overlay_marks, 0, None);
+            uploads.table_builds += 1;
             encoder.copy_buffer_to_buffer(
                 &r.vertices.positions,
                 0,
@@ -429,6 +502,7 @@ impl GpuKernels {
                 table,
                 positions,
                 drift: 0.0,
+                overlay: None,
             });
         }
         Ok(r)
@@ -502,6 +576,7 @@ impl GpuKernels {
                 table: &hashed.table,
                 positions: &hashed.positions,
                 drift: hashed.drift,
+                overlay: hashed.overlay(&r.overlay_marks),
             },
             &BrushSphere {
                 center: dab.frame.center,
@@ -659,6 +734,16 @@ impl GpuKernels {
             rings: step.rings.buffer(),
             marks: &r.marks,
         };
+        // Vertices remeshing changed are filed in the overlay: each pass walks it too (their
+        // stale entries in the main table only repeat tests, which take the minimum).
+        let overlay = hashed.overlay(&r.overlay_marks).map(|o| {
+            let buffers = ProximityBuffers {
+                offsets: o.table.offsets,
+                entries: o.table.entries,
+                ..proximity
+            };
+            (buffers, o.table.table_size - 1)
+        });
         let apply = ApplyMovesBuffers {
             moving: step.moving.buffer(),
             targets: step.targets.buffer(),
@@ -697,6 +782,13 @@ impl GpuKernels {
                 pulls,
                 sized,
             )?;
+            if let Some((buffers, table_mask)) = &overlay {
+                let params = ProximityParams {
+                    table_mask: *table_mask,
+                    ..params(pass == 0)
+                };
+                record_proximity(gpu, &mut encoder, buffers, &params, pulls, sized)?;
+            }
             encoder.clear_buffer(&step.next_count, 0, None);
             let mode = if pass + 1 == MAX_PASSES {
                 ApplyMode::PullLast
@@ -766,6 +858,7 @@ impl GpuKernels {
         if r.patch(&self.gpu, mesh, &rows) {
             r.version = mesh.version();
             self.uploads.patched += 1;
+            self.uploads.overlay_filings += r.hashed.is_some() as usize;
         } else {
             self.resident = None;
         }

@@ -57,7 +57,8 @@ pub struct SelectParams {
     pub layer_count: u32,
     /// How far any vertex may have moved since the table was built.
     pub drift: f32,
-    pub _pad1: u32,
+    /// Nonzero: leave out vertices marked as filed in the overlay table.
+    pub skip_marked: u32,
 }
 
 /// `SelectedVertex` in `wgsl/select.wgsl`: one entry of the compacted selection.

@@ -9,6 +9,7 @@ mod dispatch_args;
 mod hash_table;
 mod kernels;
 mod layout;
+mod overlay;
 mod pages;
 mod proximity;
 mod reusable;
@@ -41,6 +42,7 @@ pub use layout::{
     ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
     NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
+pub use overlay::{OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};
 pub use proximity::{
     PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,
@@ -51,7 +53,7 @@ pub use rows::{Placement, SlottedRows};
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, falloff_code, record_select,
-    run_select, select_params,
+    run_select, run_select_with_overlay, select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology, TopologyLayout};
 pub use vertex_normals::{record_vertex_normals, run_vertex_normals};

@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::overlay::{OverlayBuffers, TableBuffers, overlay_table};
 use super::reusable::ReusableBuffer;
 use super::{
     GpuContext, GpuError, GpuHashTable, SelectParams, SelectedVertex, VertexBuffers, table_size_for,
@@ -74,7 +75,7 @@ pub fn select_params(
         capacity: vertex_count as u32,
         layer_count: layer_count as u32,
         drift,
-        _pad1: 0,
+        skip_marked: 0,
     }
 }
 
@@ -138,9 +139,12 @@ impl GpuSelection {
 /// A hash table and the positions it was built from, with how far any vertex has moved since.
 pub struct HashedVertices<'a> {
     pub table: &'a GpuHashTable,
-    /// Packed positions at the build (may be the current positions buffer).
+    /// Packed positions at the build (may be the current positions buffer); the overlay's
+    /// members at their filing.
     pub positions: &'a wgpu::Buffer,
     pub drift: f32,
+    /// Vertices filed apart from `table` (`super::overlay`), if any.
+    pub overlay: Option<OverlayBuffers<'a>>,
 }
 
 /// Records a selection into `selection` (its counter is cleared first).
@@ -166,27 +170,45 @@ pub fn record_select(
     );
     params.capacity = selection.capacity as u32;
     let pipeline = gpu.compute_pipeline("select")?;
-    let uniform = gpu.uniform_buffer("select params", &params);
     encoder.clear_buffer(&selection.count, 0, None);
-    gpu.record_dispatch(
-        encoder,
-        &pipeline,
-        "select",
-        &[
-            &uniform,
-            &vertices.positions,
-            &vertices.layers,
-            &vertices.flags,
-            active_layers,
-            &table.offsets,
-            &table.entries,
-            &selection.selected,
-            &selection.count,
-            hashed.positions,
-        ],
-        params.candidate_count as usize,
-        WORKGROUP_SIZE,
-    );
+    // A scan tests every vertex by its current position: the tables do not matter.
+    let overlay = hashed.overlay.filter(|_| params.scan_vertices == 0);
+    let main = TableBuffers {
+        table_size: table.table_size,
+        offsets: &table.offsets,
+        entries: &table.entries,
+    };
+    // Without an overlay the marks are never read; the flags stand in for them.
+    let marks = overlay.map_or(&vertices.flags, |o| o.marks);
+    let walks = std::iter::once((main, overlay.is_some())).chain(overlay.map(|o| (o.table, false)));
+    for (walked, skip_marked) in walks {
+        let params = SelectParams {
+            table_mask: walked.table_size - 1,
+            skip_marked: skip_marked as u32,
+            ..params
+        };
+        let uniform = gpu.uniform_buffer("select params", &params);
+        gpu.record_dispatch(
+            encoder,
+            &pipeline,
+            "select",
+            &[
+                &uniform,
+                &vertices.positions,
+                &vertices.layers,
+                &vertices.flags,
+                active_layers,
+                walked.offsets,
+                walked.entries,
+                &selection.selected,
+                &selection.count,
+                hashed.positions,
+                marks,
+            ],
+            params.candidate_count as usize,
+            WORKGROUP_SIZE,
+        );
+    }
     Ok(())
 }
 
@@ -203,13 +225,55 @@ pub fn run_select(
     inv_cell_size: f32,
     brush: &BrushSphere,
 ) -> Result<Vec<SelectedVertex>, GpuError> {
+    let vertices = (positions, layers, flags);
+    run_select_with_overlay(gpu, hashed, vertices, active, inv_cell_size, brush, &[])
+}
+
+/// [`run_select`] with `members` (ascending vertex ids) filed in an overlay at their current
+/// positions, as the GPU backend files the vertices remeshing changed; their `hashed` positions
+/// are stale (and may be anything).
+#[allow(clippy::too_many_arguments)]
+pub fn run_select_with_overlay(
+    gpu: &GpuContext,
+    hashed: &[Vec3],
+    (positions, layers, flags): (&[Vec3], &[u32], &[u32]),
+    active: &[bool],
+    inv_cell_size: f32,
+    brush: &BrushSphere,
+    members: &[u32],
+) -> Result<Vec<SelectedVertex>, GpuError> {
     assert_eq!(
         hashed.len(),
         positions.len(),
         "one hashed position per vertex"
     );
-    let drift = crate::geom::largest_move(hashed, positions);
+    // The main table is built from the stale positions; the overlay's members are filed (and
+    // their filing positions recorded) where they are now.
+    let mut filed_at = hashed.to_vec();
+    let mut marks = vec![0u32; positions.len()];
+    for &v in members {
+        filed_at[v as usize] = positions[v as usize];
+        marks[v as usize] = 1;
+    }
+    let unmarked = |v: usize| marks[v] == 0;
+    let drift = (0..positions.len())
+        .filter(|&v| unmarked(v))
+        .map(|v| hashed[v].distance(positions[v]))
+        .fold(0.0f32, f32::max);
     let filed = VertexBuffers::upload(gpu, hashed, layers, flags)?;
+    let filed_positions = gpu.storage_buffer("filed positions", &filed_at, false);
+    let overlay_table = overlay_table(positions, members, inv_cell_size);
+    let overlay_offsets = gpu.storage_buffer("overlay offsets", &overlay_table.offsets, false);
+    let overlay_entries = gpu.storage_buffer("overlay entries", &overlay_table.entries, false);
+    let marks = gpu.storage_buffer("overlay marks", &marks, false);
+    let overlay = (!members.is_empty()).then_some(OverlayBuffers {
+        table: TableBuffers {
+            table_size: overlay_table.table_size() as u32,
+            offsets: &overlay_offsets,
+            entries: &overlay_entries,
+        },
+        marks: &marks,
+    });
     let vertices = VertexBuffers::upload(gpu, positions, layers, flags)?;
     let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
     let active_buffer = gpu.storage_buffer("active layers", &active, false);
@@ -232,8 +296,9 @@ pub fn run_select(
         active.len(),
         &HashedVertices {
             table: &table,
-            positions: &filed.positions,
+            positions: &filed_positions,
             drift,
+            overlay,
         },
         brush,
         &selection,

@@ -69,12 +69,17 @@ pub trait StepKernels: Send {
     }
 }
 
-/// How often kernels that keep a copy of the mesh (the GPU's) sent it whole, and how often they
-/// patched it after remeshing instead.
+/// How often kernels that keep a copy of the mesh (the GPU's) sent it whole, how often they
+/// patched it after remeshing instead, and how often they rebuilt their hash table.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct Uploads {
     pub whole: usize,
     pub patched: usize,
+    /// Hash tables built over every vertex (drift past a limit rebuilds).
+    pub table_builds: usize,
+    /// Times the vertices remeshing changed went into the table's small overlay instead of a
+    /// rebuild.
+    pub overlay_filings: usize,
 }
 
 /// The CPU's selection (through the spatial hash, or by scanning) and deformation (rayon).
