@@ -89,8 +89,10 @@ struct Hashed {
     positions: wgpu::Buffer,
     /// How far any vertex may have moved since it was filed.
     drift: f32,
-    /// The vertices remeshing changed since the build, filed apart (`super::overlay`).
+    /// The vertices moved or changed since the build, filed apart (`super::overlay`).
     overlay: Option<Overlay>,
+    /// Vertices moved since the last filing (unsorted, may repeat).
+    moved: Vec<u32>,
 }
 
 /// The overlay table and its members.
@@ -103,17 +105,26 @@ struct Overlay {
 }
 
 impl Hashed {
-    /// Files `changed` (ascending) in the overlay with its earlier members, all at their
-    /// current positions. `false` when the overlay would pass its limit (or its buffers the
-    /// adapter's): rebuild the main table instead.
-    fn file(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
+    /// Files every vertex that moved or changed since the main table was built — the
+    /// overlay's members, the vertices moved since its filing (`moved`) and `changed` — in the
+    /// overlay at its current position, marked in `marks`: afterwards no vertex has drifted
+    /// from where it is filed. O(those vertices), where a rebuild is O(every vertex). `false`
+    /// when they pass [`overlay_limit`] (or the overlay's buffers the adapter's limits):
+    /// rebuild the main table instead.
+    fn refile(
+        &mut self,
+        gpu: &GpuContext,
+        mesh: &Mesh,
+        changed: &[u32],
+        marks: &wgpu::Buffer,
+    ) -> bool {
         let overlay = self.overlay.get_or_insert_with(|| Overlay {
             members: Vec::new(),
             table_size: 0,
             offsets: ReusableBuffer::storage("overlay offsets"),
             entries: ReusableBuffer::storage("overlay entries"),
         });
-        let mut members = Vec::with_capacity(overlay.members.len() + changed.len());
+        let mut members = std::mem::take(&mut self.moved);
         members.extend_from_slice(&overlay.members);
         members.extend_from_slice(changed);
         members.sort_unstable();
@@ -122,10 +133,32 @@ impl Hashed {
             return false;
         }
         let table = overlay_table(mesh.positions(), &members, self.table.inv_cell_size);
-        overlay.members = members;
         overlay.table_size = table.table_size() as u32;
-        overlay.offsets.upload(gpu, &table.offsets).is_ok()
-            && overlay.entries.upload(gpu, &table.entries).is_ok()
+        if overlay.offsets.upload(gpu, &table.offsets).is_err()
+            || overlay.entries.upload(gpu, &table.entries).is_err()
+        {
+            return false;
+        }
+        let mut patches = Patches::default();
+        patches.rows(&self.positions, mesh.positions(), &members);
+        for &v in &members {
+            patches.write(marks, v as usize, &[1u32]);
+        }
+        patches.submit(gpu);
+        overlay.members = members;
+        self.drift = 0.0;
+        true
+    }
+
+    /// Notes that `vertices` moved by at most `max_move`: they are filed anew at the next
+    /// refiling, and until then queries reach that much farther.
+    fn note_moved(&mut self, vertices: &[u32], max_move: f32, vertex_count: usize) {
+        self.drift += max_move;
+        self.moved.extend_from_slice(vertices);
+        if self.moved.len() > overlay_limit(vertex_count) {
+            self.moved.sort_unstable();
+            self.moved.dedup();
+        }
     }
 
     /// The overlay as queries bind it, with `marks` (per vertex, nonzero for members).
@@ -244,24 +277,17 @@ impl Resident {
         ) {
             return false;
         }
+        patches.submit(gpu);
         // What remeshing changed goes into the hash table's overlay; the main table stays.
+        let marks = &self.overlay_marks;
         let filed = self
             .hashed
             .as_mut()
-            .is_none_or(|h| h.file(gpu, mesh, changed));
+            .is_none_or(|h| h.refile(gpu, mesh, changed, marks));
         if !filed {
             // Rebuilt (and the marks cleared) at the next use.
             self.hashed = None;
         }
-        if let Some(h) = &self.hashed {
-            if let Some(overlay) = &h.overlay {
-                patches.rows(&h.positions, mesh.positions(), &overlay.members);
-            }
-            for &v in changed {
-                patches.write(&self.overlay_marks, v as usize, &[1u32]);
-            }
-        }
-        patches.submit(gpu);
         if let Some(t) = &mut self.topology {
             let mut topology = Patches::default();
             let fits = t.layout.patch(mesh, changed, &t.buffer, &mut topology);
@@ -474,7 +500,18 @@ impl GpuKernels {
                 .as_ref()
                 .is_none_or(|h| h.drift > limit || h.table.inv_cell_size != 1.0 / cell)
         });
-        if stale {
+        // Drift is undone by filing the moved vertices in the overlay; the table is rebuilt
+        // over every vertex only when there is none yet, its cells changed size, or the
+        // overlay grew too large.
+        let marks = &r.overlay_marks;
+        let refiled = stale
+            && r.hashed.as_mut().is_some_and(|h| {
+                h.table.inv_cell_size == 1.0 / cell && h.refile(gpu, mesh, &[], marks)
+            });
+        if refiled {
+            uploads.overlay_filings += 1;
+        }
+        if stale && !refiled {
             let count = r.vertices.count;
             // Rows for every vertex there is room for: the overlay files new ones here.
             let positions = gpu.output_buffer::<Vec3>("hashed positions", r.capacity);
@@ -503,6 +540,7 @@ impl GpuKernels {
                 positions,
                 drift: 0.0,
                 overlay: None,
+                moved: Vec::new(),
             });
         }
         Ok(r)
@@ -837,7 +875,7 @@ impl GpuKernels {
         };
         upload_rows(&self.gpu, &r.vertices.positions, mesh.positions(), vertices);
         if let Some(h) = r.hashed.as_mut() {
-            h.drift += max_move;
+            h.note_moved(vertices, max_move, mesh.vertex_count());
         }
         r.version.positions = mesh.version().positions;
     }
@@ -858,6 +896,7 @@ impl GpuKernels {
         if r.patch(&self.gpu, mesh, &rows) {
             r.version = mesh.version();
             self.uploads.patched += 1;
+            // Still a table: what remeshing changed went into its overlay.
             self.uploads.overlay_filings += r.hashed.is_some() as usize;
         } else {
             self.resident = None;
