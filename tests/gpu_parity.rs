@@ -1038,6 +1038,7 @@ fn cpu_proximity(
             moving: &moving,
             rings: &rings,
             marks: query.marks.unwrap_or(&[]),
+            overlay_marks: &[],
         },
         &mut pulls,
     );

@@ -353,7 +353,11 @@ fn proximity_and_normal_structs_match_naga_layout() {
             vertex_rows_base,
             all_faces,
             span,
-            cells_per_entry
+            cells_per_entry,
+            skip_marked,
+            _pad0,
+            _pad1,
+            _pad2
         }
     );
     assert_layout!(

@@ -46,6 +46,13 @@ struct ProximityParams {
     // Cells per entry, from the cell of x − cell_reach: enough for any x (the host sizes it).
     span: vec3<u32>,
     cells_per_entry: u32,
+    // Nonzero: leave out vertices with a nonzero `overlay_marks` entry (filed in the overlay
+    // table, src/gpu/overlay.rs, which the host walks in a second dispatch; their entries in
+    // this table are stale, and walking their faces twice would double the work).
+    skip_marked: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Bisection rounds when clamping a move: 2^-16 of a step (CLAMP_ROUNDS of the CPU).
@@ -65,6 +72,8 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(5) var<storage, read> marks: array<u32>;
 // Per entry: the largest pull-back amount found, 65536 − 65536·t; zero when not pulled.
 @group(0) @binding(6) var<storage, read_write> pulls: array<atomic<u32>>;
+// Per vertex: nonzero when filed in the overlay table (read when `skip_marked` is set).
+@group(0) @binding(7) var<storage, read> overlay_marks: array<u32>;
 // Paged (shared/pages.wgsl), group 1: `topology(i)`, the packed topology
 // (src/gpu/topology.rs): faces first, four words each (a, b, c, layer); then from
 // vertex_rows_base per vertex the absolute start and length of its row of face ids
@@ -159,7 +168,8 @@ fn main(
         let end = offsets[bucket + 1u];
         for (var j = offsets[bucket]; j < end; j++) {
             let u = entries[j];
-            if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
+            let elsewhere = params.skip_marked != 0u && overlay_marks[u] != 0u;
+            if !elsewhere && all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
                 let row = params.vertex_rows_base + 2u * u;
                 let first = topology(row);
                 let last = first + topology(row + 1u);

@@ -28,6 +28,9 @@ pub struct ProximityInputs<'a> {
     pub rings: &'a [u32],
     /// Per vertex; unread when `params.all_faces` is 1.
     pub marks: &'a [u32],
+    /// Per vertex: nonzero when filed in the overlay table; unread unless
+    /// `params.skip_marked`.
+    pub overlay_marks: &'a [u32],
 }
 
 fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
@@ -118,8 +121,9 @@ pub fn proximity(params: &ProximityParams, inputs: &ProximityInputs<'_>, pulls: 
             let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
             for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
                 let u = inputs.entries[j as usize];
+                let elsewhere = params.skip_marked != 0 && inputs.overlay_marks[u as usize] != 0;
                 let offset = (packed_position(inputs.positions, u) - x).abs();
-                if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
+                if !elsewhere && offset.cmple(Vec3::splat(params.vertex_reach)).all() {
                     let row = (params.vertex_rows_base + 2 * u) as usize;
                     let first = inputs.topology[row];
                     for k in first..first + inputs.topology[row + 1] {

@@ -757,8 +757,10 @@ impl GpuKernels {
             count,
             layout.vertex_rows_base,
         );
+        // The main table leaves the overlay's members to the overlay.
         let params = |all_faces: bool| ProximityParams {
             all_faces: all_faces as u32,
+            skip_marked: hashed.overlay.is_some() as u32,
             ..first
         };
         check_invocations(&params(true))?;
@@ -771,9 +773,10 @@ impl GpuKernels {
             moving: step.moving.buffer(),
             rings: step.rings.buffer(),
             marks: &r.marks,
+            overlay_marks: &r.overlay_marks,
         };
-        // Vertices remeshing changed are filed in the overlay: each pass walks it too (their
-        // stale entries in the main table only repeat tests, which take the minimum).
+        // Vertices moved or changed since the main table was built are filed in the overlay:
+        // each pass walks it too.
         let overlay = hashed.overlay(&r.overlay_marks).map(|o| {
             let buffers = ProximityBuffers {
                 offsets: o.table.offsets,
@@ -823,6 +826,7 @@ impl GpuKernels {
             if let Some((buffers, table_mask)) = &overlay {
                 let params = ProximityParams {
                     table_mask: *table_mask,
+                    skip_marked: 0,
                     ..params(pass == 0)
                 };
                 record_proximity(gpu, &mut encoder, buffers, &params, pulls, sized)?;

@@ -117,6 +117,9 @@ pub struct ProximityBuffers<'a> {
     pub rings: &'a wgpu::Buffer,
     /// Per-vertex marks; any buffer when `params.all_faces` is 1.
     pub marks: &'a wgpu::Buffer,
+    /// Per vertex: nonzero when filed in the overlay table; any buffer unless
+    /// `params.skip_marked`.
+    pub overlay_marks: &'a wgpu::Buffer,
 }
 
 /// Records one pass folding into `pulls[i]` (zero beforehand) the pull-back amount of each of
@@ -140,6 +143,7 @@ pub fn record_proximity(
         inputs.moving,
         inputs.marks,
         pulls,
+        inputs.overlay_marks,
     ];
     let workgroups = match indirect {
         Some(args) => Workgroups::Indirect(args),
@@ -240,6 +244,10 @@ pub fn pass_params(
         all_faces: 1,
         span,
         cells_per_entry: cells,
+        skip_marked: 0,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     }
 }
 
@@ -299,6 +307,8 @@ pub fn run_proximity(
             moving: &moving,
             rings: &rings,
             marks: &marks,
+            // No overlay: unread.
+            overlay_marks: &marks,
         },
         &params,
         &pulls,
