@@ -1039,6 +1039,8 @@ fn cpu_proximity(
             rings: &rings,
             marks: query.marks.unwrap_or(&[]),
             overlay_marks: &[],
+            overlay_offsets: &[],
+            overlay_entries: &[],
         },
         &mut pulls,
     );

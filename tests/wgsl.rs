@@ -354,10 +354,10 @@ fn proximity_and_normal_structs_match_naga_layout() {
             all_faces,
             span,
             cells_per_entry,
-            skip_marked,
+            overlay,
+            overlay_mask,
             _pad0,
-            _pad1,
-            _pad2
+            _pad1
         }
     );
     assert_layout!(

@@ -46,13 +46,14 @@ struct ProximityParams {
     // Cells per entry, from the cell of x − cell_reach: enough for any x (the host sizes it).
     span: vec3<u32>,
     cells_per_entry: u32,
-    // Nonzero: leave out vertices with a nonzero `overlay_marks` entry (filed in the overlay
-    // table, src/gpu/overlay.rs, which the host walks in a second dispatch; their entries in
-    // this table are stale, and walking their faces twice would double the work).
-    skip_marked: u32,
+    // Nonzero: vertices moved or changed since the table was built are filed in the overlay
+    // table (src/gpu/overlay.rs, `overlay_mask + 1` buckets): each invocation walks its cell's
+    // bucket there too, and leaves out of the main table's bucket the vertices marked in
+    // `overlay_marks` (their entries there are stale).
+    overlay: u32,
+    overlay_mask: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // Bisection rounds when clamping a move: 2^-16 of a step (CLAMP_ROUNDS of the CPU).
@@ -72,8 +73,11 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(5) var<storage, read> marks: array<u32>;
 // Per entry: the largest pull-back amount found, 65536 − 65536·t; zero when not pulled.
 @group(0) @binding(6) var<storage, read_write> pulls: array<atomic<u32>>;
-// Per vertex: nonzero when filed in the overlay table (read when `skip_marked` is set).
+// The overlay: per vertex nonzero when filed there, and its buckets (read when `overlay` is
+// set).
 @group(0) @binding(7) var<storage, read> overlay_marks: array<u32>;
+@group(0) @binding(8) var<storage, read> overlay_offsets: array<u32>;
+@group(0) @binding(9) var<storage, read> overlay_entries: array<u32>;
 // Paged (shared/pages.wgsl), group 1: `topology(i)`, the packed topology
 // (src/gpu/topology.rs): faces first, four words each (a, b, c, layer); then from
 // vertex_rows_base per vertex the absolute start and length of its row of face ids
@@ -146,6 +150,20 @@ fn safe_fraction(entry: MovingVertex, f: u32, x: vec3<f32>) -> f32 {
 // Bisection fractions are multiples of 1 / PULL_SCALE.
 const PULL_SCALE: f32 = 65536.0;
 
+// The smallest safe fraction against the faces of vertex u, if u is within reach of x.
+fn faces_fraction(entry: MovingVertex, u: u32, x: vec3<f32>) -> f32 {
+    var t = 1.0;
+    if all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
+        let row = params.vertex_rows_base + 2u * u;
+        let first = topology(row);
+        let last = first + topology(row + 1u);
+        for (var k = first; k < last; k++) {
+            t = min(t, safe_fraction(entry, topology(k), x));
+        }
+    }
+    return t;
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(
     @builtin(global_invocation_id) global_id: vec3<u32>,
@@ -164,18 +182,20 @@ fn main(
         let low = cell_of(x - vec3<f32>(params.cell_reach), params.inv_cell_size);
         let span = params.span;
         let step = vec3<u32>(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-        let bucket = hash_cell(low + bitcast<vec3<i32>>(step), params.table_mask);
+        let cell = low + bitcast<vec3<i32>>(step);
+        let bucket = hash_cell(cell, params.table_mask);
         let end = offsets[bucket + 1u];
         for (var j = offsets[bucket]; j < end; j++) {
             let u = entries[j];
-            let elsewhere = params.skip_marked != 0u && overlay_marks[u] != 0u;
-            if !elsewhere && all(abs(position(u) - x) <= vec3<f32>(params.vertex_reach)) {
-                let row = params.vertex_rows_base + 2u * u;
-                let first = topology(row);
-                let last = first + topology(row + 1u);
-                for (var k = first; k < last; k++) {
-                    t = min(t, safe_fraction(entry, topology(k), x));
-                }
+            if params.overlay == 0u || overlay_marks[u] == 0u {
+                t = min(t, faces_fraction(entry, u, x));
+            }
+        }
+        if params.overlay != 0u {
+            let b = hash_cell(cell, params.overlay_mask);
+            let last = overlay_offsets[b + 1u];
+            for (var j = overlay_offsets[b]; j < last; j++) {
+                t = min(t, faces_fraction(entry, overlay_entries[j], x));
             }
         }
     }

@@ -28,9 +28,32 @@ pub struct ProximityInputs<'a> {
     pub rings: &'a [u32],
     /// Per vertex; unread when `params.all_faces` is 1.
     pub marks: &'a [u32],
-    /// Per vertex: nonzero when filed in the overlay table; unread unless
-    /// `params.skip_marked`.
+    /// The overlay table: per vertex nonzero when filed there, and its `offsets` and
+    /// `entries`; unread unless `params.overlay`.
     pub overlay_marks: &'a [u32],
+    pub overlay_offsets: &'a [u32],
+    pub overlay_entries: &'a [u32],
+}
+
+/// The smallest safe fraction against the faces of vertex `u`, if `u` is within reach of `x`.
+fn faces_fraction(
+    params: &ProximityParams,
+    inputs: &ProximityInputs<'_>,
+    entry: &MovingVertex,
+    u: u32,
+    x: Vec3,
+) -> f32 {
+    let mut t = 1.0f32;
+    let offset = (packed_position(inputs.positions, u) - x).abs();
+    if offset.cmple(Vec3::splat(params.vertex_reach)).all() {
+        let row = (params.vertex_rows_base + 2 * u) as usize;
+        let first = inputs.topology[row];
+        for k in first..first + inputs.topology[row + 1] {
+            let f = inputs.topology[k as usize];
+            t = t.min(safe_fraction(params, inputs, entry, f, x));
+        }
+    }
+    t
 }
 
 fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
@@ -118,18 +141,19 @@ pub fn proximity(params: &ProximityParams, inputs: &ProximityInputs<'_>, pulls: 
         if x != Vec3::from_array(entry.start) {
             let low = cell_coordinates(x - Vec3::splat(params.cell_reach), params.inv_cell_size);
             let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-            let bucket = hash_cell(low + step.as_ivec3(), table_size) as usize;
+            let cell = low + step.as_ivec3();
+            let bucket = hash_cell(cell, table_size) as usize;
             for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
                 let u = inputs.entries[j as usize];
-                let elsewhere = params.skip_marked != 0 && inputs.overlay_marks[u as usize] != 0;
-                let offset = (packed_position(inputs.positions, u) - x).abs();
-                if !elsewhere && offset.cmple(Vec3::splat(params.vertex_reach)).all() {
-                    let row = (params.vertex_rows_base + 2 * u) as usize;
-                    let first = inputs.topology[row];
-                    for k in first..first + inputs.topology[row + 1] {
-                        let f = inputs.topology[k as usize];
-                        t = t.min(safe_fraction(params, inputs, entry, f, x));
-                    }
+                if params.overlay == 0 || inputs.overlay_marks[u as usize] == 0 {
+                    t = t.min(faces_fraction(params, inputs, entry, u, x));
+                }
+            }
+            if params.overlay != 0 {
+                let b = hash_cell(cell, params.overlay_mask.wrapping_add(1)) as usize;
+                for j in inputs.overlay_offsets[b]..inputs.overlay_offsets[b + 1] {
+                    let u = inputs.overlay_entries[j as usize];
+                    t = t.min(faces_fraction(params, inputs, entry, u, x));
                 }
             }
         }

@@ -757,14 +757,18 @@ impl GpuKernels {
             count,
             layout.vertex_rows_base,
         );
-        // The main table leaves the overlay's members to the overlay.
+        // Vertices moved or changed since the main table was built are filed in the overlay:
+        // each invocation walks its cell there too, and leaves them out of the main table.
+        let overlay = hashed.overlay(&r.overlay_marks);
         let params = |all_faces: bool| ProximityParams {
             all_faces: all_faces as u32,
-            skip_marked: hashed.overlay.is_some() as u32,
+            overlay: overlay.is_some() as u32,
+            overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
             ..first
         };
         check_invocations(&params(true))?;
         let invocations = count * first.cells_per_entry as usize;
+        // Without an overlay its bindings are never read: the main table's stand in.
         let proximity = ProximityBuffers {
             positions: &r.vertices.positions,
             offsets: &hashed.table.offsets,
@@ -774,17 +778,9 @@ impl GpuKernels {
             rings: step.rings.buffer(),
             marks: &r.marks,
             overlay_marks: &r.overlay_marks,
+            overlay_offsets: overlay.map_or(&hashed.table.offsets, |o| o.table.offsets),
+            overlay_entries: overlay.map_or(&hashed.table.entries, |o| o.table.entries),
         };
-        // Vertices moved or changed since the main table was built are filed in the overlay:
-        // each pass walks it too.
-        let overlay = hashed.overlay(&r.overlay_marks).map(|o| {
-            let buffers = ProximityBuffers {
-                offsets: o.table.offsets,
-                entries: o.table.entries,
-                ..proximity
-            };
-            (buffers, o.table.table_size - 1)
-        });
         let apply = ApplyMovesBuffers {
             moving: step.moving.buffer(),
             targets: step.targets.buffer(),
@@ -823,14 +819,6 @@ impl GpuKernels {
                 pulls,
                 sized,
             )?;
-            if let Some((buffers, table_mask)) = &overlay {
-                let params = ProximityParams {
-                    table_mask: *table_mask,
-                    skip_marked: 0,
-                    ..params(pass == 0)
-                };
-                record_proximity(gpu, &mut encoder, buffers, &params, pulls, sized)?;
-            }
             encoder.clear_buffer(&step.next_count, 0, None);
             let mode = if pass + 1 == MAX_PASSES {
                 ApplyMode::PullLast

@@ -120,11 +120,12 @@ pub struct ProximityParams {
     /// Cells searched per entry (x, y, z), from the cell of x − `cell_reach`.
     pub span: [u32; 3],
     pub cells_per_entry: u32,
-    /// Nonzero: leave out vertices marked as filed in the overlay table.
-    pub skip_marked: u32,
+    /// Nonzero: walk the overlay table too (`overlay_mask + 1` buckets), leaving its members
+    /// out of the main table's buckets.
+    pub overlay: u32,
+    pub overlay_mask: u32,
     pub _pad0: u32,
     pub _pad1: u32,
-    pub _pad2: u32,
 }
 
 /// `ApplyParams` in `wgsl/apply_moves.wgsl`.

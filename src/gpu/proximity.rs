@@ -117,9 +117,11 @@ pub struct ProximityBuffers<'a> {
     pub rings: &'a wgpu::Buffer,
     /// Per-vertex marks; any buffer when `params.all_faces` is 1.
     pub marks: &'a wgpu::Buffer,
-    /// Per vertex: nonzero when filed in the overlay table; any buffer unless
-    /// `params.skip_marked`.
+    /// The overlay table: per vertex nonzero when filed there, its offsets and entries; any
+    /// buffers unless `params.overlay`.
     pub overlay_marks: &'a wgpu::Buffer,
+    pub overlay_offsets: &'a wgpu::Buffer,
+    pub overlay_entries: &'a wgpu::Buffer,
 }
 
 /// Records one pass folding into `pulls[i]` (zero beforehand) the pull-back amount of each of
@@ -144,6 +146,8 @@ pub fn record_proximity(
         inputs.marks,
         pulls,
         inputs.overlay_marks,
+        inputs.overlay_offsets,
+        inputs.overlay_entries,
     ];
     let workgroups = match indirect {
         Some(args) => Workgroups::Indirect(args),
@@ -244,10 +248,10 @@ pub fn pass_params(
         all_faces: 1,
         span,
         cells_per_entry: cells,
-        skip_marked: 0,
+        overlay: 0,
+        overlay_mask: 0,
         _pad0: 0,
         _pad1: 0,
-        _pad2: 0,
     }
 }
 
@@ -309,6 +313,8 @@ pub fn run_proximity(
             marks: &marks,
             // No overlay: unread.
             overlay_marks: &marks,
+            overlay_offsets: &marks,
+            overlay_entries: &marks,
         },
         &params,
         &pulls,
