@@ -63,6 +63,8 @@ const SELECT_DRIFT_SHARE: f32 = 0.25;
 enum TableUse {
     /// Not at all (deformation): whatever table there is stays, stale or not.
     None,
+    /// Any table, however old (the warm-up before a stroke).
+    Present,
     /// Brush selection with this radius.
     Select { radius: f32 },
     /// The proximity passes.
@@ -76,6 +78,7 @@ impl TableUse {
         let least = DRIFT_LIMIT_CELLS * cell;
         match self {
             TableUse::None => None,
+            TableUse::Present => Some(f32::INFINITY),
             TableUse::Select { radius } => Some((SELECT_DRIFT_SHARE * radius).max(least)),
             TableUse::Proximity => Some(least),
         }
@@ -963,6 +966,15 @@ impl StepKernels for GpuKernels {
 
     fn failure(&self) -> Option<String> {
         self.failed.clone()
+    }
+
+    fn warm_up(&mut self, mesh: &Mesh, cell_size: f32) {
+        // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
+        // their failures at the strokes' calls.
+        self.on_gpu(|k| {
+            let tables = (&mut k.resident, &mut k.uploads);
+            GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present).map(|_| ())
+        });
     }
 
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {

@@ -253,7 +253,11 @@ fn frame_at(
 
 impl SculptPipeline for CpuPipeline {
     fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
-        self.prepare_state(mesh)
+        self.prepare_state(mesh)?;
+        if let Some(prepared) = &self.prepared {
+            self.kernels.warm_up(mesh, prepared.grid.cell_size());
+        }
+        Ok(())
     }
 
     fn uploads(&self) -> Option<Uploads> {

@@ -24,6 +24,10 @@ pub trait StepKernels: Send {
     fn failure(&self) -> Option<String> {
         None
     }
+    /// Gets ready for strokes on `mesh` with the pipeline's cells of `cell_size` (the GPU's:
+    /// its copy of the mesh uploaded, its hash table built), so that the first stroke does not
+    /// pay for it. Called before every stroke; nothing to do when ready.
+    fn warm_up(&mut self, _mesh: &Mesh, _cell_size: f32) {}
     /// The vertices under the brush with their falloff weights, in vertex order.
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)>;
     /// Where the brush moves each selected vertex.
