@@ -381,6 +381,14 @@ impl GpuContext {
         Ok(bytemuck::pod_collect_to_vec::<u8, T>(&bytes))
     }
 
+    /// Waits until the GPU has done everything submitted so far.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Readback(e.to_string()))
+    }
+
     /// Waits for the GPU and copies a mappable (`MAP_READ`) buffer's bytes out.
     pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         let (sender, receiver) = mpsc::channel();

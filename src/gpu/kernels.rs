@@ -973,7 +973,9 @@ impl StepKernels for GpuKernels {
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
             let tables = (&mut k.resident, &mut k.uploads);
-            GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present).map(|_| ())
+            GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present)?;
+            // Done here, not in the first call that reads something back.
+            k.gpu.wait()
         });
     }
 
