@@ -461,6 +461,16 @@ fn random_vertices(size: usize, seed: u64, extent: f32) -> (Vec<Vec3>, Vec<u32>,
     (positions, layers, flags)
 }
 
+/// A brush of a few cells around the first vertex (or the origin when there is none), so that
+/// buckets shared by cells in and out of its box are filtered; the `i`-th falloff.
+fn brush_around(positions: &[Vec3], extent: f32, i: usize) -> BrushSphere {
+    BrushSphere {
+        center: positions.first().copied().unwrap_or(Vec3::ZERO),
+        radius: 0.6 * extent + 0.3,
+        falloff: FALLOFFS[i % FALLOFFS.len()],
+    }
+}
+
 /// Vertices remeshing changed are filed in the overlay at their new positions while their
 /// entries in the main table stay where they were: selecting through both (the main table
 /// leaving the overlay's members out) finds exactly what one fresh table of the current
@@ -485,11 +495,7 @@ fn select_through_an_overlay_matches_a_fresh_table() {
                 Vec3::splat(1e-6)
             };
         }
-        let brush = BrushSphere {
-            center: positions.first().copied().unwrap_or(Vec3::ZERO),
-            radius: 0.6 * extent + 0.3,
-            falloff: FALLOFFS[i % FALLOFFS.len()],
-        };
+        let brush = brush_around(&positions, extent, i);
         let inv = 1.0 / cell_size;
         let expected = cpu_select(
             &positions, &positions, &layers, &flags, &active, inv, &brush,
@@ -527,13 +533,7 @@ fn select_matches_cpu_mirror_at_awkward_sizes() {
         let cell_size = 0.25f32;
         let extent = 0.5 * cell_size * (size as f32).cbrt().max(1.0);
         let (positions, layers, flags) = random_vertices(size, 200 + 3 * i as u64, extent);
-        // A brush of a few cells around a vertex (or the origin when there is none), so
-        // buckets shared by cells in and out of the box are filtered.
-        let brush = BrushSphere {
-            center: positions.first().copied().unwrap_or(Vec3::ZERO),
-            radius: 0.6 * extent + 0.3,
-            falloff: FALLOFFS[i % FALLOFFS.len()],
-        };
+        let brush = brush_around(&positions, extent, i);
         let inv = 1.0 / cell_size;
         let expected = cpu_select(
             &positions, &positions, &layers, &flags, &active, inv, &brush,

@@ -158,9 +158,14 @@ impl Hashed {
     fn note_moved(&mut self, vertices: &[u32], max_move: f32, vertex_count: usize) {
         self.drift += max_move;
         self.moved.extend_from_slice(vertices);
-        if self.moved.len() > overlay_limit(vertex_count) {
+        let limit = overlay_limit(vertex_count);
+        if self.moved.len() > limit {
             self.moved.sort_unstable();
             self.moved.dedup();
+            if self.moved.len() > limit {
+                // Too many to file apart: stale for every use, so the next rebuilds.
+                self.drift = f32::INFINITY;
+            }
         }
     }
 
@@ -257,7 +262,8 @@ impl Resident {
     /// Sends what remeshing changed — the rows of `changed` (ascending, every vertex added
     /// since among them) in every per-vertex array, the neighbour and topology rows, the faces
     /// around them — into room left for it. `false` when the mesh outgrew the room (upload
-    /// afresh). The hash table is dropped: the next use rebuilds it over the new vertices.
+    /// afresh). The changed vertices go into the hash table's overlay (or, past its limit, the
+    /// table is rebuilt at its next use).
     fn patch(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
         if mesh.vertex_count() > self.capacity || mesh.layer_count() != self.layer_count {
             return false;
