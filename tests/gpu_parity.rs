@@ -414,6 +414,69 @@ fn pairs(selection: &[SelectedVertex]) -> Vec<(u32, f32)> {
     selection.iter().map(|s| (s.vertex, s.weight)).collect()
 }
 
+/// The CPU mirror of the GPU backend's selection through an overlay: the main table of the
+/// `hashed` positions walked leaving `members` out, then the overlay of `members` at
+/// `positions` (or, for a brush whose box outnumbers the vertices, one scan).
+#[allow(clippy::too_many_arguments)]
+fn cpu_select_with_overlay(
+    hashed: &[Vec3],
+    positions: &[Vec3],
+    layers: &[u32],
+    flags: &[u32],
+    active: &[bool],
+    inv_cell_size: f32,
+    brush: &BrushSphere,
+    members: &[u32],
+) -> Vec<SelectedVertex> {
+    let table_size = table_size_for(positions.len());
+    let main = slayer::cpu::hash_table(hashed, flags, inv_cell_size, table_size);
+    let overlay = slayer::gpu::overlay_table(positions, members, inv_cell_size);
+    let (mut filed_at, mut marks) = (hashed.to_vec(), vec![0u32; positions.len()]);
+    for &v in members {
+        filed_at[v as usize] = positions[v as usize];
+        marks[v as usize] = 1;
+    }
+    let drift = (0..positions.len())
+        .filter(|&v| marks[v] == 0)
+        .map(|v| hashed[v].distance(positions[v]))
+        .fold(0.0f32, f32::max);
+    let params = select_params(
+        brush,
+        drift,
+        inv_cell_size,
+        table_size,
+        positions.len(),
+        active.len(),
+    );
+    let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
+    let mut walks = vec![(&main, params.scan_vertices == 0 && !members.is_empty())];
+    if params.scan_vertices == 0 && !members.is_empty() {
+        walks.push((&overlay, false));
+    }
+    let mut selected = vec![SelectedVertex::default(); positions.len()];
+    let mut count = 0u32;
+    for (table, skip_marked) in walks {
+        let inputs = slayer::cpu::SelectInputs {
+            positions: bytemuck::cast_slice(positions),
+            vertex_layers: layers,
+            flags,
+            active_layers: &active,
+            offsets: &table.offsets,
+            entries: &table.entries,
+            hashed: bytemuck::cast_slice(&filed_at),
+            marks: &marks,
+        };
+        let params = slayer::gpu::SelectParams {
+            table_mask: table.table_size() as u32 - 1,
+            skip_marked: skip_marked as u32,
+            ..params
+        };
+        slayer::cpu::select(&params, &inputs, &mut selected, &mut count);
+    }
+    selected.truncate(count as usize);
+    selected
+}
+
 /// The CPU mirror chain: hash table of the `hashed` positions, then `select` at `positions`.
 fn cpu_select(
     hashed: &[Vec3],
@@ -474,7 +537,7 @@ fn brush_around(positions: &[Vec3], extent: f32, i: usize) -> BrushSphere {
 /// Vertices remeshing changed are filed in the overlay at their new positions while their
 /// entries in the main table stay where they were: selecting through both (the main table
 /// leaving the overlay's members out) finds exactly what one fresh table of the current
-/// positions finds — no member missed, none found twice.
+/// positions finds — no member missed, none found twice — on the GPU and in the mirror.
 #[test]
 fn select_through_an_overlay_matches_a_fresh_table() {
     let gpu = gpu();
@@ -500,6 +563,9 @@ fn select_through_an_overlay_matches_a_fresh_table() {
         let expected = cpu_select(
             &positions, &positions, &layers, &flags, &active, inv, &brush,
         );
+        let mirrored = cpu_select_with_overlay(
+            &stale, &positions, &layers, &flags, &active, inv, &brush, &members,
+        );
         let actual = slayer::gpu::run_select_with_overlay(
             &gpu,
             &stale,
@@ -514,10 +580,20 @@ fn select_through_an_overlay_matches_a_fresh_table() {
             size < 64 || expected.iter().any(|s| s.vertex % 3 == 0),
             "size {size}: the overlay's members are selected"
         );
+        // The mirror walks the tables as the GPU does; both find what a fresh table finds.
+        for (found, by) in [(&actual, "GPU"), (&mirrored, "mirror")] {
+            assert_same_selection(
+                &format!("size {size} with an overlay ({by})"),
+                &pairs(found),
+                &pairs(&expected),
+                &positions,
+                &brush,
+            );
+        }
         assert_same_selection(
-            &format!("size {size} with an overlay"),
+            &format!("size {size} with an overlay (GPU vs mirror)"),
             &pairs(&actual),
-            &pairs(&expected),
+            &pairs(&mirrored),
             &positions,
             &brush,
         );
