@@ -431,18 +431,10 @@ fn cpu_select_with_overlay(
     let table_size = table_size_for(positions.len());
     let main = slayer::cpu::hash_table(hashed, flags, inv_cell_size, table_size);
     let overlay = slayer::gpu::overlay_table(positions, members, inv_cell_size);
-    let (mut filed_at, mut marks) = (hashed.to_vec(), vec![0u32; positions.len()]);
-    for &v in members {
-        filed_at[v as usize] = positions[v as usize];
-        marks[v as usize] = 1;
-    }
-    let drift = (0..positions.len())
-        .filter(|&v| marks[v] == 0)
-        .map(|v| hashed[v].distance(positions[v]))
-        .fold(0.0f32, f32::max);
+    let filing = slayer::gpu::Filing::of(hashed, positions, members);
     let params = select_params(
         brush,
-        drift,
+        filing.drift,
         inv_cell_size,
         table_size,
         positions.len(),
@@ -463,8 +455,8 @@ fn cpu_select_with_overlay(
             active_layers: &active,
             offsets: &table.offsets,
             entries: &table.entries,
-            hashed: bytemuck::cast_slice(&filed_at),
-            marks: &marks,
+            hashed: bytemuck::cast_slice(&filing.filed_at),
+            marks: &filing.marks,
         };
         let params = slayer::gpu::SelectParams {
             table_mask: table.table_size() as u32 - 1,
@@ -487,33 +479,16 @@ fn cpu_select(
     inv_cell_size: f32,
     brush: &BrushSphere,
 ) -> Vec<SelectedVertex> {
-    let table_size = table_size_for(positions.len());
-    let table = slayer::cpu::hash_table(hashed, flags, inv_cell_size, table_size);
-    let drift = slayer::geom::largest_move(hashed, positions);
-    let params = select_params(
-        brush,
-        drift,
-        inv_cell_size,
-        table_size,
-        positions.len(),
-        active.len(),
-    );
-    let active: Vec<u32> = active.iter().map(|&a| a as u32).collect();
-    let inputs = slayer::cpu::SelectInputs {
-        positions: bytemuck::cast_slice(positions),
-        vertex_layers: layers,
+    cpu_select_with_overlay(
+        hashed,
+        positions,
+        layers,
         flags,
-        active_layers: &active,
-        offsets: &table.offsets,
-        entries: &table.entries,
-        hashed: bytemuck::cast_slice(hashed),
-        marks: &[],
-    };
-    let mut selected = vec![SelectedVertex::default(); positions.len()];
-    let mut count = 0u32;
-    slayer::cpu::select(&params, &inputs, &mut selected, &mut count);
-    selected.truncate(count as usize);
-    selected
+        active,
+        inv_cell_size,
+        brush,
+        &[],
+    )
 }
 
 /// Random vertices on three layers (the middle one inactive), some masked or dead.

@@ -42,7 +42,7 @@ pub use layout::{
     ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
     NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
-pub use overlay::{OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
+pub use overlay::{Filing, OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};
 pub use proximity::{
     PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,

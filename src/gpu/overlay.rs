@@ -37,6 +37,37 @@ pub fn overlay_table(positions: &[Vec3], members: &[u32], inv_cell_size: f32) ->
     table
 }
 
+/// Where queries find each vertex when `members` are filed in the overlay at `positions` and
+/// the others where the main table filed them (`hashed`).
+pub struct Filing {
+    /// Per vertex: the position it is filed at.
+    pub filed_at: Vec<Vec3>,
+    /// Per vertex: 1 for members.
+    pub marks: Vec<u32>,
+    /// How far any other vertex has moved since the main table filed it.
+    pub drift: f32,
+}
+
+impl Filing {
+    pub fn of(hashed: &[Vec3], positions: &[Vec3], members: &[u32]) -> Filing {
+        let mut filed_at = hashed.to_vec();
+        let mut marks = vec![0u32; positions.len()];
+        for &v in members {
+            filed_at[v as usize] = positions[v as usize];
+            marks[v as usize] = 1;
+        }
+        let drift = (0..positions.len())
+            .filter(|&v| marks[v] == 0)
+            .map(|v| hashed[v].distance(positions[v]))
+            .fold(0.0f32, f32::max);
+        Filing {
+            filed_at,
+            marks,
+            drift,
+        }
+    }
+}
+
 /// The buckets of a table a query walks (the main table's or the overlay's).
 #[derive(Clone, Copy)]
 pub struct TableBuffers<'a> {

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::overlay::{OverlayBuffers, TableBuffers, overlay_table};
+use super::overlay::{Filing, OverlayBuffers, TableBuffers, overlay_table};
 use super::reusable::ReusableBuffer;
 use super::{
     GpuContext, GpuError, GpuHashTable, SelectParams, SelectedVertex, VertexBuffers, table_size_for,
@@ -249,17 +249,11 @@ pub fn run_select_with_overlay(
     );
     // The main table is built from the stale positions; the overlay's members are filed (and
     // their filing positions recorded) where they are now.
-    let mut filed_at = hashed.to_vec();
-    let mut marks = vec![0u32; positions.len()];
-    for &v in members {
-        filed_at[v as usize] = positions[v as usize];
-        marks[v as usize] = 1;
-    }
-    let unmarked = |v: usize| marks[v] == 0;
-    let drift = (0..positions.len())
-        .filter(|&v| unmarked(v))
-        .map(|v| hashed[v].distance(positions[v]))
-        .fold(0.0f32, f32::max);
+    let Filing {
+        filed_at,
+        marks,
+        drift,
+    } = Filing::of(hashed, positions, members);
     let filed = VertexBuffers::upload(gpu, hashed, layers, flags)?;
     let filed_positions = gpu.storage_buffer("filed positions", &filed_at, false);
     let overlay_table = overlay_table(positions, members, inv_cell_size);
