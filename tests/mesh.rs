@@ -114,6 +114,13 @@ fn versions_count_changes() {
     assert_eq!(mesh.version().positions, before.positions + 1);
     mesh.brdfs_mut()[0].roughness = 0.1;
     assert_eq!(mesh.version().attributes, before.attributes + 1);
+    mesh.flags_mut()[0] = VertexFlags::MASKED;
+    assert_eq!(mesh.version().flags, before.flags + 1);
+    assert_eq!(
+        mesh.version().attributes,
+        before.attributes + 1,
+        "flags are apart"
+    );
     mesh.kill_face(0);
     assert_eq!(mesh.version().topology, before.topology + 1);
     assert!(mesh.version().total() > before.total());

@@ -12,9 +12,12 @@
 //! - after remeshing (`remeshed`), the rows of the vertices it changed — positions, normals,
 //!   flags, layers, smoothing neighbours, faces and the faces around them — are patched in
 //!   place (`super::rows` keeps variable-length rows patchable), in one upload;
-//! - flags alone: in full when they changed (painting or masking between strokes);
-//! - the hash table: rebuilt only when the vertices have drifted more than half a cell since it
-//!   was built — queries grow their reach by the drift instead (`select`, `proximity`);
+//! - flags alone: in full when they changed (masking between strokes; painting changes BRDFs,
+//!   which the GPU does not keep);
+//! - the hash table: built once; the vertices moved or changed since are filed in its overlay
+//!   (`super::overlay`) and refiled when they drift farther than the use tolerates — queries
+//!   grow their reach by the drift until then (`select`, `proximity`); rebuilt over every
+//!   vertex only when the overlay passes its limit;
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
 //!
 //! A step is three submissions, each with one blocking read-back: the selection (its count and
@@ -584,7 +587,7 @@ impl GpuKernels {
                 .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
             r.hashed = None;
         }
-        if r.version.attributes != version.attributes {
+        if r.version.flags != version.flags {
             gpu.queue
                 .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(&flag_bits(mesh)));
         }

@@ -34,14 +34,17 @@ pub struct MeshVersion {
     pub topology: u64,
     /// Positions (and therefore normals) changed.
     pub positions: u64,
-    /// BRDFs, flags or layer labels changed.
+    /// BRDFs changed (painting, file import).
     pub attributes: u64,
+    /// Vertex flags changed (masking). Apart from the BRDFs because the GPU keeps the flags
+    /// and not the BRDFs: painting must not make it re-send them.
+    pub flags: u64,
 }
 
 impl MeshVersion {
     /// One counter covering every kind of change.
     pub fn total(&self) -> u64 {
-        self.topology + self.positions + self.attributes
+        self.topology + self.positions + self.attributes + self.flags
     }
 }
 
@@ -211,7 +214,7 @@ impl Mesh {
     }
 
     pub fn flags_mut(&mut self) -> &mut [VertexFlags] {
-        self.version.attributes += 1;
+        self.version.flags += 1;
         &mut self.flags
     }
 
