@@ -320,7 +320,7 @@ fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
         .filter(|&&(v, _)| v as usize >= old_count)
         .count();
     assert!(new > 0, "new vertices are selected");
-    let uploads = kernels.uploads();
+    let uploads = kernels.uploads().expect("GPU kernels keep a copy");
     assert_eq!((uploads.table_builds, uploads.overlay_filings), (1, 1));
     assert_eq!(kernels.failure(), None);
 }

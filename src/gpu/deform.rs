@@ -71,17 +71,8 @@ impl SmoothingNeighbours {
         (table, words): (&'a wgpu::Buffer, &'a wgpu::Buffer),
         patches: &mut Patches<'a>,
     ) -> bool {
-        let mut row = Vec::new();
-        for &v in changed {
-            row.clear();
-            neighbour_row(mesh, v, &mut row);
-            let Some(placed) = rows.place(v, row.len() as u32) else {
-                return false;
-            };
-            patches.write(words, placed.start as usize, &row);
-            patches.write(table, 2 * v as usize, &[placed.start, row.len() as u32]);
-        }
-        true
+        let row_of = |v, row: &mut Vec<u32>| neighbour_row(mesh, v, row);
+        rows.patch(changed, row_of, ((table, 0), words), patches)
     }
 }
 

@@ -93,6 +93,8 @@ struct Hashed {
     table: GpuHashTable,
     /// Where each vertex was filed: at the build, or for the overlay's members at their filing.
     positions: wgpu::Buffer,
+    /// Per vertex: nonzero when filed in the overlay.
+    marks: wgpu::Buffer,
     /// How far any vertex may have moved since it was filed.
     drift: f32,
     /// The vertices moved or changed since the build, filed apart (`super::overlay`).
@@ -113,17 +115,11 @@ struct Overlay {
 impl Hashed {
     /// Files every vertex that moved or changed since the main table was built — the
     /// overlay's members, the vertices moved since its filing (`moved`) and `changed` — in the
-    /// overlay at its current position, marked in `marks`: afterwards no vertex has drifted
+    /// overlay at its current position, and marks them: afterwards no vertex has drifted
     /// from where it is filed. O(those vertices), where a rebuild is O(every vertex). `false`
     /// when they pass [`overlay_limit`] (or the overlay's buffers the adapter's limits):
     /// rebuild the main table instead.
-    fn refile(
-        &mut self,
-        gpu: &GpuContext,
-        mesh: &Mesh,
-        changed: &[u32],
-        marks: &wgpu::Buffer,
-    ) -> bool {
+    fn refile(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
         let overlay = self.overlay.get_or_insert_with(|| Overlay {
             members: Vec::new(),
             table_size: 0,
@@ -148,7 +144,7 @@ impl Hashed {
         let mut patches = Patches::default();
         patches.rows(&self.positions, mesh.positions(), &members);
         for &v in &members {
-            patches.write(marks, v as usize, &[1u32]);
+            patches.write(&self.marks, v as usize, &[1u32]);
         }
         patches.submit(gpu);
         overlay.members = members;
@@ -172,15 +168,15 @@ impl Hashed {
         }
     }
 
-    /// The overlay as queries bind it, with `marks` (per vertex, nonzero for members).
-    fn overlay<'a>(&'a self, marks: &'a wgpu::Buffer) -> Option<OverlayBuffers<'a>> {
+    /// The overlay as queries bind it.
+    fn overlay(&self) -> Option<OverlayBuffers<'_>> {
         self.overlay.as_ref().map(|o| OverlayBuffers {
             table: TableBuffers {
                 table_size: o.table_size,
                 offsets: o.offsets.buffer(),
                 entries: o.entries.buffer(),
             },
-            marks,
+            marks: &self.marks,
         })
     }
 }
@@ -222,8 +218,6 @@ struct Resident {
     /// Per vertex: pulled back in the last proximity pass (zero between steps).
     marks: wgpu::Buffer,
     hashed: Option<Hashed>,
-    /// Per vertex: nonzero when filed in the hash table's overlay.
-    overlay_marks: wgpu::Buffer,
     layer_count: usize,
 }
 
@@ -236,9 +230,13 @@ impl Resident {
         // As much room as the bindings allow, and never less than the mesh needs.
         let fits = (gpu.limits.max_storage_buffer_binding_size / 12) as usize;
         let capacity = vertex_capacity(count).min(fits).max(count);
-        let layers = mesh.vertex_layers().to_vec();
-        let vertices =
-            VertexBuffers::with_room(gpu, mesh.positions(), &layers, &flag_bits(mesh), capacity)?;
+        let vertices = VertexBuffers::with_room(
+            gpu,
+            mesh.positions(),
+            mesh.vertex_layers(),
+            flag_bits(mesh),
+            capacity,
+        )?;
         let neighbours = smoothing_neighbours(mesh, capacity);
         gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
         Ok(Resident {
@@ -256,7 +254,6 @@ impl Resident {
             topology: None,
             marks: gpu.output_buffer::<u32>("proximity marks", capacity),
             hashed: None,
-            overlay_marks: gpu.output_buffer::<u32>("overlay marks", capacity),
             layer_count: mesh.layer_count(),
             vertices,
         })
@@ -272,10 +269,7 @@ impl Resident {
             return false;
         }
         let mut patches = Patches::default();
-        for &v in changed {
-            let flags = mesh.flags()[v as usize].bits();
-            patches.write(&self.vertices.flags, v as usize, &[flags]);
-        }
+        patches.rows(&self.vertices.flags, flag_bits(mesh), changed);
         patches.rows(&self.vertices.layers, mesh.vertex_layers(), changed);
         patches.rows(&self.vertices.positions, mesh.positions(), changed);
         patches.rows(&self.normals, mesh.normals(), changed);
@@ -291,13 +285,12 @@ impl Resident {
         }
         patches.submit(gpu);
         // What remeshing changed goes into the hash table's overlay; the main table stays.
-        let marks = &self.overlay_marks;
         let filed = self
             .hashed
             .as_mut()
-            .is_none_or(|h| h.refile(gpu, mesh, changed, marks));
+            .is_none_or(|h| h.refile(gpu, mesh, changed));
         if !filed {
-            // Rebuilt (and the marks cleared) at the next use.
+            // Rebuilt at the next use.
             self.hashed = None;
         }
         if let Some(t) = &mut self.topology {
@@ -350,7 +343,7 @@ impl Resident {
             &words(mesh.normals()),
             3,
         )?;
-        same("flags", read(&self.vertices.flags, n)?, &flag_bits(mesh), 1)?;
+        same("flags", read(&self.vertices.flags, n)?, flag_bits(mesh), 1)?;
         same(
             "layers",
             read(&self.vertices.layers, n)?,
@@ -515,11 +508,10 @@ impl GpuKernels {
         // Drift is undone by filing the moved vertices in the overlay; the table is rebuilt
         // over every vertex only when there is none yet, its cells changed size, or the
         // overlay grew too large.
-        let marks = &r.overlay_marks;
         let refiled = stale
-            && r.hashed.as_mut().is_some_and(|h| {
-                h.table.inv_cell_size == 1.0 / cell && h.refile(gpu, mesh, &[], marks)
-            });
+            && r.hashed
+                .as_mut()
+                .is_some_and(|h| h.table.inv_cell_size == 1.0 / cell && h.refile(gpu, mesh, &[]));
         if refiled {
             uploads.overlay_filings += 1;
         }
@@ -528,7 +520,6 @@ impl GpuKernels {
             // Rows for every vertex there is room for: the overlay files new ones here.
             let positions = gpu.output_buffer::<Vec3>("hashed positions", r.capacity);
             let mut encoder = gpu.encoder("hash table");
-            encoder.clear_buffer(&r.overlay_marks, 0, None);
             uploads.table_builds += 1;
             encoder.copy_buffer_to_buffer(
                 &r.vertices.positions,
@@ -550,6 +541,7 @@ impl GpuKernels {
             r.hashed = Some(Hashed {
                 table,
                 positions,
+                marks: gpu.output_buffer::<u32>("overlay marks", r.capacity),
                 drift: 0.0,
                 overlay: None,
                 moved: Vec::new(),
@@ -589,7 +581,7 @@ impl GpuKernels {
         }
         if r.version.flags != version.flags {
             gpu.queue
-                .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(&flag_bits(mesh)));
+                .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(flag_bits(mesh)));
         }
         r.version = version;
         Ok(r)
@@ -626,7 +618,7 @@ impl GpuKernels {
                 table: &hashed.table,
                 positions: &hashed.positions,
                 drift: hashed.drift,
-                overlay: hashed.overlay(&r.overlay_marks),
+                overlay: hashed.overlay(),
             },
             &BrushSphere {
                 center: dab.frame.center,
@@ -771,7 +763,7 @@ impl GpuKernels {
         );
         // Vertices moved or changed since the main table was built are filed in the overlay:
         // each invocation walks its cell there too, and leaves them out of the main table.
-        let overlay = hashed.overlay(&r.overlay_marks);
+        let overlay = hashed.overlay();
         let params = |all_faces: bool| ProximityParams {
             all_faces: all_faces as u32,
             overlay: overlay.is_some() as u32,
@@ -789,7 +781,7 @@ impl GpuKernels {
             moving: step.moving.buffer(),
             rings: step.rings.buffer(),
             marks: &r.marks,
-            overlay_marks: &r.overlay_marks,
+            overlay_marks: &hashed.marks,
             overlay_offsets: overlay.map_or(&hashed.table.offsets, |o| o.table.offsets),
             overlay_entries: overlay.map_or(&hashed.table.entries, |o| o.table.entries),
         };
@@ -960,8 +952,8 @@ fn read_back<T: bytemuck::Pod>(
 }
 
 /// The vertex flags as the kernels read them, one `u32` each.
-fn flag_bits(mesh: &Mesh) -> Vec<u32> {
-    mesh.flags().iter().map(|f| f.bits()).collect()
+fn flag_bits(mesh: &Mesh) -> &[u32] {
+    bytemuck::cast_slice(mesh.flags())
 }
 
 impl StepKernels for GpuKernels {
@@ -1044,8 +1036,8 @@ impl StepKernels for GpuKernels {
         }
     }
 
-    fn uploads(&self) -> Uploads {
-        self.uploads
+    fn uploads(&self) -> Option<Uploads> {
+        Some(self.uploads)
     }
 
     fn check_copy(&self, mesh: &Mesh) -> Result<(), String> {

@@ -49,7 +49,7 @@ pub use proximity::{
     moving_vertices, pass_params, proximity_params, proximity_reaches, record_proximity,
     run_proximity, verdicts,
 };
-pub use rows::{Placement, SlottedRows};
+pub use rows::SlottedRows;
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
     BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, falloff_code, record_select,

@@ -147,10 +147,6 @@ impl<'a> Patches<'a> {
         }
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.pieces.is_empty()
-    }
-
     /// Uploads everything queued, ahead of any later submission.
     pub fn submit(self, gpu: &GpuContext) {
         if self.pieces.is_empty() {

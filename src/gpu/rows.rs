@@ -9,6 +9,8 @@
 //!
 //! Kernels read row `r` as `table[2r]` (absolute start) and `table[2r + 1]` (length).
 
+use super::reusable::Patches;
+
 /// Words of room each row gets beyond its length: remeshing edits change a vertex's valence by
 /// one at a time.
 const ROW_ROOM: u32 = 1;
@@ -25,13 +27,6 @@ pub struct SlottedRows {
     /// Words laid out so far (relative to `base`), and the words there is room for.
     used: u32,
     capacity: u32,
-}
-
-/// One row rewritten by [`SlottedRows::place`]: the table entry to send, and where its words go.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Placement {
-    /// Absolute word index of the row's start.
-    pub start: u32,
 }
 
 impl SlottedRows {
@@ -83,9 +78,9 @@ impl SlottedRows {
     }
 
     /// Sets row `r` (which may be one past the last, a new row) to `len` words: in its slot if
-    /// they fit, else in a new slot at the end. `None` when the words have run out (lay the
-    /// rows out afresh).
-    pub fn place(&mut self, r: u32, len: u32) -> Option<Placement> {
+    /// they fit, else in a new slot at the end. Returns the row's absolute start; `None` when
+    /// the words have run out (lay the rows out afresh).
+    pub fn place(&mut self, r: u32, len: u32) -> Option<u32> {
         let r = r as usize;
         if r == self.slot.len() {
             self.table.extend([0, 0]);
@@ -105,9 +100,31 @@ impl SlottedRows {
             self.used += room;
         }
         self.table[2 * r + 1] = len;
-        Some(Placement {
-            start: self.table[2 * r],
-        })
+        Some(self.table[2 * r])
+    }
+
+    /// Rewrites the rows of `changed` (ascending; new rows among them) with `row_of` into
+    /// `patches`: each row's words into `words`, its (start, length) entry into `table` from
+    /// word `table_base` on. `false` when the words have run out (lay the rows out afresh).
+    pub fn patch<'a>(
+        &mut self,
+        changed: &[u32],
+        mut row_of: impl FnMut(u32, &mut Vec<u32>),
+        ((table, table_base), words): ((&'a wgpu::Buffer, usize), &'a wgpu::Buffer),
+        patches: &mut Patches<'a>,
+    ) -> bool {
+        let mut row = Vec::new();
+        for &v in changed {
+            row.clear();
+            row_of(v, &mut row);
+            let Some(start) = self.place(v, row.len() as u32) else {
+                return false;
+            };
+            patches.write(words, start as usize, &row);
+            let entry = table_base + 2 * v as usize;
+            patches.write(table, entry, &[start, row.len() as u32]);
+        }
+        true
     }
 
     /// Start and length of row `r`.
@@ -146,13 +163,13 @@ mod tests {
         let (mut layout, _) = SlottedRows::build(2, 1, 0, rows_of(&lists));
         let start = layout.row(0).0;
         // One word of room: three words still fit.
-        assert_eq!(layout.place(0, 3), Some(Placement { start }));
+        assert_eq!(layout.place(0, 3), Some(start));
         let moved = layout.place(0, 4).expect("room at the end");
-        assert_ne!(moved.start, start);
-        assert!(moved.start >= layout.row(1).0 + 3, "past every other row");
+        assert_ne!(moved, start);
+        assert!(moved >= layout.row(1).0 + 3, "past every other row");
         // A new row goes to the end too.
         let new = layout.place(2, 5).expect("room for a new row");
-        assert!(new.start >= moved.start + 4);
+        assert!(new >= moved + 4);
         assert_eq!(layout.row_count(), 3);
     }
 

@@ -122,17 +122,12 @@ impl TopologyLayout {
             let words = [a, b, c, mesh.face_layers()[f as usize]];
             patches.write(buffer, FACE_WORDS * f as usize, &words);
         }
-        let mut row = Vec::new();
-        for &v in changed {
-            row.clear();
-            faces_row(mesh, v, &mut row);
-            let Some(placed) = self.rows.place(v, row.len() as u32) else {
-                return false;
-            };
-            patches.write(buffer, placed.start as usize, &row);
-            let entry = self.vertex_rows_base as usize + 2 * v as usize;
-            patches.write(buffer, entry, &[placed.start, row.len() as u32]);
-        }
-        true
+        let table = (buffer, self.vertex_rows_base as usize);
+        self.rows.patch(
+            changed,
+            |v, row| faces_row(mesh, v, row),
+            (table, buffer),
+            patches,
+        )
     }
 }

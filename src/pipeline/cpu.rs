@@ -261,7 +261,7 @@ impl SculptPipeline for CpuPipeline {
     }
 
     fn uploads(&self) -> Option<Uploads> {
-        (self.kernels.name() != "cpu").then(|| self.kernels.uploads())
+        self.kernels.uploads()
     }
 
     fn name(&self) -> String {

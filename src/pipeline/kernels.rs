@@ -62,9 +62,10 @@ pub trait StepKernels: Send {
     /// Remeshing changed `mesh` from version `since`: `changed` (ascending) lists every vertex
     /// whose position, normal, flags, faces or neighbours changed, vertices it added included.
     fn remeshed(&mut self, _mesh: &Mesh, _since: MeshVersion, _changed: &[u32]) {}
-    /// How the kernels' copy of the mesh was kept up to date (for reports and tests).
-    fn uploads(&self) -> Uploads {
-        Uploads::default()
+    /// How the kernels' copy of the mesh was kept up to date (for reports and tests); `None`
+    /// for kernels that keep none.
+    fn uploads(&self) -> Option<Uploads> {
+        None
     }
     /// Compares the kernels' copy of the mesh, if they keep one, with `mesh`: `Err` names the
     /// first difference. Reads everything back: for tests.
