@@ -10,9 +10,9 @@ use slayer::gpu::shaders::{
     render_source, validate,
 };
 use slayer::gpu::{
-    ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
-    NormalParams, ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code,
-    falloff_code,
+    ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
+    DispatchParams, MovingVertex, NormalParams, ProximityParams, SCAN_BLOCK, SelectParams,
+    SelectedVertex, brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -281,6 +281,8 @@ fn wgsl_constants_match_the_host() {
         ("MODE_PULL", ApplyMode::Pull),
         ("MODE_PULL_LAST", ApplyMode::PullLast),
         ("MODE_GATHER", ApplyMode::Gather),
+        ("MODE_MARK_MOVED", ApplyMode::MarkMoved),
+        ("MODE_CLEAR", ApplyMode::Clear),
     ] {
         assert_eq!(
             naga_u32_constant("apply_moves", name),
@@ -291,6 +293,10 @@ fn wgsl_constants_match_the_host() {
     assert_eq!(
         naga_f32_constant("proximity", "CLAMP_SLACK"),
         slayer::pipeline::step::CLAMP_SLACK
+    );
+    assert_eq!(
+        naga_f32_constant("backstop", "MARGIN"),
+        slayer::cpu::BACKSTOP_MARGIN
     );
     for kernel in ["proximity", "apply_moves"] {
         assert_eq!(
@@ -393,6 +399,36 @@ fn proximity_and_normal_structs_match_naga_layout() {
     );
 
     assert_layout!(
+        "backstop",
+        BackstopParams {
+            cell_reach,
+            vertex_reach,
+            inv_cell_size,
+            table_mask,
+            count,
+            vertex_rows_base,
+            cells_per_entry,
+            capacity,
+            span,
+            overlay,
+            overlay_mask,
+            _pad0,
+            _pad1,
+            _pad2
+        }
+    );
+    assert_layout!(
+        "backstop",
+        MovingVertex {
+            start,
+            vertex,
+            layer,
+            ring_start,
+            ring_end,
+            _pad
+        }
+    );
+    assert_layout!(
         "vertex_normals",
         NormalParams {
             count,
@@ -408,7 +444,12 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
     // A kernel with paged arrays has PAGE_COUNT read-only bindings in each bind group past 0
     // (the host binds that many per array, groups 1, 2, … in order) and the override the host
     // sets when it compiles the kernel.
-    let expected_groups = [("proximity", 2), ("vertex_normals", 1), ("deform", 1)];
+    let expected_groups = [
+        ("proximity", 2),
+        ("backstop", 1),
+        ("vertex_normals", 1),
+        ("deform", 1),
+    ];
     for (kernel, _) in KERNELS {
         let source = kernel_source(kernel).unwrap();
         let (module, _) = validate(kernel, &source).unwrap();

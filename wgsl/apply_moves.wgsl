@@ -13,6 +13,9 @@
 // - PULL_LAST: as PULL, but out of passes: what still collides goes back to its start.
 // - GATHER: the final position of every entry into `finals` (what the host reads back), and
 //   the marks cleared for the next step.
+// - MARK_MOVED: after GATHER, each entry's vertex marked with the entry + 1 where the step
+//   moved it (zero where not): the map the backstop filter reads.
+// - CLEAR: the marks cleared (after the backstop filter).
 //
 // Entries name distinct vertices, so no two invocations write the same slot.
 // CPU mirror: src/cpu/apply_moves.rs.
@@ -33,6 +36,8 @@ const MODE_PLACE: u32 = 0u;
 const MODE_PULL: u32 = 1u;
 const MODE_PULL_LAST: u32 = 2u;
 const MODE_GATHER: u32 = 3u;
+const MODE_MARK_MOVED: u32 = 4u;
+const MODE_CLEAR: u32 = 5u;
 const WORKGROUP_SIZE: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> params: ApplyParams;
@@ -93,6 +98,12 @@ fn main(
             } else {
                 marks[v] = 0u;
             }
+        }
+        case MODE_MARK_MOVED: {
+            marks[v] = select(0u, i + 1u, any(position(v) != entry.start));
+        }
+        case MODE_CLEAR: {
+            marks[v] = 0u;
         }
         default: {
             let p = position(v);

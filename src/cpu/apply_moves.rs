@@ -30,6 +30,8 @@ pub fn apply_moves(params: &ApplyParams, buffers: &mut ApplyBuffers<'_>) {
     let place = ApplyMode::Place as u32;
     let pull = ApplyMode::Pull as u32;
     let pull_last = ApplyMode::PullLast as u32;
+    let mark_moved = ApplyMode::MarkMoved as u32;
+    let clear = ApplyMode::Clear as u32;
     for i in invocations(params.count) {
         let entry = &buffers.moving[i as usize];
         let v = entry.vertex;
@@ -58,6 +60,11 @@ pub fn apply_moves(params: &ApplyParams, buffers: &mut ApplyBuffers<'_>) {
                     buffers.marks[v as usize] = 0;
                 }
             }
+            mode if mode == mark_moved => {
+                let moved = packed_position(buffers.positions, v) != Vec3::from_array(entry.start);
+                buffers.marks[v as usize] = if moved { i + 1 } else { 0 };
+            }
+            mode if mode == clear => buffers.marks[v as usize] = 0,
             _ => {
                 let p = packed_position(buffers.positions, v).to_array();
                 set_position(buffers.finals, i, p);

@@ -128,6 +128,35 @@ pub struct ProximityParams {
     pub _pad1: u32,
 }
 
+/// `BackstopParams` in `wgsl/backstop.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct BackstopParams {
+    /// Half-size of the box of cells searched around each moved vertex.
+    pub cell_reach: f32,
+    /// Bucket entries farther than this from the moved vertex (on some axis) are skipped: two
+    /// longest edges.
+    pub vertex_reach: f32,
+    pub inv_cell_size: f32,
+    pub table_mask: u32,
+    /// Entries in the moving list.
+    pub count: u32,
+    /// Where the per-vertex (start, length) entries of the vertex→faces rows begin in the
+    /// packed topology.
+    pub vertex_rows_base: u32,
+    pub cells_per_entry: u32,
+    /// Room for pairs in the output.
+    pub capacity: u32,
+    /// Cells searched per entry (x, y, z), from the cell of x − `cell_reach`.
+    pub span: [u32; 3],
+    /// Nonzero: walk the overlay table too, as `ProximityParams::overlay`.
+    pub overlay: u32,
+    pub overlay_mask: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
 /// `ApplyParams` in `wgsl/apply_moves.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -153,6 +182,11 @@ pub enum ApplyMode {
     PullLast = 2,
     /// Final positions out, marks cleared.
     Gather = 3,
+    /// Marks set to the entry + 1 where the step moved the vertex, zero elsewhere: what the
+    /// backstop filter reads (after `Gather`).
+    MarkMoved = 4,
+    /// Marks cleared (after the backstop filter).
+    Clear = 5,
 }
 
 impl ApplyParams {

@@ -2,6 +2,7 @@
 //! Each kernel in `wgsl/` has a CPU mirror of the same name in [`crate::cpu`].
 
 mod apply_moves;
+mod backstop;
 mod cell_keys;
 mod context;
 mod deform;
@@ -24,6 +25,11 @@ mod vertices;
 pub use apply_moves::{
     APPLY_WORKGROUP_SIZE, AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves,
 };
+pub use backstop::{
+    BACKSTOP_WORKGROUP_SIZE, BackstopBuffers, BackstopQuery, PAIRS_GUESS, UndecidedPairs,
+    backstop_inputs, backstop_params, backstop_query_params, check_backstop_invocations,
+    moved_edge_bound, record_backstop, run_backstop,
+};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{
     AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, Workgroups,
@@ -39,8 +45,9 @@ pub use hash_table::{
 };
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
-    ApplyMode, ApplyParams, CellKeyParams, CountParams, DeformParams, DispatchParams, MovingVertex,
-    NormalParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
+    ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
+    DispatchParams, MovingVertex, NormalParams, ProximityParams, PulledVertex, SelectParams,
+    SelectedVertex,
 };
 pub use overlay::{Filing, OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};

@@ -39,6 +39,7 @@ pub const KERNELS: &[(&str, &str)] = &[
     ),
     ("proximity", include_str!("../../wgsl/proximity.wgsl")),
     ("apply_moves", include_str!("../../wgsl/apply_moves.wgsl")),
+    ("backstop", include_str!("../../wgsl/backstop.wgsl")),
     (
         "vertex_normals",
         include_str!("../../wgsl/vertex_normals.wgsl"),
