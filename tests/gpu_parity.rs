@@ -1504,6 +1504,8 @@ fn apply_moves_matches_cpu_mirror_in_every_mode() {
 fn check_clamp_loop(scene: ProximityScene) {
     use slayer::pipeline::StepKernels;
     let mut kernels = slayer::gpu::GpuKernels::new(gpu());
+    // On lavapipe the passes stay on the CPU unless asked: this test is about the GPU's.
+    kernels.set_proximity_on_gpu(true);
     let mesh = &scene.mesh;
     let grid = SpatialHash::build(mesh, scene.edge).unwrap();
     let active = vec![true; mesh.layer_count()];
@@ -1551,8 +1553,20 @@ fn check_clamp_loop(scene: ProximityScene) {
             &before,
         );
         let mut on_gpu = mesh.clone();
-        kernels.clamp(&state, &region, &mut on_gpu, &selection, &targets, &before);
+        let backstop = kernels.clamp(
+            &state,
+            &mut slayer::pipeline::step::Region::default(),
+            &mut on_gpu,
+            (&selection, &targets, &target_of),
+            &before,
+        );
         assert_eq!(kernels.failure(), None);
+        // The GPU filtered the backstop's pairs too: no region needed.
+        assert!(
+            matches!(backstop, slayer::pipeline::step::Backstop::Undecided(_)),
+            "{}: {backstop:?}",
+            scene.name
+        );
         let clamped = selection
             .iter()
             .zip(&targets)

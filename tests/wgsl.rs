@@ -412,7 +412,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
             span,
             overlay,
             overlay_mask,
-            _pad0,
+            face_reach,
             _pad1,
             _pad2
         }

@@ -17,8 +17,9 @@
 // lowest-numbered one too: g is met once, through that vertex, in the cells around x. Where
 // both faces moved, the pair is tested from the lower face only, as the CPU does.
 //
-// One invocation per (entry, cell of the box around the entry's vertex); the first cell's also
-// tests the neighbours. Pairs are appended to `pairs` (two words each) up to `capacity`;
+// One invocation per (entry, row of cells along x of the box around the entry's vertex); the
+// first row's also tests the neighbours. Cells farther than an edge from every face the entry
+// tests are skipped (most of the box: it must reach two edges around the vertex). Pairs are appended to `pairs` (two words each) up to `capacity`;
 // `pair_count` counts them all, so the host sees an overflow and searches on the CPU instead.
 // CPU mirror: src/cpu/backstop.rs.
 
@@ -41,15 +42,20 @@ struct BackstopParams {
     count: u32,
     // Where the vertex→faces rows start in `topology`.
     vertex_rows_base: u32,
+    // Invocations per entry: rows of cells, span.y · span.z.
     cells_per_entry: u32,
     // Room in `pairs`, in pairs.
     capacity: u32,
-    // Cells per entry, from the cell of x − cell_reach.
+    // Cells of the entry's box (x, y, z), from the cell of x − cell_reach; an invocation walks
+    // one row along x, so there are span.y · span.z per entry.
     span: vec3<u32>,
     // Nonzero: the overlay table is walked too (as in proximity.wgsl).
     overlay: u32,
     overlay_mask: u32,
-    _pad0: u32,
+    // One longest edge (after the step's moves) plus how far any vertex may be from where it
+    // is filed: a cell farther than this from every face the entry tests holds no vertex of a
+    // face crossing one of them, and is skipped.
+    face_reach: f32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -312,6 +318,25 @@ fn test_vertex(v: u32, first: u32, last: u32, u: u32, x: vec3<f32>) {
     }
 }
 
+// The faces of the vertices filed in `cell`, main table and overlay.
+fn test_cell(v: u32, first: u32, last: u32, cell: vec3<i32>, x: vec3<f32>) {
+    let bucket = hash_cell(cell, params.table_mask);
+    let end = offsets[bucket + 1u];
+    for (var j = offsets[bucket]; j < end; j++) {
+        let u = entries[j];
+        if params.overlay == 0u || overlay_marks[u] == 0u {
+            test_vertex(v, first, last, u, x);
+        }
+    }
+    if params.overlay != 0u {
+        let b = hash_cell(cell, params.overlay_mask);
+        let last_entry = overlay_offsets[b + 1u];
+        for (var j = overlay_offsets[b]; j < last_entry; j++) {
+            test_vertex(v, first, last, overlay_entries[j], x);
+        }
+    }
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn main(
     @builtin(global_invocation_id) global_id: vec3<u32>,
@@ -334,23 +359,31 @@ fn main(
     if n == 0u {
         test_neighbours(v, first, last);
     }
-    let low = cell_of(x - vec3<f32>(params.cell_reach), params.inv_cell_size);
-    let span = params.span;
-    let step = vec3<u32>(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-    let cell = low + bitcast<vec3<i32>>(step);
-    let bucket = hash_cell(cell, params.table_mask);
-    let end = offsets[bucket + 1u];
-    for (var j = offsets[bucket]; j < end; j++) {
-        let u = entries[j];
-        if params.overlay == 0u || overlay_marks[u] == 0u {
-            test_vertex(v, first, last, u, x);
+    // The box of the faces the entry tests: most cells of the entry's box are too far from it.
+    var lo = x;
+    var hi = x;
+    var tests_any = false;
+    for (var k = first; k < last; k++) {
+        let t = face(topology(k));
+        if tests_face(v, t) {
+            tests_any = true;
+            lo = min(lo, min(min(position(t.x), position(t.y)), position(t.z)));
+            hi = max(hi, max(max(position(t.x), position(t.y)), position(t.z)));
         }
     }
-    if params.overlay != 0u {
-        let b = hash_cell(cell, params.overlay_mask);
-        let last_entry = overlay_offsets[b + 1u];
-        for (var j = overlay_offsets[b]; j < last_entry; j++) {
-            test_vertex(v, first, last, overlay_entries[j], x);
+    let reach = vec3<f32>(params.face_reach);
+    let near_lo = cell_of(lo - reach, params.inv_cell_size);
+    let near_hi = cell_of(hi + reach, params.inv_cell_size);
+    let low = cell_of(x - vec3<f32>(params.cell_reach), params.inv_cell_size);
+    let span = params.span;
+    let row_cell = low + bitcast<vec3<i32>>(vec3<u32>(0u, n % span.y, n / span.y));
+    let near_row = all(row_cell.yz >= near_lo.yz) && all(row_cell.yz <= near_hi.yz);
+    if tests_any && near_row {
+        for (var step = 0u; step < span.x; step++) {
+            let cell = row_cell + vec3<i32>(i32(step), 0, 0);
+            if cell.x >= near_lo.x && cell.x <= near_hi.x {
+                test_cell(v, first, last, cell, x);
+            }
         }
     }
 }

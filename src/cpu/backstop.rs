@@ -1,10 +1,11 @@
 //! Mirror of `wgsl/backstop.wgsl`: the f32 filter in front of the exact backstop, with the
-//! shader's invocations (entry, cell of the box around its moved vertex), loops (the first
-//! cell's neighbour tests, bucket entries, their faces, the entry's faces) and tests. Pairs come
+//! shader's invocations (entry, row of cells of the box around its moved vertex), loops (the
+//! first row's neighbour tests, the row's cells near the entry's faces, bucket entries, their
+//! faces, the entry's faces) and tests. Pairs come
 //! out in invocation order; the GPU's come in whatever order its threads ran, so compare them
 //! sorted.
 
-use glam::{UVec3, Vec3};
+use glam::{IVec3, UVec3, Vec3};
 
 use super::shared::{invocations, packed_position};
 use crate::gpu::{BackstopParams, MovingVertex};
@@ -255,7 +256,7 @@ impl Filter<'_, '_> {
     }
 }
 
-/// The pairs every invocation (entry, cell of the box around its moved vertex) appends, in
+/// The pairs every invocation (entry, row of cells of the box around its moved vertex) appends, in
 /// invocation order; the kernel keeps the first `params.capacity` and counts them all.
 pub fn backstop(params: &BackstopParams, inputs: &BackstopInputs<'_>) -> Vec<[u32; 2]> {
     let mut pairs = Vec::new();
@@ -278,20 +279,47 @@ pub fn backstop(params: &BackstopParams, inputs: &BackstopInputs<'_>) -> Vec<[u3
         if n == 0 {
             filter.test_neighbours(v, row);
         }
-        let low = cell_coordinates(x - Vec3::splat(params.cell_reach), params.inv_cell_size);
-        let step = UVec3::new(n % span.x, (n / span.x) % span.y, n / (span.x * span.y));
-        let cell = low + step.as_ivec3();
-        let bucket = hash_cell(cell, table_size) as usize;
-        for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
-            let u = inputs.entries[j as usize];
-            if params.overlay == 0 || inputs.overlay_marks[u as usize] == 0 {
-                filter.test_vertex(v, row, u, x);
+        let (mut lo, mut hi) = (x, x);
+        let mut tests_any = false;
+        for k in row.0..row.1 {
+            let t = filter.face(filter.topology(k));
+            if filter.tests_face(v, t) {
+                tests_any = true;
+                for w in t {
+                    lo = lo.min(filter.position(w));
+                    hi = hi.max(filter.position(w));
+                }
             }
         }
-        if params.overlay != 0 {
-            let b = hash_cell(cell, params.overlay_mask.wrapping_add(1)) as usize;
-            for j in inputs.overlay_offsets[b]..inputs.overlay_offsets[b + 1] {
-                filter.test_vertex(v, row, inputs.overlay_entries[j as usize], x);
+        let reach = Vec3::splat(params.face_reach);
+        let near_lo = cell_coordinates(lo - reach, params.inv_cell_size);
+        let near_hi = cell_coordinates(hi + reach, params.inv_cell_size);
+        let low = cell_coordinates(x - Vec3::splat(params.cell_reach), params.inv_cell_size);
+        let row_cell = low + UVec3::new(0, n % span.y, n / span.y).as_ivec3();
+        let near_row = row_cell.y >= near_lo.y
+            && row_cell.z >= near_lo.z
+            && row_cell.y <= near_hi.y
+            && row_cell.z <= near_hi.z;
+        if !(tests_any && near_row) {
+            continue;
+        }
+        for step in 0..span.x {
+            let cell = row_cell + IVec3::new(step as i32, 0, 0);
+            if cell.x < near_lo.x || cell.x > near_hi.x {
+                continue;
+            }
+            let bucket = hash_cell(cell, table_size) as usize;
+            for j in inputs.offsets[bucket]..inputs.offsets[bucket + 1] {
+                let u = inputs.entries[j as usize];
+                if params.overlay == 0 || inputs.overlay_marks[u as usize] == 0 {
+                    filter.test_vertex(v, row, u, x);
+                }
+            }
+            if params.overlay != 0 {
+                let b = hash_cell(cell, params.overlay_mask.wrapping_add(1)) as usize;
+                for j in inputs.overlay_offsets[b]..inputs.overlay_offsets[b + 1] {
+                    filter.test_vertex(v, row, inputs.overlay_entries[j as usize], x);
+                }
             }
         }
     }

@@ -30,7 +30,7 @@ pub const PAIRS_GUESS: usize = 1024;
 /// A face crossing a moved face f meets it within one of f's edges of f's moved vertex x, and
 /// has every vertex within one of its own edges of there: within `moved_edge + max(max_edge,
 /// moved_edge)` of x (the vertex reach), filed at most `drift + step_move` farther (the cell
-/// reach).
+/// reach); and within one edge and that drift of the box of f (the face reach).
 pub fn backstop_params(
     (max_edge, moved_edge): (f32, f32),
     (drift, step_move): (f32, f32),
@@ -39,9 +39,12 @@ pub fn backstop_params(
     vertex_rows_base: u32,
     capacity: usize,
 ) -> BackstopParams {
-    let vertex_reach = REACH_SLACK * (moved_edge + max_edge.max(moved_edge));
+    let longest = max_edge.max(moved_edge);
+    let vertex_reach = REACH_SLACK * (moved_edge + longest);
     let cell_reach = REACH_SLACK * (vertex_reach + drift + step_move);
-    let (span, cells) = cells_per_entry(cell_reach, inv_cell_size);
+    let face_reach = REACH_SLACK * (longest + drift + step_move);
+    // An invocation walks a row of cells along x.
+    let (span, _) = cells_per_entry(cell_reach, inv_cell_size);
     BackstopParams {
         cell_reach,
         vertex_reach,
@@ -49,12 +52,12 @@ pub fn backstop_params(
         table_mask: table_size - 1,
         count: count as u32,
         vertex_rows_base,
-        cells_per_entry: cells,
+        cells_per_entry: span[1] * span[2],
         capacity: capacity as u32,
         span,
         overlay: 0,
         overlay_mask: 0,
-        _pad0: 0,
+        face_reach,
         _pad1: 0,
         _pad2: 0,
     }

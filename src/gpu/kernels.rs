@@ -33,17 +33,20 @@ use glam::Vec3;
 
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
-    APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BrushSphere, DeformBuffers,
-    FACE_WORDS, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers,
-    PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
-    SelectedVertex, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
-    check_invocations, indirect_args_buffer, moving_vertices, overlay_limit, overlay_table,
-    pass_params, record_apply_moves, record_deform, record_dispatch_args, record_proximity,
-    record_select, smoothing_neighbours, table_size_for,
+    APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
+    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, GpuContext, GpuError, GpuHashTable,
+    GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE,
+    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
+    SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, backstop_params,
+    check_invocations, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
+    overlay_table, pass_params, record_apply_moves, record_backstop, record_deform,
+    record_dispatch_args, record_proximity, record_select, smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
 use crate::mesh::{Mesh, MeshVersion};
-use crate::pipeline::step::{MAX_PASSES, Region, StrokeState, clamp_moves};
+use crate::pipeline::step::{
+    Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region,
+};
 use crate::pipeline::{CpuKernels, StepKernels, Uploads};
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
@@ -403,6 +406,10 @@ struct StepBuffers {
     /// Per entry: the last proximity pass's pull-back amount.
     pulls: ReusableBuffer,
     finals: ReusableBuffer,
+    /// The backstop filter's undecided pairs, their count, and the room there is for them.
+    pairs: ReusableBuffer,
+    pair_count: wgpu::Buffer,
+    pair_capacity: usize,
     next_count: wgpu::Buffer,
     pass_args: wgpu::Buffer,
     apply_args: wgpu::Buffer,
@@ -419,6 +426,9 @@ impl StepBuffers {
             rings: ReusableBuffer::paged("exclusion rings"),
             pulls: ReusableBuffer::storage("pull-back amounts"),
             finals: ReusableBuffer::storage("finals"),
+            pairs: ReusableBuffer::storage("undecided pairs"),
+            pair_count: gpu.output_buffer::<u32>("undecided pair count", 1),
+            pair_capacity: PAIRS_GUESS,
             next_count: gpu.output_buffer::<u32>("next pass count", 1),
             pass_args: indirect_args_buffer(gpu, "proximity pass sizes"),
             apply_args: indirect_args_buffer(gpu, "apply pass sizes"),
@@ -433,6 +443,9 @@ pub struct GpuKernels {
     last_selection: usize,
     /// Whether the proximity passes run on the GPU (else on the CPU, `clamp_moves`).
     proximity_on_gpu: bool,
+    /// Whether, after GPU proximity passes, the backstop's first round is filtered there too
+    /// (else the CPU gathers the step's region and searches it).
+    backstop_on_gpu: bool,
     resident: Option<Resident>,
     step: StepBuffers,
     /// Set once the GPU failed: why. Everything after runs on the CPU.
@@ -453,6 +466,7 @@ impl GpuKernels {
         GpuKernels {
             last_selection: 0,
             proximity_on_gpu: forced || !gpu.adapter.software,
+            backstop_on_gpu: std::env::var("SLAYER_GPU_BACKSTOP").map_or(true, |v| v != "0"),
             step: StepBuffers::new(&gpu),
             gpu,
             resident: None,
@@ -469,6 +483,12 @@ impl GpuKernels {
 
     pub fn proximity_on_gpu(&self) -> bool {
         self.proximity_on_gpu
+    }
+
+    /// With the proximity passes on the GPU, filters the exact backstop's pairs there too
+    /// (`true`, the default) or leaves the whole backstop to the CPU.
+    pub fn set_backstop_on_gpu(&mut self, on: bool) {
+        self.backstop_on_gpu = on;
     }
 
     /// Makes the GPU calls after the next `calls` fail, as a lost device would: for tests of
@@ -700,7 +720,10 @@ impl GpuKernels {
     /// The proximity passes of one step on the GPU, as [`clamp_moves`] runs them: targets
     /// placed, a first pass against every face, then passes against the faces pulled-back
     /// vertices moved until one pulls nothing (the GPU sizes each pass from the last), the last
-    /// sending what still collides back to its start. Returns the final positions.
+    /// sending what still collides back to its start; then, unless turned off, the backstop
+    /// filter (`wgsl/backstop.wgsl`) over the faces that moved. Returns the final positions, and
+    /// the filter's undecided pairs (`None` when it did not run or they overflowed its room).
+    /// One submission, one read-back.
     fn gpu_clamp(
         &mut self,
         state: &StrokeState<'_>,
@@ -708,9 +731,9 @@ impl GpuKernels {
         selection: &[(u32, f32)],
         targets: &[Vec3],
         before: &[Vec3],
-    ) -> Result<Vec<Vec3>, GpuError> {
+    ) -> Result<(Vec<Vec3>, Option<Vec<[u32; 2]>>), GpuError> {
         if selection.is_empty() {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), Some(Vec::new())));
         }
         self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
@@ -855,13 +878,75 @@ impl GpuKernels {
             &ApplyParams::new(count, ApplyMode::Gather),
             None,
         )?;
-        read_back(
-            gpu,
-            &mut step.readback,
-            encoder,
-            step.finals.buffer(),
-            bytes,
-        )
+        let mut parts = vec![(step.finals.buffer(), bytes)];
+        let capacity = step.pair_capacity;
+        if self.backstop_on_gpu {
+            let moved_edge = moved_edge_bound(mesh, &vertices, before, targets);
+            let params = BackstopParams {
+                overlay: overlay.is_some() as u32,
+                overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
+                ..backstop_params(
+                    (state.max_edge, moved_edge),
+                    (hashed.drift, step_move),
+                    (hashed.table.inv_cell_size, hashed.table.table_size),
+                    count,
+                    layout.vertex_rows_base,
+                    capacity,
+                )
+            };
+            let pair_bytes = (capacity * std::mem::size_of::<[u32; 2]>()) as u64;
+            step.pairs.reserve(gpu, pair_bytes)?;
+            // The map from vertex to moved entry lives in the marks for the filter's while.
+            record_apply_moves(
+                gpu,
+                &mut encoder,
+                &apply,
+                &ApplyParams::new(count, ApplyMode::MarkMoved),
+                None,
+            )?;
+            encoder.clear_buffer(&step.pair_count, 0, None);
+            record_backstop(
+                gpu,
+                &mut encoder,
+                &BackstopBuffers {
+                    positions: &r.vertices.positions,
+                    offsets: &hashed.table.offsets,
+                    entries: &hashed.table.entries,
+                    topology,
+                    moving: step.moving.buffer(),
+                    moved: &r.marks,
+                    overlay_marks: &hashed.marks,
+                    overlay_offsets: proximity.overlay_offsets,
+                    overlay_entries: proximity.overlay_entries,
+                },
+                &params,
+                (step.pairs.buffer(), &step.pair_count),
+            )?;
+            record_apply_moves(
+                gpu,
+                &mut encoder,
+                &apply,
+                &ApplyParams::new(count, ApplyMode::Clear),
+                None,
+            )?;
+            parts.push((&step.pair_count, 4));
+            parts.push((step.pairs.buffer(), pair_bytes));
+        }
+        let data = read_back_parts(gpu, &mut step.readback, encoder, &parts)?;
+        let finals = bytemuck::pod_collect_to_vec(&data[..bytes as usize]);
+        if !self.backstop_on_gpu {
+            return Ok((finals, None));
+        }
+        let at = bytes as usize;
+        let found =
+            u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as usize;
+        if found > capacity {
+            // Room for them next time; this step's backstop searches on the CPU.
+            step.pair_capacity = found.next_power_of_two();
+            return Ok((finals, None));
+        }
+        let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
+        Ok((finals, Some(pairs)))
     }
 
     /// Sends the rows the pipeline changed, and notes how far they may have drifted.
@@ -940,15 +1025,33 @@ fn cell_size(state: &StrokeState<'_>) -> f32 {
 fn read_back<T: bytemuck::Pod>(
     gpu: &GpuContext,
     staging: &mut ReusableBuffer,
-    mut encoder: wgpu::CommandEncoder,
+    encoder: wgpu::CommandEncoder,
     source: &wgpu::Buffer,
     bytes: u64,
 ) -> Result<Vec<T>, GpuError> {
-    staging.reserve(gpu, bytes)?;
-    encoder.copy_buffer_to_buffer(source, 0, staging.buffer(), 0, bytes);
+    let data = read_back_parts(gpu, staging, encoder, &[(source, bytes)])?;
+    Ok(bytemuck::pod_collect_to_vec(&data))
+}
+
+/// Submits `encoder` with copies of the first bytes of each part (multiples of 4) one after
+/// another into `staging`, and reads them back in one map.
+fn read_back_parts(
+    gpu: &GpuContext,
+    staging: &mut ReusableBuffer,
+    mut encoder: wgpu::CommandEncoder,
+    parts: &[(&wgpu::Buffer, u64)],
+) -> Result<Vec<u8>, GpuError> {
+    let total: u64 = parts.iter().map(|&(_, bytes)| bytes).sum();
+    staging.reserve(gpu, total)?;
+    let mut at = 0;
+    for &(source, bytes) in parts {
+        encoder.copy_buffer_to_buffer(source, 0, staging.buffer(), at, bytes);
+        at += bytes;
+    }
     gpu.queue.submit([encoder.finish()]);
-    let data = gpu.map_read(staging.buffer())?;
-    Ok(bytemuck::pod_collect_to_vec(&data[..bytes as usize]))
+    let mut data = gpu.map_read(staging.buffer())?;
+    data.truncate(total as usize);
+    Ok(data)
 }
 
 /// The vertex flags as the kernels read them, one `u32` each.
@@ -999,23 +1102,23 @@ impl StepKernels for GpuKernels {
     fn clamp(
         &mut self,
         state: &StrokeState<'_>,
-        region: &Region,
+        region: &mut Region,
         mesh: &mut Mesh,
-        selection: &[(u32, f32)],
-        targets: &[Vec3],
+        moves: StepMoves<'_>,
         before: &[Vec3],
-    ) {
+    ) -> Backstop {
+        let (selection, targets, _) = moves;
         if self.proximity_on_gpu
-            && let Some(finals) =
+            && let Some((finals, undecided)) =
                 self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
         {
             let positions = mesh.positions_mut();
             for (&(v, _), p) in selection.iter().zip(finals) {
                 positions[v as usize] = p;
             }
-            return;
+            return undecided.map_or(Backstop::Gather, Backstop::Undecided);
         }
-        clamp_moves(state, region, mesh, selection, targets, before);
+        clamp_in_region(state, region, mesh, moves, before)
     }
 
     fn moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {

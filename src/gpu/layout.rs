@@ -152,7 +152,9 @@ pub struct BackstopParams {
     /// Nonzero: walk the overlay table too, as `ProximityParams::overlay`.
     pub overlay: u32,
     pub overlay_mask: u32,
-    pub _pad0: u32,
+    /// Cells farther than this from the faces an entry tests are skipped: one longest edge and
+    /// the filing drift.
+    pub face_reach: f32,
     pub _pad1: u32,
     pub _pad2: u32,
 }

@@ -451,14 +451,17 @@ impl SculptPipeline for CpuPipeline {
                     .map(|&(v, _)| mesh.positions()[v as usize])
                     .collect();
                 let kernels = &mut self.kernels;
+                let moves = (
+                    selection.as_slice(),
+                    targets.as_slice(),
+                    target_of.as_slice(),
+                );
                 let outcome = collide_with(
                     &state,
                     &mut self.region,
                     mesh,
-                    (&selection, &targets, &target_of),
-                    |region, mesh, before| {
-                        kernels.clamp(&state, region, mesh, &selection, &targets, before)
-                    },
+                    moves,
+                    |region, mesh, before| kernels.clamp(&state, region, mesh, moves, before),
                 );
                 for &(v, _) in &selection {
                     target_of[v as usize] = INVALID;

@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 
-use super::step::{Region, StrokeState, clamp_moves, deform, select};
+use super::step::{Backstop, Region, StepMoves, StrokeState, clamp_in_region, deform, select};
 use crate::brush::Dab;
 use crate::mesh::{Mesh, MeshVersion};
 use serde::Serialize;
@@ -38,21 +38,19 @@ pub trait StepKernels: Send {
         dab: &Dab,
         selection: &[(u32, f32)],
     ) -> Vec<Vec3>;
-    /// The collision response's first phase, [`clamp_moves`]: the selection moved to
-    /// `targets`, then pulled back where it comes too close to a face. `before` holds each
-    /// selected vertex's start; `region` is the step's gathered faces. Leaves the positions in
-    /// `mesh`.
-    #[allow(clippy::too_many_arguments)]
+    /// The collision response's first phase, [`super::step::clamp_moves`]: the selection
+    /// moved to its targets, then pulled back where it comes too close to a face. `before`
+    /// holds each selected vertex's start; `region` is the step's, gathered here if needed.
+    /// Leaves the positions in `mesh`, and says what it leaves the exact backstop.
     fn clamp(
         &mut self,
         state: &StrokeState<'_>,
-        region: &Region,
+        region: &mut Region,
         mesh: &mut Mesh,
-        selection: &[(u32, f32)],
-        targets: &[Vec3],
+        moves: StepMoves<'_>,
         before: &[Vec3],
-    ) {
-        clamp_moves(state, region, mesh, selection, targets, before);
+    ) -> Backstop {
+        clamp_in_region(state, region, mesh, moves, before)
     }
     /// The pipeline has finished moving `vertices` (ascending; each by at most `max_move` since
     /// the kernels last saw it): kernels that keep a copy of the positions bring it up to date.

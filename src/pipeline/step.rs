@@ -404,32 +404,117 @@ pub fn collide(
     targets: &[Vec3],
     target_of: &[u32],
 ) -> CollisionOutcome {
-    collide_with(
-        state,
-        region,
-        mesh,
-        (selection, targets, target_of),
-        |region, mesh, before| clamp_moves(state, region, mesh, selection, targets, before),
-    )
+    let moves = (selection, targets, target_of);
+    collide_with(state, region, mesh, moves, |region, mesh, before| {
+        clamp_in_region(state, region, mesh, moves, before)
+    })
+}
+
+/// A step's moves: the selection, each selected vertex's target, and per vertex its index in
+/// the selection (`INVALID` for the others).
+pub type StepMoves<'a> = (&'a [(u32, f32)], &'a [Vec3], &'a [u32]);
+
+/// What the first phase of a step leaves the exact backstop.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Backstop {
+    /// The region was gathered (around the step's starts and targets): search it.
+    Search,
+    /// The region was not gathered: gather it, then search.
+    Gather,
+    /// The face pairs of the first round were filtered already (by the GPU): the exact
+    /// predicates decide these, the ones the filter could not clear; `(f, f)` asks whether
+    /// face f turned over. The region is gathered only if an undo calls for another round.
+    Undecided(Vec<[u32; 2]>),
+}
+
+/// The CPU's first phase: the region gathered, then [`clamp_moves`].
+pub fn clamp_in_region(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, target_of): StepMoves<'_>,
+    before: &[Vec3],
+) -> Backstop {
+    region.gather(state, mesh, selection, targets, target_of);
+    clamp_moves(state, region, mesh, selection, targets, before);
+    Backstop::Search
+}
+
+/// Gathers the region of a step whose selection has moved already: with the selection put
+/// back at `before` meanwhile, so that it is the region [`clamp_in_region`] gathers.
+fn gather_from_start(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, target_of): StepMoves<'_>,
+    before: &[Vec3],
+) {
+    let now: Vec<Vec3> = selection
+        .iter()
+        .map(|&(v, _)| mesh.positions()[v as usize])
+        .collect();
+    let positions = mesh.positions_mut();
+    for (&(v, _), &p) in selection.iter().zip(before) {
+        positions[v as usize] = p;
+    }
+    region.gather(state, mesh, selection, targets, target_of);
+    let positions = mesh.positions_mut();
+    for (&(v, _), p) in selection.iter().zip(now) {
+        positions[v as usize] = p;
+    }
+}
+
+/// Whether face `f` turned over in the step: its normal before (vertices of the selection at
+/// `before`, through `target_of`) and now point apart. A face turned over onto its neighbours
+/// (a fold within a fan, which twist and pinch can make) shares vertices with everything it
+/// overlaps, so no pair test sees it; its normal reversing does.
+fn turned_over(mesh: &Mesh, f: u32, target_of: &[u32], before: &[Vec3]) -> bool {
+    let old = mesh.faces()[f as usize].map(|w| {
+        let slot = target_of[w as usize];
+        if slot == INVALID {
+            mesh.positions()[w as usize]
+        } else {
+            before[slot as usize]
+        }
+    });
+    let (n_old, n_new) = (face_normal(old), face_normal(triangle(mesh, f)));
+    n_old.dot(n_new) <= 0.0 && n_old != Vec3::ZERO
+}
+
+/// The exact verdict on a candidate pair of the backstop: `(f, f)` whether f turned over; faces
+/// sharing a vertex whether they overlap beyond it; others whether they cross.
+fn pair_crosses(mesh: &Mesh, (f, g): (u32, u32), target_of: &[u32], before: &[Vec3]) -> bool {
+    if f == g {
+        return turned_over(mesh, f, target_of, before);
+    }
+    let faces = mesh.faces();
+    let (tri_f, tri_g) = (triangle(mesh, f), triangle(mesh, g));
+    if faces[g as usize]
+        .iter()
+        .any(|v| faces[f as usize].contains(v))
+    {
+        return neighbours_overlap(tri_f, faces[f as usize], tri_g, faces[g as usize]);
+    }
+    Aabb::of_points(&tri_f).overlaps(&Aabb::of_points(&tri_g)) && triangles_intersect(tri_f, tri_g)
 }
 
 /// [`collide`] with its first phase — targets written in, proximity passes — done by `clamp`
-/// (given the gathered region, the mesh and each selected vertex's start), which must leave
-/// the positions [`clamp_moves`] would: a GPU backend runs it there.
+/// (given the region, the mesh and each selected vertex's start), which must leave the
+/// positions [`clamp_moves`] would, and say what it leaves the backstop: a GPU backend runs
+/// it there, and filters the backstop's first round too.
 pub fn collide_with(
     state: &StrokeState<'_>,
     region: &mut Region,
     mesh: &mut Mesh,
-    (selection, targets, target_of): (&[(u32, f32)], &[Vec3], &[u32]),
-    clamp: impl FnOnce(&Region, &mut Mesh, &[Vec3]),
+    moves: StepMoves<'_>,
+    clamp: impl FnOnce(&mut Region, &mut Mesh, &[Vec3]) -> Backstop,
 ) -> CollisionOutcome {
-    region.gather(state, mesh, selection, targets, target_of);
-    let region: &Region = region;
+    let (selection, targets, target_of) = moves;
     let before: Vec<Vec3> = selection
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
         .collect();
-    clamp(region, mesh, &before);
+    let backstop = clamp(region, mesh, &before);
     let clamped_count = selection
         .iter()
         .zip(targets)
@@ -444,6 +529,11 @@ pub fn collide_with(
         .map(|(&(v, _), p)| mesh.positions()[v as usize] != *p)
         .collect();
     let mut reverted = 0;
+    let (mut gathered, mut undecided) = match backstop {
+        Backstop::Search => (true, None),
+        Backstop::Gather => (false, None),
+        Backstop::Undecided(pairs) => (false, Some(pairs)),
+    };
     // First every moved face; after an undo, only the faces around the vertices put back (the
     // others have not moved since they were found clean).
     let mut changed: Vec<u32> = selection
@@ -460,65 +550,21 @@ pub fn collide_with(
         if moving_faces.is_empty() {
             break;
         }
-        let is_moving = |f: u32| moving_faces.binary_search(&f).is_ok();
-        let mesh_view: &Mesh = mesh;
-        let crossings: Vec<Vec<(u32, u32)>> =
-            map_with_scratch(state.parallel, &moving_faces, |scratch, &f| {
-                let tri_f = triangle(mesh_view, f);
-                let box_f = Aabb::of_points(&tri_f);
-                let faces = mesh_view.faces();
-                let mut found = Vec::new();
-                // A face turned over onto its neighbours (a fold within a fan, which twist and
-                // pinch can make) shares vertices with everything it overlaps, so no pair test
-                // sees it; its normal reversing does.
-                let old = faces[f as usize].map(|w| {
-                    let slot = target_of[w as usize];
-                    if slot == INVALID {
-                        mesh_view.positions()[w as usize]
-                    } else {
-                        before[slot as usize]
-                    }
-                });
-                let (n_old, n_new) = (face_normal(old), face_normal(tri_f));
-                if n_old.dot(n_new) <= 0.0 && n_old != Vec3::ZERO {
-                    found.push((f, f));
+        let mut pairs: Vec<(u32, u32)> = match undecided.take() {
+            // The filter tested exactly the pairs the search below would: the same crossings.
+            Some(candidates) => candidates
+                .into_iter()
+                .map(|[f, g]| (f.min(g), f.max(g)))
+                .filter(|&pair| pair_crosses(mesh, pair, target_of, &before))
+                .collect(),
+            None => {
+                if !gathered {
+                    gather_from_start(state, region, mesh, moves, &before);
+                    gathered = true;
                 }
-                // Nor may the step fold two faces around a shared vertex onto each other: they
-                // overlap while sharing a vertex, which the pair test skips.
-                let ids_f = faces[f as usize];
-                for w in ids_f {
-                    for g in mesh_view.faces_around(w) {
-                        if g == f || (g < f && is_moving(g)) {
-                            continue;
-                        }
-                        let tri_g = triangle(mesh_view, g);
-                        if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
-                            found.push((f.min(g), f.max(g)));
-                        }
-                    }
-                }
-                region.candidates(&box_f, scratch, |local| {
-                    let g = region.faces[local];
-                    if g == f || (g < f && is_moving(g)) {
-                        return;
-                    }
-                    if faces[g as usize]
-                        .iter()
-                        .any(|v| faces[f as usize].contains(v))
-                    {
-                        return;
-                    }
-                    let tri_g = triangle(mesh_view, g);
-                    if !box_f.overlaps(&Aabb::of_points(&tri_g)) {
-                        return;
-                    }
-                    if triangles_intersect(tri_f, tri_g) {
-                        found.push((f.min(g), f.max(g)));
-                    }
-                });
-                found
-            });
-        let mut pairs: Vec<(u32, u32)> = crossings.into_iter().flatten().collect();
+                crossings(state, region, mesh, &moving_faces, (target_of, &before))
+            }
+        };
         if pairs.is_empty() {
             break;
         }
@@ -557,6 +603,65 @@ pub fn collide_with(
         clamped: clamped_count,
         reverted,
     }
+}
+
+/// The crossing pairs of `moving_faces` (ascending), searched in the gathered region: each
+/// moving face against itself (turned over), the faces around its vertices (overlap beyond
+/// a shared vertex) and the region's faces whose boxes meet its box. A pair of two moving
+/// faces is tested from the lower one.
+fn crossings(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    moving_faces: &[u32],
+    (target_of, before): (&[u32], &[Vec3]),
+) -> Vec<(u32, u32)> {
+    let is_moving = |f: u32| moving_faces.binary_search(&f).is_ok();
+    let found: Vec<Vec<(u32, u32)>> =
+        map_with_scratch(state.parallel, moving_faces, |scratch, &f| {
+            let tri_f = triangle(mesh, f);
+            let box_f = Aabb::of_points(&tri_f);
+            let faces = mesh.faces();
+            let mut found = Vec::new();
+            if turned_over(mesh, f, target_of, before) {
+                found.push((f, f));
+            }
+            // Nor may the step fold two faces around a shared vertex onto each other: they
+            // overlap while sharing a vertex, which the pair test skips.
+            let ids_f = faces[f as usize];
+            for w in ids_f {
+                for g in mesh.faces_around(w) {
+                    if g == f || (g < f && is_moving(g)) {
+                        continue;
+                    }
+                    let tri_g = triangle(mesh, g);
+                    if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
+                        found.push((f.min(g), f.max(g)));
+                    }
+                }
+            }
+            region.candidates(&box_f, scratch, |local| {
+                let g = region.faces[local];
+                if g == f || (g < f && is_moving(g)) {
+                    return;
+                }
+                if faces[g as usize]
+                    .iter()
+                    .any(|v| faces[f as usize].contains(v))
+                {
+                    return;
+                }
+                let tri_g = triangle(mesh, g);
+                if !box_f.overlaps(&Aabb::of_points(&tri_g)) {
+                    return;
+                }
+                if triangles_intersect(tri_f, tri_g) {
+                    found.push((f.min(g), f.max(g)));
+                }
+            });
+            found
+        });
+    found.into_iter().flatten().collect()
 }
 
 /// The first phase of [`collide`] (sLayer's narrow phase and response): the selection moved to
