@@ -105,13 +105,19 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
     let (start, strokes) = plaster_and_strokes(3);
     let settings = PipelineSettings::default();
     let mut on_cpu = start.clone();
-    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut cpu_pipeline = CpuPipeline::new(settings);
+    let (mut cpu_collisions, mut cpu_reverted) = (0, 0);
+    for stroke in &strokes {
+        let report = cpu_pipeline.apply_stroke(&mut on_cpu, stroke).unwrap();
+        cpu_collisions += report.clamped;
+        cpu_reverted += report.reverted;
+    }
     for proximity_on_gpu in [true, false] {
         let mut kernels = all_on_gpu();
         kernels.set_proximity_on_gpu(proximity_on_gpu);
         let mut mesh = start.clone();
         let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
-        let mut gpu_collisions = 0;
+        let (mut gpu_collisions, mut gpu_reverted) = (0, 0);
         for stroke in &strokes {
             let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
             assert!(
@@ -119,11 +125,24 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
                 "remeshing edits"
             );
             gpu_collisions += report.clamped;
+            gpu_reverted += report.reverted;
             pipeline.check_kernel_copy(&mesh).unwrap();
         }
         assert_eq!(pipeline.kernel_failure(), None);
         let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
-        eprintln!("proximity on the GPU: {proximity_on_gpu}, {uploads:?}");
+        let filter = pipeline.backstop_filter();
+        eprintln!(
+            "proximity on the GPU: {proximity_on_gpu}, {uploads:?}, {filter:?}, \
+             reverted {gpu_reverted} (cpu {cpu_reverted})"
+        );
+        // With the passes on the GPU, so is the backstop's filter: every step's first round.
+        if proximity_on_gpu {
+            let filter = filter.expect("the GPU filters the backstop");
+            assert!(filter.filtered > 0 && filter.overflowed == 0, "{filter:?}");
+        } else {
+            assert_eq!(filter, None);
+        }
+        assert_eq!(cpu_reverted, gpu_reverted);
         assert_eq!((uploads.whole, uploads.patched), (1, strokes.len()));
         assert!(uploads.overlay_filings > 0, "the overlay is used");
         assert!(

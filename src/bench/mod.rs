@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
-use crate::pipeline::{PhaseTimes, PipelineError, SculptPipeline, Uploads};
+use crate::pipeline::{BackstopFilter, PhaseTimes, PipelineError, SculptPipeline, Uploads};
 use crate::remesh::RemeshReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
@@ -102,6 +102,9 @@ pub struct SceneResult {
     /// GPU backends: how often the mesh was sent to the GPU whole, and how often patched after
     /// remeshing.
     pub gpu_uploads: Option<Uploads>,
+    /// GPU backends: how many steps' backstop pairs the GPU filtered, how many pairs it left
+    /// the CPU, and how many steps overflowed its room.
+    pub gpu_backstop: Option<BackstopFilter>,
 }
 
 /// One row of the scaling run.
@@ -197,6 +200,7 @@ pub fn run_strokes(
         reverted,
         moves,
         gpu_uploads: pipeline.uploads(),
+        gpu_backstop: pipeline.backstop_filter(),
     })
 }
 

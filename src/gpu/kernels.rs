@@ -47,7 +47,7 @@ use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{
     Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region,
 };
-use crate::pipeline::{CpuKernels, StepKernels, Uploads};
+use crate::pipeline::{BackstopFilter, CpuKernels, StepKernels, Uploads};
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -453,6 +453,7 @@ pub struct GpuKernels {
     /// Test hook: fail as a lost device would after this many more GPU calls.
     fail_after: Option<usize>,
     uploads: Uploads,
+    filter: BackstopFilter,
 }
 
 impl GpuKernels {
@@ -473,6 +474,7 @@ impl GpuKernels {
             failed: None,
             fail_after: None,
             uploads: Uploads::default(),
+            filter: BackstopFilter::default(),
         }
     }
 
@@ -943,8 +945,11 @@ impl GpuKernels {
         if found > capacity {
             // Room for them next time; this step's backstop searches on the CPU.
             step.pair_capacity = found.next_power_of_two();
+            self.filter.overflowed += 1;
             return Ok((finals, None));
         }
+        self.filter.filtered += 1;
+        self.filter.undecided_pairs += found;
         let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
         Ok((finals, Some(pairs)))
     }
@@ -1141,6 +1146,10 @@ impl StepKernels for GpuKernels {
 
     fn uploads(&self) -> Option<Uploads> {
         Some(self.uploads)
+    }
+
+    fn backstop_filter(&self) -> Option<BackstopFilter> {
+        (self.proximity_on_gpu && self.backstop_on_gpu).then_some(self.filter)
     }
 
     fn check_copy(&self, mesh: &Mesh) -> Result<(), String> {

@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use super::kernels::{CpuKernels, StepKernels};
 use super::step::{Region, StrokeState, collide_with, paint};
 use super::{
-    PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline, StrokeHook,
-    StrokeReport, Uploads,
+    BackstopFilter, PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline,
+    StrokeHook, StrokeReport, Uploads,
 };
 use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
@@ -262,6 +262,10 @@ impl SculptPipeline for CpuPipeline {
 
     fn uploads(&self) -> Option<Uploads> {
         self.kernels.uploads()
+    }
+
+    fn backstop_filter(&self) -> Option<BackstopFilter> {
+        self.kernels.backstop_filter()
     }
 
     fn name(&self) -> String {

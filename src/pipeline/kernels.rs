@@ -65,6 +65,10 @@ pub trait StepKernels: Send {
     fn uploads(&self) -> Option<Uploads> {
         None
     }
+    /// How the kernels filtered the exact backstop's first rounds, for kernels that do.
+    fn backstop_filter(&self) -> Option<BackstopFilter> {
+        None
+    }
     /// Compares the kernels' copy of the mesh, if they keep one, with `mesh`: `Err` names the
     /// first difference. Reads everything back: for tests.
     fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
@@ -83,6 +87,18 @@ pub struct Uploads {
     /// Times the vertices remeshing changed went into the table's small overlay instead of a
     /// rebuild.
     pub overlay_filings: usize,
+}
+
+/// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct BackstopFilter {
+    /// Steps whose first round the kernels filtered: the CPU gathered no region for them
+    /// unless an undo called for a second round.
+    pub filtered: usize,
+    /// Pairs over those steps the filter could not clear, decided on the CPU.
+    pub undecided_pairs: usize,
+    /// Steps whose pairs overflowed the filter's room: the CPU searched its region.
+    pub overflowed: usize,
 }
 
 /// The CPU's selection (through the spatial hash, or by scanning) and deformation (rayon).

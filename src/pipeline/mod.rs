@@ -13,7 +13,7 @@ mod kernels;
 pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
-pub use kernels::{CpuKernels, StepKernels, Uploads};
+pub use kernels::{BackstopFilter, CpuKernels, StepKernels, Uploads};
 
 use serde::Serialize;
 use thiserror::Error;
@@ -175,6 +175,10 @@ pub trait SculptPipeline {
     ) -> Result<StrokeReport, PipelineError>;
     /// Backends that keep a copy of the mesh elsewhere (the GPU): how they kept it current.
     fn uploads(&self) -> Option<Uploads> {
+        None
+    }
+    /// Backends that filter the backstop's pairs elsewhere (the GPU): what they left the CPU.
+    fn backstop_filter(&self) -> Option<BackstopFilter> {
         None
     }
 }
