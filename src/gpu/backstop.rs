@@ -93,18 +93,11 @@ pub fn moved_edge_bound(mesh: &Mesh, selection: &[u32], starts: &[Vec3], ends: &
 
 /// Fails clearly when a filter would need more invocations than a `u32` counts.
 pub fn check_backstop_invocations(params: &BackstopParams) -> Result<(), GpuError> {
-    let invocations = params.count as u64 * params.cells_per_entry as u64;
-    if invocations > u32::MAX as u64 {
-        return Err(GpuError::TooLarge {
-            what: format!(
-                "a backstop filter ({} moving vertices × {} cells)",
-                params.count, params.cells_per_entry
-            ),
-            bytes: invocations,
-            limit: u32::MAX as u64,
-        });
-    }
-    Ok(())
+    super::proximity::check_entry_invocations(
+        "a backstop filter",
+        params.count,
+        params.cells_per_entry,
+    )
 }
 
 /// Buffers `backstop` binds besides its parameters and outputs.

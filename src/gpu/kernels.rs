@@ -724,7 +724,8 @@ impl GpuKernels {
     /// vertices moved until one pulls nothing (the GPU sizes each pass from the last), the last
     /// sending what still collides back to its start; then, unless turned off, the backstop
     /// filter (`wgsl/backstop.wgsl`) over the faces that moved. Returns the final positions, and
-    /// the filter's undecided pairs (`None` when it did not run or they overflowed its room).
+    /// the filter's undecided pairs (or `Backstop::Gather` when it did not run or they
+    /// overflowed its room).
     /// One submission, one read-back.
     fn gpu_clamp(
         &mut self,
@@ -733,9 +734,9 @@ impl GpuKernels {
         selection: &[(u32, f32)],
         targets: &[Vec3],
         before: &[Vec3],
-    ) -> Result<(Vec<Vec3>, Option<Vec<[u32; 2]>>), GpuError> {
+    ) -> Result<(Vec<Vec3>, Backstop), GpuError> {
         if selection.is_empty() {
-            return Ok((Vec::new(), Some(Vec::new())));
+            return Ok((Vec::new(), Backstop::Undecided(Vec::new())));
         }
         self.check_injected_failure()?;
         let (gpu, step) = (&self.gpu, &mut self.step);
@@ -937,7 +938,7 @@ impl GpuKernels {
         let data = read_back_parts(gpu, &mut step.readback, encoder, &parts)?;
         let finals = bytemuck::pod_collect_to_vec(&data[..bytes as usize]);
         if !self.backstop_on_gpu {
-            return Ok((finals, None));
+            return Ok((finals, Backstop::Gather));
         }
         let at = bytes as usize;
         let found =
@@ -946,12 +947,12 @@ impl GpuKernels {
             // Room for them next time; this step's backstop searches on the CPU.
             step.pair_capacity = found.next_power_of_two();
             self.filter.overflowed += 1;
-            return Ok((finals, None));
+            return Ok((finals, Backstop::Gather));
         }
         self.filter.filtered += 1;
         self.filter.undecided_pairs += found;
         let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
-        Ok((finals, Some(pairs)))
+        Ok((finals, Backstop::Undecided(pairs)))
     }
 
     /// Sends the rows the pipeline changed, and notes how far they may have drifted.
@@ -1114,14 +1115,14 @@ impl StepKernels for GpuKernels {
     ) -> Backstop {
         let (selection, targets, _) = moves;
         if self.proximity_on_gpu
-            && let Some((finals, undecided)) =
+            && let Some((finals, backstop)) =
                 self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
         {
             let positions = mesh.positions_mut();
             for (&(v, _), p) in selection.iter().zip(finals) {
                 positions[v as usize] = p;
             }
-            return undecided.map_or(Backstop::Gather, Backstop::Undecided);
+            return backstop;
         }
         clamp_in_region(state, region, mesh, moves, before)
     }

@@ -169,13 +169,20 @@ pub fn record_proximity(
 
 /// Fails clearly when a pass would need more invocations than a `u32` counts.
 pub fn check_invocations(params: &ProximityParams) -> Result<(), GpuError> {
-    let invocations = params.count as u64 * params.cells_per_entry as u64;
+    check_entry_invocations("a proximity pass", params.count, params.cells_per_entry)
+}
+
+/// Fails clearly when `what`, `count` entries of `per_entry` invocations each, would need more
+/// invocations than a `u32` counts (the kernels' flat index).
+pub(super) fn check_entry_invocations(
+    what: &str,
+    count: u32,
+    per_entry: u32,
+) -> Result<(), GpuError> {
+    let invocations = count as u64 * per_entry as u64;
     if invocations > u32::MAX as u64 {
         return Err(GpuError::TooLarge {
-            what: format!(
-                "a proximity pass ({} moving vertices × {} cells)",
-                params.count, params.cells_per_entry
-            ),
+            what: format!("{what} ({count} moving vertices × {per_entry} invocations)"),
             bytes: invocations,
             limit: u32::MAX as u64,
         });
