@@ -514,20 +514,7 @@ pub fn collide_with(
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
         .collect();
-    let t0 = std::time::Instant::now();
     let backstop = clamp(region, mesh, &before);
-    let t1 = std::time::Instant::now();
-    struct T(std::time::Instant, std::time::Instant);
-    impl Drop for T {
-        fn drop(&mut self) {
-            eprintln!(
-                "TRACE clamp {:.3} backstop {:.3}",
-                (self.1 - self.0).as_secs_f64() * 1e3,
-                self.1.elapsed().as_secs_f64() * 1e3
-            );
-        }
-    }
-    let _t = T(t0, t1);
     let clamped_count = selection
         .iter()
         .zip(targets)
