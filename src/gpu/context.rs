@@ -150,8 +150,8 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
 }
 
 /// The resident-memory budget when `SLAYER_GPU_BUDGET_MIB` is not set: room for a 16M-face mesh
-/// (about 1.3 GB resident, `resident_bytes`) with margin, well within an H100; a desktop GPU with
-/// less memory should set its own.
+/// (about 1.8 GB resident with its room to grow, `resident_bytes`) with margin, well within an
+/// H100; a desktop GPU with less memory should set its own.
 pub const DEFAULT_GPU_BUDGET_MIB: u64 = 8192;
 
 /// A device and queue on the chosen adapter.

@@ -1012,14 +1012,18 @@ impl GpuKernels {
     }
 }
 
-/// What a mesh keeps resident on the GPU, in bytes (per-step buffers, a selection's worth, are
-/// not counted): per vertex positions, hashed positions and normals (12 bytes each), layer,
-/// flags, marks, selection entry (8), hash keys and entries, two table slots, smoothing
-/// neighbours (about 7 words with their offsets); per face the packed topology (4 words, and
-/// 3 in the vertex→faces rows).
+/// What a mesh keeps resident on the GPU, in bytes, with the room it is allocated with
+/// ([`vertex_capacity`], [`face_capacity`], the slotted rows' spare words): per vertex of room
+/// positions, hashed positions and normals (12 bytes each), layer, flags, marks, overlay marks,
+/// selection entry (8), hash keys and entries, up to four table slots (the table has a power of
+/// two at least twice the vertices); two slotted rows — smoothing neighbours and faces — each a
+/// (start, length) entry and about six words, one of room, a quarter spare; per face of room
+/// its four packed words. Per-step buffers (a selection's worth) are not counted.
 pub fn resident_bytes(mesh: &Mesh) -> u64 {
-    let (v, f) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
-    v * (3 * 12 + 4 + 4 + 4 + 8 + 4 + 4 + 2 * 4 + 7 * 4) + f * 7 * 4
+    let v = vertex_capacity(mesh.vertex_count()) as u64;
+    let f = face_capacity(mesh.face_count()) as u64;
+    let row_words = 2 + (6 + 1) * 5 / 4;
+    v * (3 * 12 + 4 + 4 + 4 + 4 + 8 + 4 + 4 + 4 * 4 + 2 * 4 * row_words) + f * 4 * 4
 }
 
 /// The cell size the pipeline's grid uses (the table is built with the same).
