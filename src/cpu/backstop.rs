@@ -52,7 +52,7 @@ fn separates(axis: Vec3, a: [Vec3; 3], b: [Vec3; 3]) -> bool {
 }
 
 /// `surely_apart` of the shader: `geom::surely_disjoint` in f32, moved and scaled.
-pub fn surely_apart_f32(a: [Vec3; 3], b: [Vec3; 3]) -> bool {
+fn surely_apart_f32(a: [Vec3; 3], b: [Vec3; 3]) -> bool {
     let o = a[0];
     let scale = max_abs(a[1] - o).max(max_abs(a[2] - o)).max(
         max_abs(b[0] - o)

@@ -20,7 +20,7 @@ mod shared;
 mod vertex_normals;
 
 pub use apply_moves::{ApplyBuffers, apply_moves};
-pub use backstop::{BACKSTOP_MARGIN, BackstopInputs, backstop, surely_apart_f32};
+pub use backstop::{BACKSTOP_MARGIN, BackstopInputs, backstop};
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
 pub use deform::{DeformInputs, deform};

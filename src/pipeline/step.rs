@@ -489,13 +489,22 @@ fn pair_crosses(mesh: &Mesh, (f, g): (u32, u32), target_of: &[u32], before: &[Ve
     }
     let faces = mesh.faces();
     let (tri_f, tri_g) = (triangle(mesh, f), triangle(mesh, g));
-    if faces[g as usize]
-        .iter()
-        .any(|v| faces[f as usize].contains(v))
-    {
+    if share_a_vertex(mesh, f, g) {
         return neighbours_overlap(tri_f, faces[f as usize], tri_g, faces[g as usize]);
     }
-    Aabb::of_points(&tri_f).overlaps(&Aabb::of_points(&tri_g)) && triangles_intersect(tri_f, tri_g)
+    apart_faces_cross(tri_f, &Aabb::of_points(&tri_f), tri_g)
+}
+
+fn share_a_vertex(mesh: &Mesh, f: u32, g: u32) -> bool {
+    let faces = mesh.faces();
+    faces[g as usize]
+        .iter()
+        .any(|v| faces[f as usize].contains(v))
+}
+
+/// Whether two faces sharing no vertex cross (`box_f` the box of `tri_f`): boxes first.
+fn apart_faces_cross(tri_f: [Vec3; 3], box_f: &Aabb, tri_g: [Vec3; 3]) -> bool {
+    box_f.overlaps(&Aabb::of_points(&tri_g)) && triangles_intersect(tri_f, tri_g)
 }
 
 /// [`collide`] with its first phase — targets written in, proximity passes — done by `clamp`
@@ -642,20 +651,10 @@ fn crossings(
             }
             region.candidates(&box_f, scratch, |local| {
                 let g = region.faces[local];
-                if g == f || (g < f && is_moving(g)) {
+                if g == f || (g < f && is_moving(g)) || share_a_vertex(mesh, f, g) {
                     return;
                 }
-                if faces[g as usize]
-                    .iter()
-                    .any(|v| faces[f as usize].contains(v))
-                {
-                    return;
-                }
-                let tri_g = triangle(mesh, g);
-                if !box_f.overlaps(&Aabb::of_points(&tri_g)) {
-                    return;
-                }
-                if triangles_intersect(tri_f, tri_g) {
+                if apart_faces_cross(tri_f, &box_f, triangle(mesh, g)) {
                     found.push((f.min(g), f.max(g)));
                 }
             });
