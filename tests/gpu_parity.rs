@@ -904,6 +904,7 @@ fn check_deform(binding: Binding) {
                 selection_count: entries.len() as u32,
                 neighbour_rows: &neighbours.rows.table,
                 neighbours: &neighbours.words,
+                frame_sums: &[0; slayer::cpu::FRAME_SUM_WORDS],
             };
             let mut mirror = vec![Vec3::ZERO; entries.len()];
             slayer::cpu::deform(&params, &inputs, &mut mirror);
@@ -936,6 +937,210 @@ fn check_deform(binding: Binding) {
     eprintln!(
         "deform: largest deviation mirror vs field {worst_mirror:e}, GPU vs mirror {worst_gpu:e} (× radius)"
     );
+}
+
+/// A selection of `mesh` under a brush at `center`, as (vertex, weight) in vertex order.
+fn selection_under(mesh: &slayer::mesh::Mesh, center: Vec3, radius: f32) -> Vec<SelectedVertex> {
+    mesh.positions()
+        .iter()
+        .enumerate()
+        .filter_map(|(v, p)| {
+            let t = p.distance(center) / radius;
+            (t < 1.0).then(|| SelectedVertex {
+                vertex: v as u32,
+                weight: Falloff::Smooth.weight(t),
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn brush_frame_sums_match_the_cpu_mirror_bit_for_bit_in_any_order() {
+    // The sums are integers: the GPU's (workgroup partials, then atomics in whatever order the
+    // workgroups ran) equal the mirror's exactly, for every awkward size and for the list in
+    // any order. The frame they give is the weighted mean normal and centroid (checked in f64).
+    let mesh = bumpy_sheets();
+    let mut gpu = gpu();
+    let (center, radius) = (Vec3::new(3.0, 2.5, 0.1), 2.4);
+    let mut full = selection_under(&mesh, center, radius);
+    assert!(full.len() > 8315, "selects {}", full.len());
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    for (round, &size) in SIZES.iter().chain(&[full.len()]).enumerate() {
+        if round == SIZES.len() {
+            // The whole list, its dispatch folded into two dimensions.
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        let selection = &mut full[..size];
+        let mut mirror = [0u32; slayer::cpu::FRAME_SUM_WORDS];
+        let params = slayer::gpu::frame_params(center, radius, size);
+        fn inputs<'a>(
+            mesh: &'a slayer::mesh::Mesh,
+            selected: &'a [SelectedVertex],
+        ) -> slayer::cpu::FrameInputs<'a> {
+            slayer::cpu::FrameInputs {
+                positions: mesh.positions(),
+                normals: mesh.normals(),
+                selected,
+                selection_count: selected.len() as u32,
+            }
+        }
+        slayer::cpu::brush_frame(&params, &inputs(&mesh, selection), &mut mirror);
+        let on_gpu = |selection: &[SelectedVertex]| {
+            slayer::gpu::run_brush_frame(
+                &gpu,
+                (mesh.positions(), mesh.normals()),
+                selection,
+                center,
+                radius,
+            )
+            .expect("GPU run")
+        };
+        assert_eq!(on_gpu(selection), mirror, "size {size}: GPU vs mirror");
+        // Shuffled: the same bits on both.
+        for i in (1..selection.len()).rev() {
+            selection.swap(i, rng.random_range(0..=i));
+        }
+        let mut shuffled = [0u32; slayer::cpu::FRAME_SUM_WORDS];
+        slayer::cpu::brush_frame(&params, &inputs(&mesh, selection), &mut shuffled);
+        assert_eq!(shuffled, mirror, "size {size}: mirror in another order");
+        assert_eq!(
+            on_gpu(selection),
+            mirror,
+            "size {size}: GPU in another order"
+        );
+        selection.sort_unstable_by_key(|s| s.vertex);
+
+        let flags = slayer::cpu::FRAME_NORMAL_FROM_SUMS | slayer::cpu::FRAME_PLANE_FROM_SUMS;
+        let (normal, plane) =
+            slayer::cpu::frame_from_sums(&mirror, flags, (center, radius), (Vec3::Z, center));
+        let (mut n, mut p, mut w) = (glam::DVec3::ZERO, glam::DVec3::ZERO, 0.0f64);
+        for s in selection.iter() {
+            let weight = s.weight as f64;
+            n += mesh.normals()[s.vertex as usize].as_dvec3() * weight;
+            p += mesh.positions()[s.vertex as usize].as_dvec3() * weight;
+            w += weight;
+        }
+        let (expected_normal, expected_plane) = if w > 0.0 {
+            (n.normalize().as_vec3(), (p / w).as_vec3())
+        } else {
+            (Vec3::Z, center)
+        };
+        assert!(
+            normal.distance(expected_normal) < 1e-5
+                && plane.distance(expected_plane) < 1e-5 * radius,
+            "size {size}: frame {normal} {plane}, expected {expected_normal} {expected_plane}"
+        );
+    }
+}
+
+#[test]
+fn deform_takes_the_frame_from_the_sums_as_the_mirror_does() {
+    // Selection → brush_frame → deform in one submission, as the GPU backend opens a sample:
+    // the brushes that read the frame (flatten its plane and normal, draw and twist their
+    // normal) move every vertex as the mirror does with the mirror's sums; with the sample's
+    // own normal only the plane comes from the sums.
+    let mesh = bumpy_sheets();
+    let gpu = gpu();
+    let neighbours = smoothing_neighbours(&mesh, 0);
+    let center = Vec3::new(2.6, 1.9, 0.1);
+    let full = selection_under(&mesh, center, 1.7);
+    let mut worst = 0.0f32;
+    for (k, kind) in [BrushKind::Flatten, BrushKind::Draw, BrushKind::Twist]
+        .into_iter()
+        .enumerate()
+    {
+        for own_normal in [None, Some(Vec3::new(0.3, 0.1, 1.0).normalize())] {
+            let dab = Dab {
+                brush: Brush {
+                    kind,
+                    radius: 1.7,
+                    strength: 0.7,
+                    falloff: Falloff::Smooth,
+                    invert: k == 1,
+                },
+                frame: DabFrame {
+                    center,
+                    normal: own_normal.unwrap_or(Vec3::Z),
+                    plane_point: center,
+                    motion: Vec3::ZERO,
+                },
+                pressure: 1.0,
+                share: 1.0,
+            };
+            let flags = slayer::pipeline::step::frame_flags(own_normal);
+            for size in [0, 65, full.len()] {
+                let selection = &full[..size];
+                let (sums, actual) =
+                    slayer::gpu::run_framed_deform(&gpu, &mesh, &dab, selection, flags)
+                        .expect("GPU run");
+                let mut mirror_sums = [0u32; slayer::cpu::FRAME_SUM_WORDS];
+                slayer::cpu::brush_frame(
+                    &slayer::gpu::frame_params(center, dab.brush.radius, size),
+                    &slayer::cpu::FrameInputs {
+                        positions: mesh.positions(),
+                        normals: mesh.normals(),
+                        selected: selection,
+                        selection_count: size as u32,
+                    },
+                    &mut mirror_sums,
+                );
+                let label = format!("{} at size {size}, own normal {own_normal:?}", kind.name());
+                assert_eq!(sums, mirror_sums, "{label}: sums");
+                let params = slayer::gpu::DeformParams {
+                    frame: flags,
+                    ..deform_params(&dab, size)
+                };
+                let mut mirror = vec![Vec3::ZERO; size];
+                slayer::cpu::deform(
+                    &params,
+                    &slayer::cpu::DeformInputs {
+                        positions: mesh.positions(),
+                        normals: mesh.normals(),
+                        selected: selection,
+                        selection_count: size as u32,
+                        neighbour_rows: &neighbours.rows.table,
+                        neighbours: &neighbours.words,
+                        frame_sums: &mirror_sums,
+                    },
+                    &mut mirror,
+                );
+                let g = worst_relative(&actual, &mirror, dab.brush.radius);
+                assert!(
+                    g <= DEFORM_TOLERANCE,
+                    "{label}: GPU off the mirror by {g:e} radii"
+                );
+                worst = worst.max(g);
+                // The mirror with the frame resolved up front, as the pipeline passes it on to
+                // the sample's later steps: the same targets.
+                let frame = slayer::pipeline::step::frame_of_sums(&mirror_sums, &dab, own_normal);
+                let resolved = deform_params(&Dab { frame, ..dab }, size);
+                let mut again = vec![Vec3::ZERO; size];
+                slayer::cpu::deform(
+                    &resolved,
+                    &slayer::cpu::DeformInputs {
+                        positions: mesh.positions(),
+                        normals: mesh.normals(),
+                        selected: selection,
+                        selection_count: size as u32,
+                        neighbour_rows: &neighbours.rows.table,
+                        neighbours: &neighbours.words,
+                        frame_sums: &[0; slayer::cpu::FRAME_SUM_WORDS],
+                    },
+                    &mut again,
+                );
+                assert_eq!(again, mirror, "{label}: frame resolved up front");
+                if size == full.len() {
+                    let moved = mirror
+                        .iter()
+                        .zip(selection)
+                        .filter(|(q, s)| **q != mesh.positions()[s.vertex as usize])
+                        .count();
+                    assert!(moved > size / 2, "{label}: {moved} of {size} moved");
+                }
+            }
+        }
+    }
+    eprintln!("deform with the frame from the sums: GPU off the mirror by {worst:e} radii at most");
 }
 
 #[test]

@@ -11,8 +11,8 @@ use slayer::gpu::shaders::{
 };
 use slayer::gpu::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, MovingVertex, NormalParams, ProximityParams, SCAN_BLOCK, SelectParams,
-    SelectedVertex, brush_code, falloff_code,
+    DispatchParams, FrameParams, MovingVertex, NormalParams, ProximityParams, SCAN_BLOCK,
+    SelectParams, SelectedVertex, brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -189,6 +189,18 @@ fn select_structs_match_naga_layout() {
     );
     assert_layout!("select", SelectedVertex { vertex, weight });
     assert_layout!("deform", SelectedVertex { vertex, weight });
+    assert_layout!("brush_frame", SelectedVertex { vertex, weight });
+    assert_layout!(
+        "brush_frame",
+        FrameParams {
+            center,
+            inv_radius,
+            capacity,
+            _pad0,
+            _pad1,
+            _pad2
+        }
+    );
     assert_layout!(
         "dispatch_args",
         DispatchParams {
@@ -212,7 +224,7 @@ fn select_structs_match_naga_layout() {
             kind,
             sign,
             capacity,
-            _pad
+            frame
         }
     );
 }
@@ -267,6 +279,15 @@ fn wgsl_constants_match_the_host() {
             falloff_code(falloff).0,
             "{name}"
         );
+    }
+    for (name, flag) in [
+        ("FRAME_PLANE_FROM_SUMS", slayer::cpu::FRAME_PLANE_FROM_SUMS),
+        (
+            "FRAME_NORMAL_FROM_SUMS",
+            slayer::cpu::FRAME_NORMAL_FROM_SUMS,
+        ),
+    ] {
+        assert_eq!(naga_u32_constant("deform", name), flag, "{name}");
     }
     for kind in BrushKind::ALL {
         let name = format!("BRUSH_{}", kind.name().to_uppercase());

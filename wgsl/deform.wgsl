@@ -2,11 +2,15 @@
 // selected vertex under the dab's field, as `src/brush/field.rs::displacement` computes it.
 // One invocation per selection entry; `targets[i]` belongs to `selected[i]`. Non-finite
 // targets (absurd input) leave the vertex where it is, as on the CPU.
+// The dab's normal and plane point come from the parameters, or (`frame` flags) from the sums
+// `brush_frame` left in `frame_sums` in the same submission, so that selection, frame and
+// deformation need no read-back between them.
 // CPU mirror: src/cpu/deform.rs.
 
 #import shared/grid
 #import shared/brush
 #import shared/pages
+#import shared/fixed
 #paged neighbour 1
 
 struct DeformParams {
@@ -28,8 +32,13 @@ struct DeformParams {
     sign: f32,
     // Entries in `selected` (its capacity): invocations past the selection count return.
     capacity: u32,
-    _pad: u32,
+    // FRAME_* flags: which of normal and plane point come from `frame_sums`.
+    frame: u32,
 }
+
+// As src/gpu/deform.rs writes them.
+const FRAME_PLANE_FROM_SUMS: u32 = 1u;
+const FRAME_NORMAL_FROM_SUMS: u32 = 2u;
 
 // As in src/brush/field.rs.
 const DRAW_RATE: f32 = 0.1;
@@ -48,8 +57,41 @@ const WORKGROUP_SIZE: u32 = 64u;
 @group(0) @binding(5) var<storage, read> neighbour_rows: array<u32>;
 // Packed x, y, z per selection entry.
 @group(0) @binding(6) var<storage, read_write> targets: array<f32>;
+// brush_frame's fixed-point sums (read only where `params.frame` asks).
+@group(0) @binding(7) var<storage, read> frame_sums: array<u32, 24>;
 // Paged (shared/pages.wgsl), group 1: `neighbour(j)`, the neighbour lists (about six words a
 // vertex: the largest per-vertex array).
+
+// The parameters with the frame resolved: what every brush below reads.
+var<private> dab: DeformParams;
+
+fn frame_sum(k: u32) -> f32 {
+    return from_fixed(vec3<u32>(frame_sums[3u * k], frame_sums[3u * k + 1u], frame_sums[3u * k + 2u]));
+}
+
+// As src/cpu/brush_frame.rs::frame_from_sums: the normalized normal sum (the parameters'
+// normal when it has no direction), and the weighted mean offset scaled back about the centre
+// (the centre when no weight).
+fn resolve_frame() {
+    dab = params;
+    if (params.frame & FRAME_NORMAL_FROM_SUMS) != 0u {
+        let sum = vec3<f32>(frame_sum(0u), frame_sum(1u), frame_sum(2u));
+        let length_squared = sum.x * sum.x + sum.y * sum.y + sum.z * sum.z;
+        // Below 1e-30 the normals cancel out (and squares that small near the denormals GPUs
+        // flush): the parameters' normal stands.
+        if length_squared >= 1e-30 && length_squared <= 3.40282347e38 {
+            dab.normal = sum * (1.0 / sqrt(length_squared));
+        }
+    }
+    if (params.frame & FRAME_PLANE_FROM_SUMS) != 0u {
+        let weight = frame_sum(6u);
+        dab.plane_point = params.center;
+        if weight > 0.0 {
+            let offset = vec3<f32>(frame_sum(3u), frame_sum(4u), frame_sum(5u));
+            dab.plane_point = params.center + offset / weight * params.radius;
+        }
+    }
+}
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -69,8 +111,8 @@ fn ring_centroid(v: u32, p: vec3<f32>) -> vec3<f32> {
 }
 
 fn pinch(p: vec3<f32>) -> vec3<f32> {
-    let to_center = params.center - p;
-    let tangential = to_center - params.normal * dot(to_center, params.normal);
+    let to_center = dab.center - p;
+    let tangential = to_center - dab.normal * dot(to_center, dab.normal);
     return tangential * PINCH_RATE;
 }
 
@@ -84,40 +126,40 @@ fn rotate(axis: vec3<f32>, angle: f32, v: vec3<f32>) -> vec3<f32> {
 }
 
 fn displacement(v: u32, p: vec3<f32>, weight: f32) -> vec3<f32> {
-    let amount = params.strength * params.pressure * weight * params.share;
-    let sign = params.sign;
-    let lift = sign * amount * DRAW_RATE * params.radius;
-    switch params.kind {
+    let amount = dab.strength * dab.pressure * weight * dab.share;
+    let sign = dab.sign;
+    let lift = sign * amount * DRAW_RATE * dab.radius;
+    switch dab.kind {
         case BRUSH_DRAW: {
-            return params.normal * lift;
+            return dab.normal * lift;
         }
         case BRUSH_INFLATE, BRUSH_DEFLATE: {
             let n = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
             return n * lift;
         }
         case BRUSH_GRAB: {
-            return params.motion * (weight * params.share);
+            return dab.motion * (weight * dab.share);
         }
         case BRUSH_SMOOTH: {
             return (ring_centroid(v, p) - p) * min(amount, 1.0);
         }
         case BRUSH_FLATTEN: {
-            let height = dot(p - params.plane_point, params.normal);
+            let height = dot(p - dab.plane_point, dab.normal);
             var pull = 0.5 * height;
             if sign > 0.0 {
                 pull = -height;
             }
-            return params.normal * (pull * min(amount, 1.0));
+            return dab.normal * (pull * min(amount, 1.0));
         }
         case BRUSH_PINCH: {
             return pinch(p) * (sign * amount);
         }
         case BRUSH_CREASE: {
-            return -params.normal * lift + pinch(p) * amount;
+            return -dab.normal * lift + pinch(p) * amount;
         }
         case BRUSH_TWIST: {
-            let turned = rotate(params.normal, sign * amount * TWIST_RATE, p - params.center);
-            return params.center + turned - p;
+            let turned = rotate(dab.normal, sign * amount * TWIST_RATE, p - dab.center);
+            return dab.center + turned - p;
         }
         default: {
             return vec3<f32>(0.0);
@@ -139,6 +181,7 @@ fn main(
     if i >= min(selection_count, params.capacity) {
         return;
     }
+    resolve_frame();
     let entry = selected[i];
     let p = position(entry.vertex);
     var q = p + displacement(entry.vertex, p, entry.weight);

@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::brush_frame::frame_from_sums;
 use super::shared::invocations;
 use crate::gpu::{DeformParams, SelectedVertex};
 
@@ -18,6 +19,8 @@ pub struct DeformInputs<'a> {
     /// Per vertex (start, length) of its row in `neighbours`.
     pub neighbour_rows: &'a [u32],
     pub neighbours: &'a [u32],
+    /// `brush_frame`'s sums, read where `DeformParams::frame` asks.
+    pub frame_sums: &'a crate::cpu::FrameSums,
 }
 
 fn ring_centroid(inputs: &DeformInputs<'_>, v: u32, p: Vec3) -> Vec3 {
@@ -85,6 +88,21 @@ fn displacement(
 
 /// `targets[i]` = where `selected[i]` moves.
 pub fn deform(params: &DeformParams, inputs: &DeformInputs<'_>, targets: &mut [Vec3]) {
+    // The shader resolves the frame per invocation; the same for each.
+    let (normal, plane_point) = frame_from_sums(
+        inputs.frame_sums,
+        params.frame,
+        (Vec3::from_array(params.center), params.radius),
+        (
+            Vec3::from_array(params.normal),
+            Vec3::from_array(params.plane_point),
+        ),
+    );
+    let params = &DeformParams {
+        normal: normal.to_array(),
+        plane_point: plane_point.to_array(),
+        ..*params
+    };
     for i in invocations(inputs.selection_count.min(params.capacity)) {
         let entry = inputs.selected[i as usize];
         let p = inputs.positions[entry.vertex as usize];

@@ -6,6 +6,7 @@
 
 mod apply_moves;
 mod backstop;
+mod brush_frame;
 mod cell_counts;
 mod cell_keys;
 mod deform;
@@ -21,6 +22,10 @@ mod vertex_normals;
 
 pub use apply_moves::{ApplyBuffers, apply_moves};
 pub use backstop::{BACKSTOP_MARGIN, BackstopInputs, backstop};
+pub use brush_frame::{
+    FRAME_NORMAL_FROM_SUMS, FRAME_PLANE_FROM_SUMS, FRAME_SUM_WORDS, FrameInputs, FrameSums,
+    brush_frame, frame_from_sums, from_fixed, to_fixed,
+};
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
 pub use deform::{DeformInputs, deform};

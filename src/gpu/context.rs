@@ -168,6 +168,9 @@ pub struct GpuContext {
     /// Compiled kernels by name: validating and compiling a kernel takes milliseconds, and a
     /// backend records the same few kernels for every step of every stroke.
     pipelines: std::sync::Mutex<std::collections::HashMap<String, wgpu::ComputePipeline>>,
+    /// Blocking read-backs so far (each a submission the CPU waited for): the figure that one
+    /// submission per step saves, whatever the adapter's speed.
+    read_backs: std::sync::atomic::AtomicUsize,
 }
 
 impl GpuContext {
@@ -228,6 +231,7 @@ impl GpuContext {
             limits,
             budget_bytes: budget_mib << 20,
             pipelines: Default::default(),
+            read_backs: Default::default(),
         })
     }
 
@@ -391,6 +395,8 @@ impl GpuContext {
 
     /// Waits for the GPU and copies a mappable (`MAP_READ`) buffer's bytes out.
     pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+        self.read_backs
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let (sender, receiver) = mpsc::channel();
         buffer.map_async(wgpu::MapMode::Read, .., move |result| {
             let _ = sender.send(result);
@@ -409,6 +415,11 @@ impl GpuContext {
             .to_vec();
         buffer.unmap();
         Ok(bytes)
+    }
+
+    /// Blocking read-backs so far ([`GpuContext::map_read`] calls).
+    pub fn read_backs(&self) -> usize {
+        self.read_backs.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Fails clearly when keeping `bytes` resident would pass the budget; checked before

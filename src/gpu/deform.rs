@@ -2,6 +2,9 @@
 
 use glam::Vec3;
 
+use super::brush_frame::{
+    FRAME_WORKGROUP_SIZE, FrameBuffers, frame_params, frame_sums_buffer, record_brush_frame,
+};
 use super::reusable::Patches;
 use super::rows::SlottedRows;
 use super::{DeformParams, GpuContext, GpuError, SelectedVertex, Workgroups};
@@ -40,7 +43,7 @@ pub fn deform_params(dab: &Dab, capacity: usize) -> DeformParams {
         kind: brush_code(dab.brush.kind),
         sign: dab.brush.direction(),
         capacity: capacity as u32,
-        _pad: 0,
+        frame: 0,
     }
 }
 
@@ -113,22 +116,23 @@ pub struct DeformBuffers<'a> {
     pub neighbour_rows: &'a wgpu::Buffer,
     /// Paged.
     pub neighbours: &'a wgpu::Buffer,
+    /// `brush_frame`'s sums (`super::frame_sums_buffer`), read where `params.frame` asks.
+    pub frame_sums: &'a wgpu::Buffer,
 }
 
 /// Records the pass writing `targets` (packed x, y, z per selection entry). It runs one
-/// invocation per entry of the selection's capacity; those past the count return at once (an
-/// indirect dispatch sized from the count is the GPU backend's next step).
+/// invocation per entry of the selection's capacity (`params.capacity`); those past the count
+/// return at once.
 pub fn record_deform(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     inputs: &DeformBuffers<'_>,
-    dab: &Dab,
-    capacity: usize,
+    params: &DeformParams,
     targets: &wgpu::Buffer,
 ) -> Result<(), GpuError> {
-    let params = deform_params(dab, capacity);
+    let capacity = params.capacity as usize;
     let pipeline = gpu.compute_pipeline("deform")?;
-    let uniform = gpu.uniform_buffer("deform params", &params);
+    let uniform = gpu.uniform_buffer("deform params", params);
     gpu.record_paged_dispatch(
         encoder,
         &pipeline,
@@ -141,6 +145,7 @@ pub fn record_deform(
             inputs.selection_count,
             inputs.neighbour_rows,
             targets,
+            inputs.frame_sums,
         ],
         &[inputs.neighbours],
         Workgroups::Cover {
@@ -158,17 +163,52 @@ pub fn run_deform(
     dab: &Dab,
     selection: &[SelectedVertex],
 ) -> Result<Vec<Vec3>, GpuError> {
+    Ok(run_framed_deform(gpu, mesh, dab, selection, 0)?.1)
+}
+
+/// [`run_deform`] with the frame parts `frame` names (`crate::cpu::FRAME_*`) taken from
+/// `brush_frame`'s sums over the selection, in the same submission as the GPU backend runs
+/// them; also returns the sums.
+pub fn run_framed_deform(
+    gpu: &GpuContext,
+    mesh: &Mesh,
+    dab: &Dab,
+    selection: &[SelectedVertex],
+    frame: u32,
+) -> Result<(crate::cpu::FrameSums, Vec<Vec3>), GpuError> {
     gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
     let neighbours = smoothing_neighbours(mesh, mesh.vertex_count());
     gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
     let positions = gpu.storage_buffer("positions", mesh.positions(), false);
     let normals = gpu.storage_buffer("normals", mesh.normals(), false);
-    let selected = gpu.storage_buffer("selected", selection, false);
+    let padded: Vec<SelectedVertex> = if selection.is_empty() {
+        vec![SelectedVertex::default()]
+    } else {
+        selection.to_vec()
+    };
+    let selected = gpu.storage_buffer("selected", &padded, false);
     let count = gpu.storage_buffer("selection count", &[selection.len() as u32], false);
     let rows = gpu.storage_buffer("neighbour rows", &neighbours.rows.table, false);
     let neighbours = gpu.storage_buffer("neighbours", &neighbours.words, false);
     let targets = gpu.output_buffer::<Vec3>("targets", selection.len());
+    let sums = frame_sums_buffer(gpu);
     let mut encoder = gpu.encoder("deform");
+    record_brush_frame(
+        gpu,
+        &mut encoder,
+        &FrameBuffers {
+            positions: &positions,
+            normals: &normals,
+            selected: &selected,
+            selection_count: &count,
+        },
+        &frame_params(dab.frame.center, dab.brush.radius, selection.len()),
+        &sums,
+        Workgroups::Cover {
+            invocations: selection.len(),
+            workgroup_size: FRAME_WORKGROUP_SIZE,
+        },
+    )?;
     record_deform(
         gpu,
         &mut encoder,
@@ -179,11 +219,16 @@ pub fn run_deform(
             selection_count: &count,
             neighbour_rows: &rows,
             neighbours: &neighbours,
+            frame_sums: &sums,
         },
-        dab,
-        selection.len(),
+        &DeformParams {
+            frame,
+            ..deform_params(dab, selection.len())
+        },
         &targets,
     )?;
     gpu.queue.submit([encoder.finish()]);
-    gpu.read_buffer(&targets, selection.len())
+    let words = gpu.read_buffer::<u32>(&sums, crate::cpu::FRAME_SUM_WORDS)?;
+    let targets = gpu.read_buffer(&targets, selection.len())?;
+    Ok((words.try_into().expect("the sums' words"), targets))
 }

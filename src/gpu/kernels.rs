@@ -20,10 +20,12 @@
 //!   vertex only when the overlay passes its limit;
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
 //!
-//! A step is three submissions, each with one blocking read-back: the selection (its count and
-//! a guessed head of the list together), the targets, and the whole Jacobi loop of proximity
-//! passes (targets placed, passes sized by the GPU through indirect dispatch, final positions
-//! gathered). The proximity passes run here on hardware adapters; see [`GpuKernels::new`].
+//! A step is two submissions, each with one blocking read-back: selection and deformation
+//! (the selection's count, a guessed head of the list and its targets together; at a sample's
+//! start also the brush frame, summed by `brush_frame` and read by `deform` on the GPU), and
+//! the whole Jacobi loop of proximity passes with the backstop's filter (targets placed,
+//! passes sized by the GPU through indirect dispatch, final positions gathered). The
+//! proximity passes run here on hardware adapters; see [`GpuKernels::new`].
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
 //! adapter's limits, a mesh past our memory budget) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
@@ -34,20 +36,23 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
-    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, GpuContext, GpuError, GpuHashTable,
-    GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE,
-    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
-    SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, backstop_params,
-    check_invocations, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
-    overlay_table, pass_params, record_apply_moves, record_backstop, record_deform,
+    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, FRAME_WORKGROUP_SIZE, FrameBuffers,
+    GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS,
+    PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
+    SelectedVertex, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
+    Workgroups, backstop_params, check_invocations, deform_params, frame_params, frame_sums_buffer,
+    indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit, overlay_table,
+    pass_params, record_apply_moves, record_backstop, record_brush_frame, record_deform,
     record_dispatch_args, record_proximity, record_select, smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
+use crate::cpu::{FRAME_SUM_WORDS, FrameSums};
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{
-    Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region,
+    Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region, frame_flags,
+    frame_of_sums,
 };
-use crate::pipeline::{BackstopFilter, CpuKernels, StepKernels, Uploads};
+use crate::pipeline::{BackstopFilter, CpuKernels, Deformed, FrameSource, StepKernels, Uploads};
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -413,6 +418,9 @@ struct StepBuffers {
     next_count: wgpu::Buffer,
     pass_args: wgpu::Buffer,
     apply_args: wgpu::Buffer,
+    /// The brush frame's sums, and its dispatch sized from the selection count.
+    frame_sums: wgpu::Buffer,
+    frame_args: wgpu::Buffer,
     readback: ReusableBuffer,
 }
 
@@ -432,6 +440,8 @@ impl StepBuffers {
             next_count: gpu.output_buffer::<u32>("next pass count", 1),
             pass_args: indirect_args_buffer(gpu, "proximity pass sizes"),
             apply_args: indirect_args_buffer(gpu, "apply pass sizes"),
+            frame_sums: frame_sums_buffer(gpu),
+            frame_args: indirect_args_buffer(gpu, "brush frame sizes"),
             readback: ReusableBuffer::readback("step readback"),
         }
     }
@@ -626,29 +636,8 @@ impl GpuKernels {
                 radius: dab.brush.radius,
             },
         )?;
-        let hashed = r.hashed();
-        let active: Vec<u32> = state.active.iter().map(|&a| a as u32).collect();
-        let active = gpu.storage_buffer("active layers", &active, false);
         let mut encoder = gpu.encoder("select");
-        record_select(
-            gpu,
-            &mut encoder,
-            &r.vertices,
-            &active,
-            state.active.len(),
-            &HashedVertices {
-                table: &hashed.table,
-                positions: &hashed.positions,
-                drift: hashed.drift,
-                overlay: hashed.overlay(),
-            },
-            &BrushSphere {
-                center: dab.frame.center,
-                radius: dab.brush.radius,
-                falloff: dab.brush.falloff,
-            },
-            &r.selection,
-        )?;
+        record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
         // Twice the last selection: brushes change size slowly.
         let guess = (2 * self.last_selection).max(SELECTION_GUESS);
         let list = r
@@ -705,9 +694,9 @@ impl GpuKernels {
                 selection_count: &step.selection_count,
                 neighbour_rows: &r.neighbour_table,
                 neighbours: &r.neighbours,
+                frame_sums: &step.frame_sums,
             },
-            dab,
-            entries.len(),
+            &deform_params(dab, entries.len()),
             step.targets.buffer(),
         )?;
         read_back(
@@ -717,6 +706,141 @@ impl GpuKernels {
             step.targets.buffer(),
             bytes,
         )
+    }
+
+    /// Selection, brush frame and deformation in one submission: the selection kernel fills
+    /// the resident list; at a sample's start `brush_frame` sums it (dispatched from the
+    /// count) and `deform` takes the frame from the sums; `deform` moves the first `guess`
+    /// entries. The count, that head of the list, the sums and the targets come back in one
+    /// map. A selection longer than the guess reads the rest of the list and deforms it apart.
+    fn gpu_select_and_deform(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        (source, deforms): (FrameSource, bool),
+    ) -> Result<Deformed, GpuError> {
+        self.check_injected_failure()?;
+        let (gpu, step) = (&self.gpu, &mut self.step);
+        let r = GpuKernels::prepare(
+            gpu,
+            (&mut self.resident, &mut self.uploads),
+            mesh,
+            cell_size(state),
+            TableUse::Select {
+                radius: dab.brush.radius,
+            },
+        )?;
+        let mut encoder = gpu.encoder("select and deform");
+        record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
+        let capacity = r.selection.capacity;
+        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        let mut params = deform_params(dab, guess);
+        let sums_from_selection = match source {
+            FrameSource::Selection { normal } => {
+                params.frame = frame_flags(normal);
+                params.normal = normal.unwrap_or(Vec3::Z).to_array();
+                record_dispatch_args(
+                    gpu,
+                    &mut encoder,
+                    &r.selection.count,
+                    capacity,
+                    FRAME_WORKGROUP_SIZE,
+                    &step.frame_args,
+                )?;
+                record_brush_frame(
+                    gpu,
+                    &mut encoder,
+                    &FrameBuffers {
+                        positions: &r.vertices.positions,
+                        normals: &r.normals,
+                        selected: &r.selection.selected,
+                        selection_count: &r.selection.count,
+                    },
+                    &frame_params(dab.frame.center, dab.brush.radius, capacity),
+                    &step.frame_sums,
+                    Workgroups::Indirect(&step.frame_args),
+                )?;
+                Some(normal)
+            }
+            FrameSource::Dab => None,
+        };
+        let entry_bytes = std::mem::size_of::<SelectedVertex>();
+        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
+        if deforms {
+            step.targets.reserve(gpu, target_bytes)?;
+            record_deform(
+                gpu,
+                &mut encoder,
+                &DeformBuffers {
+                    positions: &r.vertices.positions,
+                    normals: &r.normals,
+                    selected: &r.selection.selected,
+                    selection_count: &r.selection.count,
+                    neighbour_rows: &r.neighbour_table,
+                    neighbours: &r.neighbours,
+                    frame_sums: &step.frame_sums,
+                },
+                &params,
+                step.targets.buffer(),
+            )?;
+        }
+        let sum_bytes = (FRAME_SUM_WORDS * 4) as u64;
+        let mut parts = vec![
+            (&r.selection.count, 4),
+            (&step.frame_sums, sum_bytes),
+            (&r.selection.selected, (entry_bytes * guess) as u64),
+        ];
+        if deforms {
+            parts.push((step.targets.buffer(), target_bytes));
+        }
+        let data = read_back_parts(gpu, &mut step.readback, encoder, &parts)?;
+        let word =
+            |at: usize| u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]);
+        let count = (word(0) as usize).min(capacity);
+        let sums: FrameSums = std::array::from_fn(|k| word(4 + 4 * k));
+        let list_at = 4 + sum_bytes as usize;
+        let head = count.min(guess);
+        let mut list: Vec<SelectedVertex> =
+            bytemuck::pod_collect_to_vec(&data[list_at..list_at + head * entry_bytes]);
+        let targets_at = list_at + guess * entry_bytes;
+        let head_targets: Vec<Vec3> = if deforms {
+            bytemuck::pod_collect_to_vec(&data[targets_at..targets_at + head * 12])
+        } else {
+            Vec::new()
+        };
+        let whole_list = count == head;
+        if !whole_list {
+            let all: Vec<SelectedVertex> = gpu.read_buffer(&r.selection.selected, count)?;
+            list.extend_from_slice(&all[head..]);
+        }
+        self.last_selection = count;
+        let frame = match sums_from_selection {
+            Some(normal) => frame_of_sums(&sums, dab, normal),
+            None => dab.frame,
+        };
+        // The kernels appended in whatever order their threads ran; the pipeline works in
+        // vertex order (its sums and the CPU's agree then), the targets permuted alike.
+        let mut order: Vec<usize> = (0..list.len()).collect();
+        order.sort_unstable_by_key(|&i| list[i].vertex);
+        let selection: Vec<(u32, f32)> = order
+            .iter()
+            .map(|&i| (list[i].vertex, list[i].weight))
+            .collect();
+        let targets = match (deforms && count > 0, whole_list) {
+            (false, _) => None,
+            (true, true) => Some(order.iter().map(|&i| head_targets[i]).collect()),
+            (true, false) => {
+                let dab = Dab { frame, ..*dab };
+                Some(self.gpu_deform(state, mesh, &dab, &selection)?)
+            }
+        };
+        Ok(Deformed {
+            selection,
+            frame,
+            targets,
+            deform_millis: 0.0,
+        })
     }
 
     /// The proximity passes of one step on the GPU, as [`clamp_moves`] runs them: targets
@@ -1026,6 +1150,38 @@ pub fn resident_bytes(mesh: &Mesh) -> u64 {
     v * (3 * 12 + 4 + 4 + 4 + 4 + 8 + 4 + 4 + 4 * 4 + 2 * 4 * row_words) + f * 4 * 4
 }
 
+/// Records a selection under `dab` into the resident selection buffers.
+fn record_brush_selection(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    r: &Resident,
+    active: &[bool],
+    dab: &Dab,
+) -> Result<(), GpuError> {
+    let hashed = r.hashed();
+    let active_words: Vec<u32> = active.iter().map(|&a| a as u32).collect();
+    let active_buffer = gpu.storage_buffer("active layers", &active_words, false);
+    record_select(
+        gpu,
+        encoder,
+        &r.vertices,
+        &active_buffer,
+        active.len(),
+        &HashedVertices {
+            table: &hashed.table,
+            positions: &hashed.positions,
+            drift: hashed.drift,
+            overlay: hashed.overlay(),
+        },
+        &BrushSphere {
+            center: dab.frame.center,
+            radius: dab.brush.radius,
+            falloff: dab.brush.falloff,
+        },
+        &r.selection,
+    )
+}
+
 /// The cell size the pipeline's grid uses (the table is built with the same).
 fn cell_size(state: &StrokeState<'_>) -> f32 {
     state.grid.map_or(state.max_edge, |g| g.cell_size())
@@ -1098,6 +1254,17 @@ impl StepKernels for GpuKernels {
             .unwrap_or_else(|| CpuKernels.select(state, mesh, dab))
     }
 
+    fn select_and_deform(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        how: (FrameSource, bool),
+    ) -> Deformed {
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how))
+            .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
+    }
+
     fn deform(
         &mut self,
         state: &StrokeState<'_>,
@@ -1150,7 +1317,10 @@ impl StepKernels for GpuKernels {
     }
 
     fn uploads(&self) -> Option<Uploads> {
-        Some(self.uploads)
+        Some(Uploads {
+            read_backs: self.gpu.read_backs(),
+            ..self.uploads
+        })
     }
 
     fn backstop_filter(&self) -> Option<BackstopFilter> {

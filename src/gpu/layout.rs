@@ -85,7 +85,22 @@ pub struct DeformParams {
     pub kind: u32,
     pub sign: f32,
     pub capacity: u32,
-    pub _pad: u32,
+    /// `FRAME_*` flags (`crate::cpu::FRAME_NORMAL_FROM_SUMS`, `FRAME_PLANE_FROM_SUMS`): which
+    /// of normal and plane point the kernel takes from `brush_frame`'s sums.
+    pub frame: u32,
+}
+
+/// `FrameParams` in `wgsl/brush_frame.wgsl`: where the brush is, and how much of the
+/// selection list to sum.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct FrameParams {
+    pub center: [f32; 3],
+    pub inv_radius: f32,
+    pub capacity: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `DispatchParams` in `wgsl/dispatch_args.wgsl`.

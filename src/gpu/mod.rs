@@ -3,6 +3,7 @@
 
 mod apply_moves;
 mod backstop;
+mod brush_frame;
 mod cell_keys;
 mod context;
 mod deform;
@@ -30,6 +31,10 @@ pub use backstop::{
     backstop_inputs, backstop_params, backstop_query_params, check_backstop_invocations,
     moved_edge_bound, record_backstop, run_backstop,
 };
+pub use brush_frame::{
+    FRAME_WORKGROUP_SIZE, FrameBuffers, frame_params, frame_sums_buffer, record_brush_frame,
+    run_brush_frame,
+};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{
     AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, Workgroups,
@@ -37,7 +42,7 @@ pub use context::{
 };
 pub use deform::{
     DeformBuffers, SmoothingNeighbours, brush_code, deform_params, record_deform, run_deform,
-    smoothing_neighbours,
+    run_framed_deform, smoothing_neighbours,
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use hash_table::{
@@ -46,8 +51,8 @@ pub use hash_table::{
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, MovingVertex, NormalParams, ProximityParams, PulledVertex, SelectParams,
-    SelectedVertex,
+    DispatchParams, FrameParams, MovingVertex, NormalParams, ProximityParams, PulledVertex,
+    SelectParams, SelectedVertex,
 };
 pub use overlay::{Filing, OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};

@@ -15,6 +15,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/geom", include_str!("../../wgsl/shared/geom.wgsl")),
     ("shared/moves", include_str!("../../wgsl/shared/moves.wgsl")),
     ("shared/pages", include_str!("../../wgsl/shared/pages.wgsl")),
+    ("shared/fixed", include_str!("../../wgsl/shared/fixed.wgsl")),
     (
         PAGED_ARRAY,
         include_str!("../../wgsl/shared/paged_array.wgsl"),
@@ -33,6 +34,7 @@ pub const KERNELS: &[(&str, &str)] = &[
     ("scatter", include_str!("../../wgsl/scatter.wgsl")),
     ("select", include_str!("../../wgsl/select.wgsl")),
     ("deform", include_str!("../../wgsl/deform.wgsl")),
+    ("brush_frame", include_str!("../../wgsl/brush_frame.wgsl")),
     (
         "dispatch_args",
         include_str!("../../wgsl/dispatch_args.wgsl"),

@@ -6,13 +6,13 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::kernels::{CpuKernels, StepKernels};
-use super::step::{Region, StrokeState, collide_with, paint};
+use super::kernels::{CpuKernels, Deformed, FrameSource, StepKernels};
+use super::step::{Region, StrokeState, brush_frame, collide_with, paint};
 use super::{
     BackstopFilter, PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline,
     StrokeHook, StrokeReport, Uploads,
 };
-use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
+use crate::brush::{BrushKind, Dab, DabFrame, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::geom::largest_move;
 use crate::grid::SpatialHash;
@@ -219,38 +219,6 @@ fn millis(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
-/// The brush frame at a sample: the surface normal and centroid under the brush, weighted by
-/// falloff, summed in vertex order so every backend gets the same bits.
-fn frame_at(
-    mesh: &Mesh,
-    selection: &[(u32, f32)],
-    sample: &Sample,
-    previous: Option<Vec3>,
-) -> DabFrame {
-    let mut normal_sum = Vec3::ZERO;
-    let mut point_sum = Vec3::ZERO;
-    let mut weight_sum = 0.0f32;
-    for &(v, w) in selection {
-        normal_sum += mesh.normals()[v as usize] * w;
-        point_sum += mesh.positions()[v as usize] * w;
-        weight_sum += w;
-    }
-    let normal = sample
-        .normal
-        .or_else(|| normal_sum.try_normalize())
-        .unwrap_or(Vec3::Z);
-    DabFrame {
-        center: sample.position,
-        normal,
-        plane_point: if weight_sum > 0.0 {
-            point_sum / weight_sum
-        } else {
-            sample.position
-        },
-        motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
-    }
-}
-
 impl SculptPipeline for CpuPipeline {
     fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
         self.prepare_state(mesh)?;
@@ -369,21 +337,49 @@ impl SculptPipeline for CpuPipeline {
                     center: sample.position,
                     normal: Vec3::Z,
                     plane_point: sample.position,
-                    motion: Vec3::ZERO,
+                    motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
                 },
                 pressure: sample.pressure,
                 share: 1.0,
             };
-            let first_selection = match (&captured, is_grab) {
-                (Some(held), true) => held.clone(),
-                _ => self.kernels.select(&state, mesh, &probe),
+            previous = Some(sample.position);
+            let deforms = stroke.brush.kind.deforms();
+            // A grab keeps the vertices it caught at its first sample; anything else selects
+            // anew, and the kernels take the frame and the whole sample's targets with it (on
+            // the GPU in one submission, booked under selection: it cannot be split).
+            let opened = match (&captured, is_grab) {
+                (Some(held), true) => {
+                    let frame = brush_frame(mesh, held, &probe, sample.normal);
+                    Deformed {
+                        selection: held.clone(),
+                        frame,
+                        targets: None,
+                        deform_millis: 0.0,
+                    }
+                }
+                _ => self.kernels.select_and_deform(
+                    &state,
+                    mesh,
+                    &probe,
+                    (
+                        FrameSource::Selection {
+                            normal: sample.normal,
+                        },
+                        deforms,
+                    ),
+                ),
             };
+            let Deformed {
+                selection: first_selection,
+                frame,
+                targets: opened_targets,
+                deform_millis,
+            } = opened;
             if is_grab && captured.is_none() {
                 captured = Some(first_selection.clone());
             }
-            let frame = frame_at(mesh, &first_selection, sample, previous);
-            previous = Some(sample.position);
-            times.selection += millis(started);
+            times.selection += millis(started) - deform_millis;
+            times.deformation += deform_millis;
             if first_selection.is_empty() {
                 continue;
             }
@@ -400,14 +396,17 @@ impl SculptPipeline for CpuPipeline {
                 }
                 times.deformation += millis(started);
             }
-            if !stroke.brush.kind.deforms() {
+            if !deforms {
                 continue;
             }
 
             // Split the sample's motion into steps of at most `max_step` edge lengths.
             let started = Instant::now();
             let whole = Dab { frame, ..probe };
-            let mut full = self.kernels.deform(&state, mesh, &whole, &first_selection);
+            let mut full = match opened_targets {
+                Some(targets) => targets,
+                None => self.kernels.deform(&state, mesh, &whole, &first_selection),
+            };
             let longest_move = first_selection
                 .iter()
                 .zip(&full)
@@ -428,23 +427,30 @@ impl SculptPipeline for CpuPipeline {
                     share: 1.0 / steps as f32,
                     ..whole
                 };
-                let started = Instant::now();
-                let selection = if step == 0 || is_grab {
-                    first_selection.clone()
-                } else {
-                    self.kernels.select(&state, mesh, &dab)
-                };
-                times.selection += millis(started);
-
-                let started = Instant::now();
                 // A sample taken in one step moves the selection exactly as its whole motion
-                // did (same vertices, share 1): its targets are already known.
-                let targets = if steps == 1 {
-                    std::mem::take(&mut full)
+                // did (same vertices, share 1): its targets are already known. Later steps
+                // select anew under the dab and deform in the same call (one submission on
+                // the GPU, booked under selection there).
+                let started = Instant::now();
+                let (selection, targets) = if step == 0 || is_grab {
+                    let targets = if steps == 1 {
+                        std::mem::take(&mut full)
+                    } else {
+                        self.kernels.deform(&state, mesh, &dab, &first_selection)
+                    };
+                    times.deformation += millis(started);
+                    (first_selection.clone(), targets)
                 } else {
-                    self.kernels.deform(&state, mesh, &dab, &selection)
+                    let step_pass = self.kernels.select_and_deform(
+                        &state,
+                        mesh,
+                        &dab,
+                        (FrameSource::Dab, true),
+                    );
+                    times.selection += millis(started) - step_pass.deform_millis;
+                    times.deformation += step_pass.deform_millis;
+                    (step_pass.selection, step_pass.targets.unwrap_or_default())
                 };
-                times.deformation += millis(started);
 
                 let started = Instant::now();
                 for (i, &(v, _)) in selection.iter().enumerate() {

@@ -5,10 +5,14 @@
 //! comparable vertex for vertex, which is what the parity figures of `bench --backend both`
 //! measure.
 
+use std::time::Instant;
+
 use glam::Vec3;
 
-use super::step::{Backstop, Region, StepMoves, StrokeState, clamp_in_region, deform, select};
-use crate::brush::Dab;
+use super::step::{
+    Backstop, Region, StepMoves, StrokeState, brush_frame, clamp_in_region, deform, select,
+};
+use crate::brush::{Dab, DabFrame};
 use crate::mesh::{Mesh, MeshVersion};
 use serde::Serialize;
 
@@ -30,6 +34,33 @@ pub trait StepKernels: Send {
     fn warm_up(&mut self, _mesh: &Mesh, _cell_size: f32) {}
     /// The vertices under the brush with their falloff weights, in vertex order.
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)>;
+    /// The selection under `dab` with, for a deforming brush, where `dab` moves each selected
+    /// vertex: at a sample's start with the brush frame taken from the selection
+    /// ([`FrameSource::Selection`], [`brush_frame`]), at its later steps under the dab's own.
+    /// The GPU does it all in one submission.
+    fn select_and_deform(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        (source, deforms): (FrameSource, bool),
+    ) -> Deformed {
+        let selection = self.select(state, mesh, dab);
+        let frame = match source {
+            FrameSource::Selection { normal } => brush_frame(mesh, &selection, dab, normal),
+            FrameSource::Dab => dab.frame,
+        };
+        let dab = Dab { frame, ..*dab };
+        let started = Instant::now();
+        let targets =
+            (deforms && !selection.is_empty()).then(|| self.deform(state, mesh, &dab, &selection));
+        Deformed {
+            selection,
+            frame,
+            targets,
+            deform_millis: started.elapsed().as_secs_f64() * 1e3,
+        }
+    }
     /// Where the brush moves each selected vertex.
     fn deform(
         &mut self,
@@ -76,8 +107,32 @@ pub trait StepKernels: Send {
     }
 }
 
+/// Where [`StepKernels::select_and_deform`] takes the brush frame from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FrameSource {
+    /// The selection (a sample's start): the falloff-weighted normal, unless the sample brings
+    /// its own `normal`, and centroid under the brush.
+    Selection { normal: Option<Vec3> },
+    /// The dab's frame as given (a sample's later steps).
+    Dab,
+}
+
+/// What [`StepKernels::select_and_deform`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deformed {
+    /// In vertex order.
+    pub selection: Vec<(u32, f32)>,
+    pub frame: DabFrame,
+    /// One per selection entry; `None` for brushes that do not deform, or nothing selected.
+    pub targets: Option<Vec<Vec3>>,
+    /// Of the call's time, how much went to the deformation, where it ran apart (booked under
+    /// deformation); zero where one submission did everything (booked under selection).
+    pub deform_millis: f64,
+}
+
 /// How often kernels that keep a copy of the mesh (the GPU's) sent it whole, how often they
-/// patched it after remeshing instead, and how often they rebuilt their hash table.
+/// patched it after remeshing instead, how often they rebuilt their hash table, and how often
+/// the CPU waited for them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct Uploads {
     pub whole: usize,
@@ -87,6 +142,9 @@ pub struct Uploads {
     /// Times the vertices remeshing changed went into the table's small overlay instead of a
     /// rebuild.
     pub overlay_filings: usize,
+    /// Blocking read-backs: submissions whose results the CPU waited for (per sample, the
+    /// round trips a hardware GPU pays beside its kernels).
+    pub read_backs: usize,
 }
 
 /// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.

@@ -13,7 +13,7 @@ mod kernels;
 pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
-pub use kernels::{BackstopFilter, CpuKernels, StepKernels, Uploads};
+pub use kernels::{BackstopFilter, CpuKernels, Deformed, FrameSource, StepKernels, Uploads};
 
 use serde::Serialize;
 use thiserror::Error;

@@ -7,15 +7,74 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::brush::{Dab, Paint, displacement, paint_share};
+use crate::brush::{Dab, DabFrame, Paint, displacement, paint_share};
 use crate::collide::neighbourhood::ring_vertices;
 use crate::collide::{LocalFaceGrid, Stamps};
+use crate::cpu;
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
+use crate::gpu::{SelectedVertex, frame_params};
 use crate::grid::SpatialHash;
 use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags};
 
 /// Bisection rounds when clamping a move: 2⁻¹⁶ of a step.
 const CLAMP_ROUNDS: u32 = 16;
+
+/// The brush frame of `probe` (its centre, radius and motion) over `selection`: the falloff-
+/// weighted normal (unless the sample brings its own `normal`) and centroid under the brush.
+/// Summed in fixed point (`crate::cpu::brush_frame`, the mirror of `wgsl/brush_frame.wgsl`) so
+/// that every backend gets the same bits, whatever order its selection came in.
+pub fn brush_frame(
+    mesh: &Mesh,
+    selection: &[(u32, f32)],
+    probe: &Dab,
+    normal: Option<Vec3>,
+) -> DabFrame {
+    let selected: Vec<SelectedVertex> = selection
+        .iter()
+        .map(|&(vertex, weight)| SelectedVertex { vertex, weight })
+        .collect();
+    let mut sums = [0u32; cpu::FRAME_SUM_WORDS];
+    cpu::brush_frame(
+        &frame_params(probe.frame.center, probe.brush.radius, selected.len()),
+        &cpu::FrameInputs {
+            positions: mesh.positions(),
+            normals: mesh.normals(),
+            selected: &selected,
+            selection_count: selected.len() as u32,
+        },
+        &mut sums,
+    );
+    frame_of_sums(&sums, probe, normal)
+}
+
+/// Which parts of the frame come from the sums: the plane point always, the normal unless the
+/// sample brings its own (`DeformParams::frame`).
+pub fn frame_flags(normal: Option<Vec3>) -> u32 {
+    cpu::FRAME_PLANE_FROM_SUMS
+        | if normal.is_none() {
+            cpu::FRAME_NORMAL_FROM_SUMS
+        } else {
+            0
+        }
+}
+
+/// The frame from `brush_frame`'s sums, as `wgsl/deform.wgsl` resolves it: +Z where the
+/// normals under the brush cancel out, the centre where nothing is under it.
+pub fn frame_of_sums(sums: &cpu::FrameSums, probe: &Dab, normal: Option<Vec3>) -> DabFrame {
+    let center = probe.frame.center;
+    let (normal, plane_point) = cpu::frame_from_sums(
+        sums,
+        frame_flags(normal),
+        (center, probe.brush.radius),
+        (normal.unwrap_or(Vec3::Z), center),
+    );
+    DabFrame {
+        center,
+        normal,
+        plane_point,
+        motion: probe.frame.motion,
+    }
+}
 
 /// A vertex already within the collision distance of a face is pulled back when its move
 /// takes it closer by more than this share of the distance. A move along the face (a grab
