@@ -343,3 +343,120 @@ fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
     assert_eq!((uploads.table_builds, uploads.overlay_filings), (1, 1));
     assert_eq!(kernels.failure(), None);
 }
+
+#[test]
+fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
+    // At a sample's start (the frame from the selection, with and without the sample's own
+    // normal) and at a later step (the dab's frame), for a brush that does not deform, and for
+    // a selection longer than the GPU guessed (its second read and separate deformation): the
+    // same vertices and weights as the CPU kernels, the same frame bits (the sums are integers,
+    // turned into the frame by the same function), and the same targets within rounding.
+    use glam::Vec3;
+    use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
+    use slayer::pipeline::step::StrokeState;
+    use slayer::pipeline::{CpuKernels, FrameSource, StepKernels};
+
+    // Vertices numbered in no spatial order, so that the GPU appends its selection out of
+    // vertex order and its targets must be put in the pipeline's order.
+    let sheets = slayer::scene::shapes::stacked_sheets(3, 120, 100, 0.05, 0.2);
+    let count = sheets.vertex_count() as u32;
+    let new_id = |v: u32| (v as u64 * 7919 % count as u64) as u32;
+    let mut positions = vec![Vec3::ZERO; count as usize];
+    for (v, p) in sheets.positions().iter().enumerate() {
+        positions[new_id(v as u32) as usize] = *p;
+    }
+    let faces = sheets.faces().iter().map(|f| f.map(new_id)).collect();
+    let mesh = Mesh::new(
+        positions,
+        faces,
+        sheets.face_layers().to_vec(),
+        sheets.layer_names().to_vec(),
+    )
+    .unwrap();
+    let grid = slayer::grid::SpatialHash::build(&mesh, 0.05).unwrap();
+    let active = [true, true, false];
+    let state = StrokeState {
+        grid: Some(&grid),
+        active: &active,
+        parallel: false,
+        collision_distance: 0.05,
+        ring: 2,
+        max_edge: 0.08,
+    };
+    let mut gpu_kernels = GpuKernels::new(gpu());
+    let dab = |kind, radius| Dab {
+        brush: Brush {
+            kind,
+            radius,
+            strength: 0.6,
+            falloff: Falloff::Smooth,
+            invert: false,
+        },
+        frame: DabFrame {
+            center: Vec3::new(3.0, 2.5, 0.1),
+            normal: Vec3::new(0.2, 0.1, 1.0).normalize(),
+            plane_point: Vec3::new(3.0, 2.5, 0.05),
+            motion: Vec3::new(0.01, 0.0, 0.0),
+        },
+        pressure: 1.0,
+        share: 1.0,
+    };
+    let own_normal = Some(Vec3::new(0.3, -0.1, 1.0).normalize());
+    let calls = [
+        (
+            BrushKind::Flatten,
+            0.2,
+            FrameSource::Selection { normal: None },
+            true,
+        ),
+        // Far past the guess: the list is read twice and deformed apart.
+        (
+            BrushKind::Flatten,
+            1.9,
+            FrameSource::Selection { normal: None },
+            true,
+        ),
+        (
+            BrushKind::Draw,
+            1.9,
+            FrameSource::Selection { normal: own_normal },
+            true,
+        ),
+        (BrushKind::Draw, 0.25, FrameSource::Dab, true),
+        (
+            BrushKind::Paint,
+            0.3,
+            FrameSource::Selection { normal: None },
+            false,
+        ),
+    ];
+    for (k, &(kind, radius, source, deforms)) in calls.iter().enumerate() {
+        let dab = dab(kind, radius);
+        let read_backs = gpu_kernels.uploads().unwrap().read_backs;
+        let on_gpu = gpu_kernels.select_and_deform(&state, &mesh, &dab, (source, deforms));
+        let read_backs = gpu_kernels.uploads().unwrap().read_backs - read_backs;
+        let on_cpu = CpuKernels.select_and_deform(&state, &mesh, &dab, (source, deforms));
+        let label = format!("call {k}: {} radius {radius}", kind.name());
+        assert!(gpu_kernels.failure().is_none(), "{label}: GPU gave up");
+        assert!(
+            on_cpu.selection.len() > 20,
+            "{label}: selects {}",
+            on_cpu.selection.len()
+        );
+        assert_eq!(on_gpu.selection, on_cpu.selection, "{label}: selection");
+        assert_eq!(on_gpu.frame, on_cpu.frame, "{label}: frame");
+        assert_eq!(on_gpu.targets.is_some(), deforms, "{label}: targets");
+        if let (Some(g), Some(c)) = (&on_gpu.targets, &on_cpu.targets) {
+            let worst = g
+                .iter()
+                .zip(c)
+                .map(|(p, q)| p.distance(*q))
+                .fold(0.0, f32::max);
+            assert!(worst <= 1e-5 * radius, "{label}: targets {worst:e} apart");
+        }
+        // The first call builds the hash table (a wait, not a read-back); past the guess the
+        // rest of the list and the deformation are two more.
+        let expected = if k == 1 { 3 } else { 1 };
+        assert_eq!(read_backs, expected, "{label}: read-backs");
+    }
+}
