@@ -1090,20 +1090,21 @@ fn deform_takes_the_frame_from_the_sums_as_the_mirror_does() {
                     frame: flags,
                     ..deform_params(&dab, size)
                 };
-                let mut mirror = vec![Vec3::ZERO; size];
-                slayer::cpu::deform(
-                    &params,
-                    &slayer::cpu::DeformInputs {
+                let mirror_deform = |params: &slayer::gpu::DeformParams, frame_sums| {
+                    let mut targets = vec![Vec3::ZERO; size];
+                    let inputs = slayer::cpu::DeformInputs {
                         positions: mesh.positions(),
                         normals: mesh.normals(),
                         selected: selection,
                         selection_count: size as u32,
                         neighbour_rows: &neighbours.rows.table,
                         neighbours: &neighbours.words,
-                        frame_sums: &mirror_sums,
-                    },
-                    &mut mirror,
-                );
+                        frame_sums,
+                    };
+                    slayer::cpu::deform(params, &inputs, &mut targets);
+                    targets
+                };
+                let mirror = mirror_deform(&params, &mirror_sums);
                 let g = worst_relative(&actual, &mirror, dab.brush.radius);
                 assert!(
                     g <= DEFORM_TOLERANCE,
@@ -1114,20 +1115,7 @@ fn deform_takes_the_frame_from_the_sums_as_the_mirror_does() {
                 // the sample's later steps: the same targets.
                 let frame = slayer::pipeline::step::frame_of_sums(&mirror_sums, &dab, own_normal);
                 let resolved = deform_params(&Dab { frame, ..dab }, size);
-                let mut again = vec![Vec3::ZERO; size];
-                slayer::cpu::deform(
-                    &resolved,
-                    &slayer::cpu::DeformInputs {
-                        positions: mesh.positions(),
-                        normals: mesh.normals(),
-                        selected: selection,
-                        selection_count: size as u32,
-                        neighbour_rows: &neighbours.rows.table,
-                        neighbours: &neighbours.words,
-                        frame_sums: &[0; slayer::cpu::FRAME_SUM_WORDS],
-                    },
-                    &mut again,
-                );
+                let again = mirror_deform(&resolved, &[0; slayer::cpu::FRAME_SUM_WORDS]);
                 assert_eq!(again, mirror, "{label}: frame resolved up front");
                 if size == full.len() {
                     let moved = mirror

@@ -619,39 +619,6 @@ impl GpuKernels {
         Ok(r)
     }
 
-    fn gpu_select(
-        &mut self,
-        state: &StrokeState<'_>,
-        mesh: &Mesh,
-        dab: &Dab,
-    ) -> Result<Vec<(u32, f32)>, GpuError> {
-        self.check_injected_failure()?;
-        let gpu = &self.gpu;
-        let r = GpuKernels::prepare(
-            gpu,
-            (&mut self.resident, &mut self.uploads),
-            mesh,
-            cell_size(state),
-            TableUse::Select {
-                radius: dab.brush.radius,
-            },
-        )?;
-        let mut encoder = gpu.encoder("select");
-        record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
-        // Twice the last selection: brushes change size slowly.
-        let guess = (2 * self.last_selection).max(SELECTION_GUESS);
-        let list = r
-            .selection
-            .submit_and_read(gpu, encoder, &mut self.step.readback, guess)?;
-        self.last_selection = list.len();
-        let mut selected: Vec<(u32, f32)> =
-            list.into_iter().map(|s| (s.vertex, s.weight)).collect();
-        // The kernel appends in whatever order its threads ran; the pipeline sums in vertex
-        // order so that every backend gets the same bits.
-        selected.sort_unstable_by_key(|&(v, _)| v);
-        Ok(selected)
-    }
-
     fn gpu_deform(
         &mut self,
         state: &StrokeState<'_>,
@@ -1250,7 +1217,10 @@ impl StepKernels for GpuKernels {
     }
 
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
-        self.on_gpu(|k| k.gpu_select(state, mesh, dab))
+        // The selection alone: the same submission as with a deformation, less its passes.
+        let alone = (FrameSource::Dab, false);
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, alone))
+            .map(|selected| selected.selection)
             .unwrap_or_else(|| CpuKernels.select(state, mesh, dab))
     }
 
