@@ -329,6 +329,20 @@ fn wgsl_constants_match_the_host() {
     for kernel in ["scan", "scan_add"] {
         assert_eq!(naga_u32_constant(kernel, "WORKGROUP_SIZE"), SCAN_BLOCK);
     }
+    // Kernels dispatched indirectly: the host sizes the dispatch with its own constant, and a
+    // smaller one than the shader's would leave entries out without a word.
+    for (kernel, host) in [
+        ("brush_frame", slayer::gpu::FRAME_WORKGROUP_SIZE),
+        ("apply_moves", slayer::gpu::APPLY_WORKGROUP_SIZE),
+        ("proximity", slayer::gpu::PROXIMITY_WORKGROUP_SIZE),
+        ("backstop", slayer::gpu::BACKSTOP_WORKGROUP_SIZE),
+    ] {
+        assert_eq!(
+            naga_u32_constant(kernel, "WORKGROUP_SIZE"),
+            host,
+            "{kernel}"
+        );
+    }
 }
 
 #[test]

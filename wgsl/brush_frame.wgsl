@@ -4,7 +4,7 @@
 // depend on the order the selection was appended in. Each workgroup sums its entries in
 // workgroup memory, then adds its total to `sums` once. `sums` (24 words: 7 sums of three
 // words, three spare) must be zero before. `deform` turns the sums into the frame
-// (shared/frame.wgsl); the host reads them back to know the frame too.
+// (`resolve_frame`); the host reads them back to know the frame too.
 // CPU mirror: src/cpu/brush_frame.rs.
 
 #import shared/grid
