@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::{FrameParams, GpuContext, GpuError, SelectedVertex, Workgroups};
+use super::{FrameParams, GpuContext, GpuError, SelectedVertex, SelectionBuffers, Workgroups};
 use crate::cpu::{FRAME_SUM_WORDS, FrameSums};
 
 pub const FRAME_WORKGROUP_SIZE: u32 = 64;
@@ -25,21 +25,12 @@ pub fn frame_sums_buffer(gpu: &GpuContext) -> wgpu::Buffer {
     gpu.output_buffer::<u32>("brush frame sums", FRAME_SUM_WORDS)
 }
 
-/// What `brush_frame` reads.
-pub struct FrameBuffers<'a> {
-    pub positions: &'a wgpu::Buffer,
-    pub normals: &'a wgpu::Buffer,
-    pub selected: &'a wgpu::Buffer,
-    /// One `u32`: the selection count.
-    pub selection_count: &'a wgpu::Buffer,
-}
-
 /// Records the sums of the selection into `sums` (cleared first); `workgroups` covers the
 /// selection (an indirect dispatch sized from its count, when only the GPU knows it).
 pub fn record_brush_frame(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
-    inputs: &FrameBuffers<'_>,
+    inputs: &SelectionBuffers<'_>,
     params: &FrameParams,
     sums: &wgpu::Buffer,
     workgroups: Workgroups<'_>,
@@ -76,13 +67,7 @@ pub fn run_brush_frame(
 ) -> Result<FrameSums, GpuError> {
     let positions = gpu.storage_buffer("positions", positions, false);
     let normals = gpu.storage_buffer("normals", normals, false);
-    // Never an empty binding: one unused entry stands in for an empty selection.
-    let padded: Vec<SelectedVertex> = if selection.is_empty() {
-        vec![SelectedVertex::default()]
-    } else {
-        selection.to_vec()
-    };
-    let selected = gpu.storage_buffer("selected", &padded, false);
+    let selected = gpu.storage_buffer("selected", selection, false);
     let count = gpu.storage_buffer("selection count", &[selection.len() as u32], false);
     let args = super::indirect_args_buffer(gpu, "brush_frame sizes");
     let sums = frame_sums_buffer(gpu);
@@ -98,7 +83,7 @@ pub fn run_brush_frame(
     record_brush_frame(
         gpu,
         &mut encoder,
-        &FrameBuffers {
+        &SelectionBuffers {
             positions: &positions,
             normals: &normals,
             selected: &selected,

@@ -291,19 +291,26 @@ impl GpuContext {
         Ok(pipeline)
     }
 
-    /// A storage buffer holding `data` (at least 4 bytes, so empty inputs stay legal).
+    /// A storage buffer holding `data`, zero-padded to at least one element and a multiple of 4
+    /// bytes, so that an empty input still binds as an array of its type.
     pub fn storage_buffer<T: Pod>(&self, label: &str, data: &[T], writable: bool) -> wgpu::Buffer {
         let mut usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         if writable {
             usage |= wgpu::BufferUsages::COPY_DST;
         }
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        let padded;
-        let contents = if bytes.len() < 4 {
-            padded = [0u8; 4];
-            &padded[..]
-        } else {
+        let size = bytes
+            .len()
+            .max(std::mem::size_of::<T>())
+            .next_multiple_of(4)
+            .max(4);
+        let mut padded;
+        let contents = if bytes.len() == size {
             bytes
+        } else {
+            padded = vec![0u8; size];
+            padded[..bytes.len()].copy_from_slice(bytes);
+            &padded[..]
         };
         self.device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {

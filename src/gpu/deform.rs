@@ -3,11 +3,11 @@
 use glam::Vec3;
 
 use super::brush_frame::{
-    FRAME_WORKGROUP_SIZE, FrameBuffers, frame_params, frame_sums_buffer, record_brush_frame,
+    FRAME_WORKGROUP_SIZE, frame_params, frame_sums_buffer, record_brush_frame,
 };
 use super::reusable::Patches;
 use super::rows::SlottedRows;
-use super::{DeformParams, GpuContext, GpuError, SelectedVertex, Workgroups};
+use super::{DeformParams, GpuContext, GpuError, SelectedVertex, SelectionBuffers, Workgroups};
 use crate::brush::{BrushKind, Dab};
 use crate::mesh::{INVALID, Mesh, next};
 
@@ -105,13 +105,9 @@ pub(super) fn neighbour_row(mesh: &Mesh, v: u32, row: &mut Vec<u32>) {
     }
 }
 
-/// Buffers `deform` reads besides the vertex buffers and the selection.
+/// What `deform` reads: what `brush_frame` reads, and smoothing's neighbours and the sums.
 pub struct DeformBuffers<'a> {
-    pub positions: &'a wgpu::Buffer,
-    pub normals: &'a wgpu::Buffer,
-    pub selected: &'a wgpu::Buffer,
-    /// One `u32`: the selection count (`GpuSelection::count`).
-    pub selection_count: &'a wgpu::Buffer,
+    pub selection: SelectionBuffers<'a>,
     /// Per vertex (start, length) of its row in `neighbours`.
     pub neighbour_rows: &'a wgpu::Buffer,
     /// Paged.
@@ -139,10 +135,10 @@ pub fn record_deform(
         "deform",
         &[
             &uniform,
-            inputs.positions,
-            inputs.normals,
-            inputs.selected,
-            inputs.selection_count,
+            inputs.selection.positions,
+            inputs.selection.normals,
+            inputs.selection.selected,
+            inputs.selection.selection_count,
             inputs.neighbour_rows,
             targets,
             inputs.frame_sums,
@@ -181,27 +177,23 @@ pub fn run_framed_deform(
     gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
     let positions = gpu.storage_buffer("positions", mesh.positions(), false);
     let normals = gpu.storage_buffer("normals", mesh.normals(), false);
-    let padded: Vec<SelectedVertex> = if selection.is_empty() {
-        vec![SelectedVertex::default()]
-    } else {
-        selection.to_vec()
-    };
-    let selected = gpu.storage_buffer("selected", &padded, false);
+    let selected = gpu.storage_buffer("selected", selection, false);
     let count = gpu.storage_buffer("selection count", &[selection.len() as u32], false);
     let rows = gpu.storage_buffer("neighbour rows", &neighbours.rows.table, false);
     let neighbours = gpu.storage_buffer("neighbours", &neighbours.words, false);
     let targets = gpu.output_buffer::<Vec3>("targets", selection.len());
     let sums = frame_sums_buffer(gpu);
+    let inputs = SelectionBuffers {
+        positions: &positions,
+        normals: &normals,
+        selected: &selected,
+        selection_count: &count,
+    };
     let mut encoder = gpu.encoder("deform");
     record_brush_frame(
         gpu,
         &mut encoder,
-        &FrameBuffers {
-            positions: &positions,
-            normals: &normals,
-            selected: &selected,
-            selection_count: &count,
-        },
+        &inputs,
         &frame_params(dab.frame.center, dab.brush.radius, selection.len()),
         &sums,
         Workgroups::Cover {
@@ -213,10 +205,7 @@ pub fn run_framed_deform(
         gpu,
         &mut encoder,
         &DeformBuffers {
-            positions: &positions,
-            normals: &normals,
-            selected: &selected,
-            selection_count: &count,
+            selection: inputs,
             neighbour_rows: &rows,
             neighbours: &neighbours,
             frame_sums: &sums,

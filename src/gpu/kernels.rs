@@ -36,17 +36,18 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
-    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, FRAME_WORKGROUP_SIZE, FrameBuffers,
-    GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS,
+    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, FRAME_WORKGROUP_SIZE, GpuContext,
+    GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS,
     PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
-    SelectedVertex, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
-    Workgroups, backstop_params, check_invocations, deform_params, frame_params, frame_sums_buffer,
-    indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit, overlay_table,
-    pass_params, record_apply_moves, record_backstop, record_brush_frame, record_deform,
-    record_dispatch_args, record_proximity, record_select, smoothing_neighbours, table_size_for,
+    SelectedVertex, SelectionBuffers, SlottedRows, SmoothingNeighbours, TableBuffers,
+    TopologyLayout, VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params,
+    frame_params, frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices,
+    overlay_limit, overlay_table, pass_params, record_apply_moves, record_backstop,
+    record_brush_frame, record_deform, record_dispatch_args, record_proximity, record_select,
+    smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
-use crate::cpu::{FRAME_SUM_WORDS, FrameSums};
+use crate::cpu::FRAME_SUM_WORDS;
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{
     Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region, frame_flags,
@@ -655,10 +656,12 @@ impl GpuKernels {
             gpu,
             &mut encoder,
             &DeformBuffers {
-                positions: &r.vertices.positions,
-                normals: &r.normals,
-                selected: step.selected.buffer(),
-                selection_count: &step.selection_count,
+                selection: SelectionBuffers {
+                    positions: &r.vertices.positions,
+                    normals: &r.normals,
+                    selected: step.selected.buffer(),
+                    selection_count: &step.selection_count,
+                },
                 neighbour_rows: &r.neighbour_table,
                 neighbours: &r.neighbours,
                 frame_sums: &step.frame_sums,
@@ -666,20 +669,18 @@ impl GpuKernels {
             &deform_params(dab, entries.len()),
             step.targets.buffer(),
         )?;
-        read_back(
-            gpu,
-            &mut step.readback,
-            encoder,
-            step.targets.buffer(),
-            bytes,
-        )
+        let data =
+            step.readback
+                .read_back_parts(gpu, encoder, &[(step.targets.buffer(), bytes)])?;
+        Ok(bytemuck::pod_collect_to_vec(&data))
     }
 
     /// Selection, brush frame and deformation in one submission: the selection kernel fills
     /// the resident list; at a sample's start `brush_frame` sums it (dispatched from the
     /// count) and `deform` takes the frame from the sums; `deform` moves the first `guess`
     /// entries. The count, that head of the list, the sums and the targets come back in one
-    /// map. A selection longer than the guess reads the rest of the list and deforms it apart.
+    /// map (`GpuSelection::submit_and_read`). A selection longer than the guess reads the rest
+    /// of the list and deforms it apart.
     fn gpu_select_and_deform(
         &mut self,
         state: &StrokeState<'_>,
@@ -702,7 +703,16 @@ impl GpuKernels {
         record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
         let capacity = r.selection.capacity;
         let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        let inputs = SelectionBuffers {
+            positions: &r.vertices.positions,
+            normals: &r.normals,
+            selected: &r.selection.selected,
+            selection_count: &r.selection.count,
+        };
         let mut params = deform_params(dab, guess);
+        let sum_bytes = (FRAME_SUM_WORDS * 4) as u64;
+        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
+        let mut extra = Vec::new();
         let sums_from_selection = match source {
             FrameSource::Selection { normal } => {
                 params.frame = frame_flags(normal);
@@ -718,32 +728,23 @@ impl GpuKernels {
                 record_brush_frame(
                     gpu,
                     &mut encoder,
-                    &FrameBuffers {
-                        positions: &r.vertices.positions,
-                        normals: &r.normals,
-                        selected: &r.selection.selected,
-                        selection_count: &r.selection.count,
-                    },
+                    &inputs,
                     &frame_params(dab.frame.center, dab.brush.radius, capacity),
                     &step.frame_sums,
                     Workgroups::Indirect(&step.frame_args),
                 )?;
+                extra.push((&step.frame_sums, sum_bytes));
                 Some(normal)
             }
             FrameSource::Dab => None,
         };
-        let entry_bytes = std::mem::size_of::<SelectedVertex>();
-        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
         if deforms {
             step.targets.reserve(gpu, target_bytes)?;
             record_deform(
                 gpu,
                 &mut encoder,
                 &DeformBuffers {
-                    positions: &r.vertices.positions,
-                    normals: &r.normals,
-                    selected: &r.selection.selected,
-                    selection_count: &r.selection.count,
+                    selection: inputs,
                     neighbour_rows: &r.neighbour_table,
                     neighbours: &r.neighbours,
                     frame_sums: &step.frame_sums,
@@ -751,41 +752,30 @@ impl GpuKernels {
                 &params,
                 step.targets.buffer(),
             )?;
+            extra.push((step.targets.buffer(), target_bytes));
         }
-        let sum_bytes = (FRAME_SUM_WORDS * 4) as u64;
-        let mut parts = vec![
-            (&r.selection.count, 4),
-            (&step.frame_sums, sum_bytes),
-            (&r.selection.selected, (entry_bytes * guess) as u64),
-        ];
-        if deforms {
-            parts.push((step.targets.buffer(), target_bytes));
-        }
-        let data = read_back_parts(gpu, &mut step.readback, encoder, &parts)?;
-        let word =
-            |at: usize| u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]);
-        let count = (word(0) as usize).min(capacity);
-        let sums: FrameSums = std::array::from_fn(|k| word(4 + 4 * k));
-        let list_at = 4 + sum_bytes as usize;
-        let head = count.min(guess);
-        let mut list: Vec<SelectedVertex> =
-            bytemuck::pod_collect_to_vec(&data[list_at..list_at + head * entry_bytes]);
-        let targets_at = list_at + guess * entry_bytes;
-        let head_targets: Vec<Vec3> = if deforms {
-            bytemuck::pod_collect_to_vec(&data[targets_at..targets_at + head * 12])
+        let read = r
+            .selection
+            .submit_and_read(gpu, encoder, &mut step.readback, guess, &extra)?;
+        let list = read.list;
+        let count = list.len();
+        // The extra parts in the order pushed: the sums (at a sample's start), the targets.
+        let (sum_part, target_part) = read.extra.split_at(if sums_from_selection.is_some() {
+            sum_bytes as usize
+        } else {
+            0
+        });
+        let frame = match sums_from_selection {
+            Some(normal) => frame_of_sums(&bytemuck::pod_read_unaligned(sum_part), dab, normal),
+            None => dab.frame,
+        };
+        let whole_list = read.head == count;
+        let head_targets: Vec<Vec3> = if deforms && whole_list {
+            bytemuck::pod_collect_to_vec(&target_part[..count * 12])
         } else {
             Vec::new()
         };
-        let whole_list = count == head;
-        if !whole_list {
-            let all: Vec<SelectedVertex> = gpu.read_buffer(&r.selection.selected, count)?;
-            list.extend_from_slice(&all[head..]);
-        }
         self.last_selection = count;
-        let frame = match sums_from_selection {
-            Some(normal) => frame_of_sums(&sums, dab, normal),
-            None => dab.frame,
-        };
         // The kernels appended in whatever order their threads ran; the pipeline works in
         // vertex order (its sums and the CPU's agree then), the targets permuted alike.
         let mut order: Vec<usize> = (0..list.len()).collect();
@@ -1026,7 +1016,7 @@ impl GpuKernels {
             parts.push((&step.pair_count, 4));
             parts.push((step.pairs.buffer(), pair_bytes));
         }
-        let data = read_back_parts(gpu, &mut step.readback, encoder, &parts)?;
+        let data = step.readback.read_back_parts(gpu, encoder, &parts)?;
         let finals = bytemuck::pod_collect_to_vec(&data[..bytes as usize]);
         if !self.backstop_on_gpu {
             return Ok((finals, Backstop::Gather));
@@ -1152,39 +1142,6 @@ fn record_brush_selection(
 /// The cell size the pipeline's grid uses (the table is built with the same).
 fn cell_size(state: &StrokeState<'_>) -> f32 {
     state.grid.map_or(state.max_edge, |g| g.cell_size())
-}
-
-/// Submits `encoder` with a copy of `bytes` of `source` into `staging`, and reads them back.
-fn read_back<T: bytemuck::Pod>(
-    gpu: &GpuContext,
-    staging: &mut ReusableBuffer,
-    encoder: wgpu::CommandEncoder,
-    source: &wgpu::Buffer,
-    bytes: u64,
-) -> Result<Vec<T>, GpuError> {
-    let data = read_back_parts(gpu, staging, encoder, &[(source, bytes)])?;
-    Ok(bytemuck::pod_collect_to_vec(&data))
-}
-
-/// Submits `encoder` with copies of the first bytes of each part (multiples of 4) one after
-/// another into `staging`, and reads them back in one map.
-fn read_back_parts(
-    gpu: &GpuContext,
-    staging: &mut ReusableBuffer,
-    mut encoder: wgpu::CommandEncoder,
-    parts: &[(&wgpu::Buffer, u64)],
-) -> Result<Vec<u8>, GpuError> {
-    let total: u64 = parts.iter().map(|&(_, bytes)| bytes).sum();
-    staging.reserve(gpu, total)?;
-    let mut at = 0;
-    for &(source, bytes) in parts {
-        encoder.copy_buffer_to_buffer(source, 0, staging.buffer(), at, bytes);
-        at += bytes;
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let mut data = gpu.map_read(staging.buffer())?;
-    data.truncate(total as usize);
-    Ok(data)
 }
 
 /// The vertex flags as the kernels read them, one `u32` each.

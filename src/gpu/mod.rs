@@ -32,8 +32,7 @@ pub use backstop::{
     moved_edge_bound, record_backstop, run_backstop,
 };
 pub use brush_frame::{
-    FRAME_WORKGROUP_SIZE, FrameBuffers, frame_params, frame_sums_buffer, record_brush_frame,
-    run_brush_frame,
+    FRAME_WORKGROUP_SIZE, frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame,
 };
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{
@@ -64,8 +63,8 @@ pub use proximity::{
 pub use rows::SlottedRows;
 pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
 pub use select::{
-    BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, falloff_code, record_select,
-    run_select, run_select_with_overlay, select_params,
+    BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, SelectionBuffers, SelectionRead,
+    falloff_code, record_select, run_select, run_select_with_overlay, select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology, TopologyLayout};
 pub use vertex_normals::{record_vertex_normals, run_vertex_normals};

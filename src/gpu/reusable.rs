@@ -90,6 +90,28 @@ impl ReusableBuffer {
         Ok(())
     }
 
+    /// Submits `encoder` with copies of the first bytes of each part (multiples of 4) one
+    /// after another into this (read-back) buffer, and reads them back in one map: one
+    /// blocking round trip however many buffers the CPU needs from the submission.
+    pub fn read_back_parts(
+        &mut self,
+        gpu: &GpuContext,
+        mut encoder: wgpu::CommandEncoder,
+        parts: &[(&wgpu::Buffer, u64)],
+    ) -> Result<Vec<u8>, GpuError> {
+        let total: u64 = parts.iter().map(|&(_, bytes)| bytes).sum();
+        self.reserve(gpu, total)?;
+        let mut at = 0;
+        for &(source, bytes) in parts {
+            encoder.copy_buffer_to_buffer(source, 0, self.buffer(), at, bytes);
+            at += bytes;
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let mut data = gpu.map_read(self.buffer())?;
+        data.truncate(total as usize);
+        Ok(data)
+    }
+
     /// The buffer; [`ReusableBuffer::reserve`] or [`ReusableBuffer::upload`] first.
     pub fn buffer(&self) -> &wgpu::Buffer {
         self.buffer

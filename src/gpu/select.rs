@@ -98,42 +98,59 @@ impl GpuSelection {
         })
     }
 
-    /// Submits `encoder`, which recorded a selection into these buffers, with copies of the
-    /// count and the first `guess` entries into `staging`, and reads them back in one map; a
-    /// longer list costs a second read. Each blocking read-back is milliseconds on lavapipe:
-    /// reading the count, then the list, was most of the GPU path's selection time.
-    /// The entries come in the order the kernel appended them.
+    /// Submits `encoder`, which recorded a selection into these buffers (and whatever else),
+    /// and reads back in one map the count, the first `guess` entries and the `extra` parts
+    /// (`ReusableBuffer::read_back_parts`); a longer list costs a second read. Each blocking
+    /// read-back is milliseconds on lavapipe: reading the count, then the list, was most of the
+    /// GPU path's selection time.
     pub fn submit_and_read(
         &self,
         gpu: &GpuContext,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         staging: &mut ReusableBuffer,
         guess: usize,
-    ) -> Result<Vec<SelectedVertex>, GpuError> {
-        let entry = std::mem::size_of::<SelectedVertex>() as u64;
+        extra: &[(&wgpu::Buffer, u64)],
+    ) -> Result<SelectionRead, GpuError> {
+        let entry = std::mem::size_of::<SelectedVertex>();
         let guess = guess.min(self.capacity);
-        staging.reserve(gpu, entry * (guess as u64 + 1))?;
-        encoder.copy_buffer_to_buffer(&self.count, 0, staging.buffer(), 0, 4);
-        encoder.copy_buffer_to_buffer(
-            &self.selected,
-            0,
-            staging.buffer(),
-            entry,
-            entry * guess as u64,
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = gpu.map_read(staging.buffer())?;
+        let mut parts = vec![(&self.count, 4), (&self.selected, (entry * guess) as u64)];
+        parts.extend_from_slice(extra);
+        let bytes = staging.read_back_parts(gpu, encoder, &parts)?;
         let count = (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize)
             .min(self.capacity);
         let head = count.min(guess);
         let mut list: Vec<SelectedVertex> =
-            bytemuck::pod_collect_to_vec(&bytes[entry as usize..entry as usize * (head + 1)]);
+            bytemuck::pod_collect_to_vec(&bytes[4..4 + entry * head]);
         if count > head {
             let all: Vec<SelectedVertex> = gpu.read_buffer(&self.selected, count)?;
             list.extend_from_slice(&all[head..]);
         }
-        Ok(list)
+        Ok(SelectionRead {
+            list,
+            head,
+            extra: bytes[4 + entry * guess..].to_vec(),
+        })
     }
+}
+
+/// What [`GpuSelection::submit_and_read`] brought back.
+pub struct SelectionRead {
+    /// The whole list, in the order the kernel appended it.
+    pub list: Vec<SelectedVertex>,
+    /// How many of its entries came with the first map (the rest took a second read).
+    pub head: usize,
+    /// The extra parts' bytes, one after another.
+    pub extra: Vec<u8>,
+}
+
+/// The selection list and its count with the per-vertex data the kernels read for each entry
+/// (`brush_frame`, `deform`).
+pub struct SelectionBuffers<'a> {
+    pub positions: &'a wgpu::Buffer,
+    pub normals: &'a wgpu::Buffer,
+    pub selected: &'a wgpu::Buffer,
+    /// One `u32`: the selection count (`GpuSelection::count`).
+    pub selection_count: &'a wgpu::Buffer,
 }
 
 /// A hash table and the positions it was built from, with how far any vertex has moved since.
@@ -298,5 +315,7 @@ pub fn run_select_with_overlay(
         &selection,
     )?;
     let mut staging = ReusableBuffer::readback("selection read-back");
-    selection.submit_and_read(gpu, encoder, &mut staging, SELECTION_GUESS)
+    Ok(selection
+        .submit_and_read(gpu, encoder, &mut staging, SELECTION_GUESS, &[])?
+        .list)
 }
