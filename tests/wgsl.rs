@@ -11,8 +11,8 @@ use slayer::gpu::shaders::{
 };
 use slayer::gpu::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, FrameParams, MovingVertex, NormalParams, ProximityParams, SCAN_BLOCK,
-    SelectParams, SelectedVertex, brush_code, falloff_code,
+    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, ProximityParams,
+    SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -207,7 +207,7 @@ fn select_structs_match_naga_layout() {
             workgroup_size,
             max_per_dimension,
             capacity,
-            _pad
+            per_item
         }
     );
     assert_layout!(
@@ -336,6 +336,7 @@ fn wgsl_constants_match_the_host() {
         ("apply_moves", slayer::gpu::APPLY_WORKGROUP_SIZE),
         ("proximity", slayer::gpu::PROXIMITY_WORKGROUP_SIZE),
         ("backstop", slayer::gpu::BACKSTOP_WORKGROUP_SIZE),
+        ("moving_entries", slayer::gpu::ENTRIES_WORKGROUP_SIZE),
     ] {
         assert_eq!(
             naga_u32_constant(kernel, "WORKGROUP_SIZE"),
@@ -432,6 +433,28 @@ fn proximity_and_normal_structs_match_naga_layout() {
             _pad
         }
     );
+
+    assert_layout!(
+        "moving_entries",
+        EntryParams {
+            capacity,
+            ring,
+            ring_stride,
+            vertex_rows_base
+        }
+    );
+    assert_layout!(
+        "moving_entries",
+        MovingVertex {
+            start,
+            vertex,
+            layer,
+            ring_start,
+            ring_end,
+            _pad
+        }
+    );
+    assert_layout!("moving_entries", SelectedVertex { vertex, weight });
 
     assert_layout!(
         "backstop",

@@ -17,10 +17,12 @@
 //   moved it (zero where not): the map the backstop filter reads.
 // - CLEAR: the marks cleared (after the backstop filter).
 //
-// Entries name distinct vertices, so no two invocations write the same slot.
+// Entries name distinct vertices, so no two invocations write the same slot; vacant entries
+// (shared/moves) write nothing.
 // CPU mirror: src/cpu/apply_moves.rs.
 
 #import shared/grid
+#import shared/mesh
 #import shared/moves
 
 struct ApplyParams {
@@ -77,6 +79,9 @@ fn main(
     }
     let entry = moving[i];
     let v = entry.vertex;
+    if v == INVALID {
+        return;
+    }
     switch params.mode {
         case MODE_PLACE: {
             set_position(v, vec3<f32>(targets[3u * i], targets[3u * i + 1u], targets[3u * i + 2u]));

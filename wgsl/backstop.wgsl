@@ -24,6 +24,7 @@
 // CPU mirror: src/cpu/backstop.rs.
 
 #import shared/grid
+#import shared/mesh
 #import shared/moves
 #import shared/pages
 #paged topology 1
@@ -349,7 +350,8 @@ fn main(
     let e = i / params.cells_per_entry;
     let n = i % params.cells_per_entry;
     let v = moving[e].vertex;
-    if !is_moved(v) {
+    // Vacant entries (shared/moves) moved nothing.
+    if v == INVALID || !is_moved(v) {
         return;
     }
     let x = position(v);

@@ -1,5 +1,6 @@
 // Indirect dispatch sizes from a count the GPU produced (the selection count), so the passes
-// after `select` run over the selection without a read-back. Folds into y exactly as
+// after `select` run over the selection without a read-back; `per_item` invocations per item
+// (a proximity pass runs one per cell of each entry's box). Folds into y exactly as
 // `GpuContext::dispatch_size` does on the host; kernels flatten with `flat_index`.
 // CPU mirror: src/cpu/dispatch_args.rs.
 
@@ -10,7 +11,8 @@ struct DispatchParams {
     max_per_dimension: u32,
     // Clamp on the count (the buffer's capacity: an overflowed count must not over-dispatch).
     capacity: u32,
-    _pad: u32,
+    // Invocations per item (the host checks that capacity · per_item fits a u32).
+    per_item: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: DispatchParams;
@@ -20,7 +22,7 @@ struct DispatchParams {
 
 @compute @workgroup_size(1)
 fn main() {
-    let invocations = min(count, params.capacity);
+    let invocations = min(count, params.capacity) * params.per_item;
     let groups = (invocations + params.workgroup_size - 1u) / params.workgroup_size;
     let max_x = max(params.max_per_dimension, 1u);
     if groups <= max_x {

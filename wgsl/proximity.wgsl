@@ -19,6 +19,7 @@
 
 #import shared/grid
 #import shared/geom
+#import shared/mesh
 #import shared/moves
 #import shared/pages
 #paged topology 1
@@ -176,7 +177,11 @@ fn main(
     let e = i / params.cells_per_entry;
     let n = i % params.cells_per_entry;
     let entry = moving[e];
-    let x = position(entry.vertex);
+    // A vacant entry (shared/moves) stays at its start: it tests nothing.
+    var x = entry.start;
+    if entry.vertex != INVALID {
+        x = position(entry.vertex);
+    }
     var t = 1.0;
     if any(x != entry.start) {
         let low = cell_of(x - vec3<f32>(params.cell_reach), params.inv_cell_size);

@@ -5,6 +5,7 @@ use glam::Vec3;
 
 use super::proximity::PULL_SCALE;
 use crate::gpu::{ApplyMode, ApplyParams, MovingVertex};
+use crate::mesh::INVALID;
 
 /// What the kernel binds besides its parameters.
 pub struct ApplyBuffers<'a> {
@@ -35,6 +36,9 @@ pub fn apply_moves(params: &ApplyParams, buffers: &mut ApplyBuffers<'_>) {
     for i in invocations(params.count) {
         let entry = &buffers.moving[i as usize];
         let v = entry.vertex;
+        if v == INVALID {
+            continue;
+        }
         match params.mode {
             mode if mode == place => {
                 let target = packed_position(buffers.targets, i).to_array();

@@ -10,6 +10,7 @@ use glam::{IVec3, UVec3, Vec3};
 use super::shared::{invocations, packed_position};
 use crate::gpu::{BackstopParams, MovingVertex};
 use crate::grid::{cell_coordinates, hash_cell};
+use crate::mesh::INVALID;
 
 /// Share of a pair's size below which a separation is not trusted (`MARGIN` of the shader).
 pub const BACKSTOP_MARGIN: f32 = 1.0 / 4096.0;
@@ -271,7 +272,7 @@ pub fn backstop(params: &BackstopParams, inputs: &BackstopInputs<'_>) -> Vec<[u3
         let e = i / params.cells_per_entry;
         let n = i % params.cells_per_entry;
         let v = inputs.moving[e as usize].vertex;
-        if !filter.is_moved(v) {
+        if v == INVALID || !filter.is_moved(v) {
             continue;
         }
         let x = filter.position(v);

@@ -10,6 +10,7 @@ use super::shared::{invocations, packed_position};
 use crate::geom::closest_point_on_triangle;
 use crate::gpu::{MovingVertex, ProximityParams};
 use crate::grid::{cell_coordinates, hash_cell};
+use crate::mesh::INVALID;
 use crate::pipeline::step::CLAMP_SLACK;
 
 const CLAMP_ROUNDS: u32 = 16;
@@ -136,7 +137,11 @@ pub fn proximity(params: &ProximityParams, inputs: &ProximityInputs<'_>, pulls: 
         let e = i / params.cells_per_entry;
         let n = i % params.cells_per_entry;
         let entry = &inputs.moving[e as usize];
-        let x = packed_position(inputs.positions, entry.vertex);
+        let x = if entry.vertex == INVALID {
+            Vec3::from_array(entry.start)
+        } else {
+            packed_position(inputs.positions, entry.vertex)
+        };
         let mut t = 1.0f32;
         if x != Vec3::from_array(entry.start) {
             let low = cell_coordinates(x - Vec3::splat(params.cell_reach), params.inv_cell_size);

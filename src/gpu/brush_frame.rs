@@ -76,7 +76,7 @@ pub fn run_brush_frame(
         gpu,
         &mut encoder,
         &count,
-        selection.len(),
+        (selection.len(), 1),
         FRAME_WORKGROUP_SIZE,
         &args,
     )?;

@@ -15,12 +15,13 @@ pub fn indirect_args_buffer(gpu: &GpuContext, label: &str) -> wgpu::Buffer {
 }
 
 /// Records the pass writing into `args` the workgroups a kernel of `workgroup_size` needs
-/// for `min(count, capacity)` invocations, folded as [`GpuContext::dispatch_size`] folds.
+/// for `min(count, capacity) · per_item` invocations, folded as [`GpuContext::dispatch_size`]
+/// folds.
 pub fn record_dispatch_args(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     count: &wgpu::Buffer,
-    capacity: usize,
+    (capacity, per_item): (usize, u32),
     workgroup_size: u32,
     args: &wgpu::Buffer,
 ) -> Result<(), GpuError> {
@@ -28,7 +29,7 @@ pub fn record_dispatch_args(
         workgroup_size,
         max_per_dimension: gpu.limits.max_compute_workgroups_per_dimension,
         capacity: capacity as u32,
-        _pad: 0,
+        per_item,
     };
     let pipeline = gpu.compute_pipeline("dispatch_args")?;
     let uniform = gpu.uniform_buffer("dispatch_args params", &params);
@@ -43,17 +44,25 @@ pub fn record_dispatch_args(
     Ok(())
 }
 
-/// The arguments for `count` invocations, computed on the GPU and read back.
+/// The arguments for `count` items of `per_item` invocations, computed on the GPU and read
+/// back.
 pub fn run_dispatch_args(
     gpu: &GpuContext,
     count: u32,
-    capacity: usize,
+    (capacity, per_item): (usize, u32),
     workgroup_size: u32,
 ) -> Result<[u32; 3], GpuError> {
     let count = gpu.storage_buffer("count", &[count], false);
     let args = indirect_args_buffer(gpu, "dispatch args");
     let mut encoder = gpu.encoder("dispatch_args");
-    record_dispatch_args(gpu, &mut encoder, &count, capacity, workgroup_size, &args)?;
+    record_dispatch_args(
+        gpu,
+        &mut encoder,
+        &count,
+        (capacity, per_item),
+        workgroup_size,
+        &args,
+    )?;
     gpu.queue.submit([encoder.finish()]);
     let values = gpu.read_buffer::<u32>(&args, 3)?;
     Ok([values[0], values[1], values[2]])

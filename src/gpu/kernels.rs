@@ -721,7 +721,7 @@ impl GpuKernels {
                     gpu,
                     &mut encoder,
                     &r.selection.count,
-                    capacity,
+                    (capacity, 1),
                     FRAME_WORKGROUP_SIZE,
                     &step.frame_args,
                 )?;
@@ -942,7 +942,7 @@ impl GpuKernels {
                 gpu,
                 &mut encoder,
                 &step.next_count,
-                invocations,
+                (invocations, 1),
                 PROXIMITY_WORKGROUP_SIZE,
                 &step.pass_args,
             )?;
@@ -950,7 +950,7 @@ impl GpuKernels {
                 gpu,
                 &mut encoder,
                 &step.next_count,
-                count,
+                (count, 1),
                 APPLY_WORKGROUP_SIZE,
                 &step.apply_args,
             )?;

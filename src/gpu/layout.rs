@@ -110,7 +110,7 @@ pub struct DispatchParams {
     pub workgroup_size: u32,
     pub max_per_dimension: u32,
     pub capacity: u32,
-    pub _pad: u32,
+    pub per_item: u32,
 }
 
 /// `ProximityParams` in `wgsl/proximity.wgsl`.
@@ -172,6 +172,20 @@ pub struct BackstopParams {
     pub face_reach: f32,
     pub _pad1: u32,
     pub _pad2: u32,
+}
+
+/// `EntryParams` in `wgsl/moving_entries.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct EntryParams {
+    /// Slots of the selection list covered (past its count they become vacant entries).
+    pub capacity: u32,
+    /// Graph distance of the exclusion ring.
+    pub ring: u32,
+    /// Words per entry in the rings buffer.
+    pub ring_stride: u32,
+    /// Where the vertex→faces rows start in the packed topology.
+    pub vertex_rows_base: u32,
 }
 
 /// `ApplyParams` in `wgsl/apply_moves.wgsl`.

@@ -11,6 +11,7 @@ mod dispatch_args;
 mod hash_table;
 mod kernels;
 mod layout;
+mod moving_entries;
 mod overlay;
 mod pages;
 mod proximity;
@@ -50,8 +51,12 @@ pub use hash_table::{
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, FrameParams, MovingVertex, NormalParams, ProximityParams, PulledVertex,
-    SelectParams, SelectedVertex,
+    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, ProximityParams,
+    PulledVertex, SelectParams, SelectedVertex,
+};
+pub use moving_entries::{
+    BuiltEntries, BuiltEntryBuffers, ENTRIES_WORKGROUP_SIZE, EntryBuffers, RING_STRIDE,
+    entry_params, record_moving_entries, ring_bytes, run_moving_entries,
 };
 pub use overlay::{Filing, OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};

@@ -41,6 +41,10 @@ pub const KERNELS: &[(&str, &str)] = &[
     ),
     ("proximity", include_str!("../../wgsl/proximity.wgsl")),
     ("apply_moves", include_str!("../../wgsl/apply_moves.wgsl")),
+    (
+        "moving_entries",
+        include_str!("../../wgsl/moving_entries.wgsl"),
+    ),
     ("backstop", include_str!("../../wgsl/backstop.wgsl")),
     (
         "vertex_normals",
