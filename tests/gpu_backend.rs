@@ -80,11 +80,14 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     let gpu_collisions = run(&mut gpu_pipeline, &mut on_gpu, &strokes);
     assert_eq!(gpu_pipeline.kernel_failure(), None);
     let deviation = largest_deviation(&on_cpu, &on_gpu);
+    let uploads = gpu_pipeline.uploads().expect("GPU kernels keep a copy");
     eprintln!(
-        "max deviation {deviation:e} ({:.2e} L), collisions cpu {cpu_collisions} gpu {gpu_collisions}",
+        "max deviation {deviation:e} ({:.2e} L), collisions cpu {cpu_collisions} gpu {gpu_collisions}; {uploads:?}",
         deviation / edge
     );
     assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
+    // Most steps ran their proximity passes in the submission that selected and deformed.
+    assert!(uploads.clamped_ahead > uploads.dropped_ahead, "{uploads:?}");
     assert!(cpu_collisions > 0, "the strokes collide");
     let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
     assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");

@@ -507,6 +507,7 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
         ("backstop", 1),
         ("vertex_normals", 1),
         ("deform", 1),
+        ("moving_entries", 1),
     ];
     for (kernel, _) in KERNELS {
         let source = kernel_source(kernel).unwrap();

@@ -20,12 +20,17 @@
 //!   vertex only when the overlay passes its limit;
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
 //!
-//! A step is two submissions, each with one blocking read-back: selection and deformation
-//! (the selection's count, a guessed head of the list and its targets together; at a sample's
-//! start also the brush frame, summed by `brush_frame` and read by `deform` on the GPU), and
-//! the whole Jacobi loop of proximity passes with the backstop's filter (targets placed,
-//! passes sized by the GPU through indirect dispatch, final positions gathered). The
-//! proximity passes run here on hardware adapters; see [`GpuKernels::new`].
+//! A step is one submission with one blocking read-back where it can be: selection and
+//! deformation (the selection's count, a guessed head of the list and its targets together; at
+//! a sample's start also the brush frame, summed by `brush_frame` and read by `deform` on the
+//! GPU), then `moving_entries` (the moving list and exclusion rings from the selection list)
+//! and the whole Jacobi loop of proximity passes with the backstop's filter (targets placed,
+//! passes sized by the GPU through indirect dispatch, final positions gathered), the passes'
+//! reach sized for an assumed longest move ([`AHEAD_MOVE_GROWTH`] times the last). A step
+//! that moves farther, or takes several steps, or outgrows the guessed list or the rings'
+//! room, drops those passes and runs them in a second submission over the host's entries once
+//! its moves are known. The proximity passes run here on hardware adapters; see
+//! [`GpuKernels::new`].
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
 //! adapter's limits, a mesh past our memory budget) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
@@ -36,22 +41,23 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
-    BackstopParams, BrushSphere, DeformBuffers, FACE_WORDS, FRAME_WORKGROUP_SIZE, GpuContext,
-    GpuError, GpuHashTable, GpuSelection, HashedVertices, OverlayBuffers, PAIRS_GUESS,
-    PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
-    SelectedVertex, SelectionBuffers, SlottedRows, SmoothingNeighbours, TableBuffers,
-    TopologyLayout, VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params,
-    frame_params, frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices,
-    overlay_limit, overlay_table, pass_params, record_apply_moves, record_backstop,
-    record_brush_frame, record_deform, record_dispatch_args, record_proximity, record_select,
-    smoothing_neighbours, table_size_for,
+    BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
+    FRAME_WORKGROUP_SIZE, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
+    MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
+    ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
+    SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, Workgroups,
+    backstop_params, check_invocations, deform_params, entry_params, frame_params,
+    frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
+    overlay_table, pass_params, record_apply_moves, record_backstop, record_brush_frame,
+    record_deform, record_dispatch_args, record_moving_entries, record_proximity, record_select,
+    ring_bytes, smoothing_neighbours, table_size_for,
 };
 use crate::brush::Dab;
 use crate::cpu::FRAME_SUM_WORDS;
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{
     Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region, frame_flags,
-    frame_of_sums,
+    frame_of_sums, longest_move,
 };
 use crate::pipeline::{BackstopFilter, CpuKernels, Deformed, FrameSource, StepKernels, Uploads};
 
@@ -395,6 +401,20 @@ impl Resident {
     }
 
     /// The hash table; [`GpuKernels::prepare`] builds it.
+    /// Uploads the packed topology (with room) if it is not resident yet: the proximity
+    /// passes and the filter read it.
+    fn ensure_topology(&mut self, gpu: &GpuContext, mesh: &Mesh) -> Result<(), GpuError> {
+        if self.topology.is_none() {
+            let packed =
+                PackedTopology::with_room(mesh, face_capacity(mesh.face_count()), self.capacity);
+            self.topology = Some(ResidentTopology {
+                buffer: packed.upload(gpu)?,
+                layout: packed.layout,
+            });
+        }
+        Ok(())
+    }
+
     fn hashed(&self) -> &Hashed {
         self.hashed
             .as_ref()
@@ -408,7 +428,12 @@ struct StepBuffers {
     selection_count: wgpu::Buffer,
     targets: ReusableBuffer,
     moving: ReusableBuffer,
+    /// Exclusion rings built by the host, one after another.
     rings: ReusableBuffer,
+    /// Exclusion rings built by `moving_entries`, `RING_STRIDE` words a slot, and how many
+    /// did not fit.
+    ring_slots: ReusableBuffer,
+    ring_overflows: wgpu::Buffer,
     /// Per entry: the last proximity pass's pull-back amount.
     pulls: ReusableBuffer,
     finals: ReusableBuffer,
@@ -433,6 +458,8 @@ impl StepBuffers {
             targets: ReusableBuffer::storage("targets"),
             moving: ReusableBuffer::storage("moving"),
             rings: ReusableBuffer::paged("exclusion rings"),
+            ring_slots: ReusableBuffer::storage("exclusion ring slots"),
+            ring_overflows: gpu.output_buffer::<u32>("ring overflows", 1),
             pulls: ReusableBuffer::storage("pull-back amounts"),
             finals: ReusableBuffer::storage("finals"),
             pairs: ReusableBuffer::storage("undecided pairs"),
@@ -457,6 +484,9 @@ pub struct GpuKernels {
     /// Whether, after GPU proximity passes, the backstop's first round is filtered there too
     /// (else the CPU gathers the step's region and searches it).
     backstop_on_gpu: bool,
+    /// Whether a step's proximity passes may run in the submission that selected and
+    /// deformed (`select_deform_and_clamp`; `SLAYER_GPU_AHEAD=0` turns it off).
+    clamp_ahead: bool,
     resident: Option<Resident>,
     step: StepBuffers,
     /// Set once the GPU failed: why. Everything after runs on the CPU.
@@ -465,6 +495,24 @@ pub struct GpuKernels {
     fail_after: Option<usize>,
     uploads: Uploads,
     filter: BackstopFilter,
+    /// The proximity passes a merged submission ran ahead of the pipeline's `clamp`.
+    ahead: Option<ClampedAhead>,
+    /// The longest move of the last deformation read back (zero before the first).
+    last_move: f32,
+}
+
+/// A merged submission's passes assume moves up to this many times the last step's longest.
+const AHEAD_MOVE_GROWTH: f32 = 2.0;
+
+/// A step's proximity passes and filter run in the submission that selected and deformed
+/// (`GpuKernels::select_deform_and_clamp`), waiting for the pipeline to clamp these moves.
+struct ClampedAhead {
+    /// The selection (ascending) and its targets.
+    vertices: Vec<u32>,
+    targets: Vec<Vec3>,
+    /// One per selected vertex.
+    finals: Vec<Vec3>,
+    backstop: Backstop,
 }
 
 impl GpuKernels {
@@ -479,6 +527,7 @@ impl GpuKernels {
             last_selection: 0,
             proximity_on_gpu: forced || !gpu.adapter.software,
             backstop_on_gpu: std::env::var("SLAYER_GPU_BACKSTOP").map_or(true, |v| v != "0"),
+            clamp_ahead: std::env::var("SLAYER_GPU_AHEAD").map_or(true, |v| v != "0"),
             step: StepBuffers::new(&gpu),
             gpu,
             resident: None,
@@ -486,6 +535,8 @@ impl GpuKernels {
             fail_after: None,
             uploads: Uploads::default(),
             filter: BackstopFilter::default(),
+            ahead: None,
+            last_move: 0.0,
         }
     }
 
@@ -631,6 +682,7 @@ impl GpuKernels {
             return Ok(Vec::new());
         }
         self.check_injected_failure()?;
+        self.drop_ahead(mesh);
         let (gpu, step) = (&self.gpu, &mut self.step);
         let r = GpuKernels::prepare(
             gpu,
@@ -681,28 +733,67 @@ impl GpuKernels {
     /// entries. The count, that head of the list, the sums and the targets come back in one
     /// map (`GpuSelection::submit_and_read`). A selection longer than the guess reads the rest
     /// of the list and deforms it apart.
+    ///
+    /// With `clamp_within` (a step limit), the same submission goes on through the step's
+    /// proximity passes and filter: `moving_entries` builds the moving list and the rings from
+    /// the selection list, and the passes run over the guessed slots, sized as if no vertex
+    /// moved farther than [`AHEAD_MOVE_GROWTH`] times the last step's longest move, within the
+    /// limit. The result is kept for the pipeline's `clamp` ([`ClampedAhead`]) when that held
+    /// (so the step is one step) and the selection and rings fitted their room; otherwise the
+    /// positions the passes wrote are put back.
     fn gpu_select_and_deform(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
         (source, deforms): (FrameSource, bool),
+        clamp_within: Option<f32>,
     ) -> Result<Deformed, GpuError> {
         self.check_injected_failure()?;
+        self.drop_ahead(mesh);
+        let filter = self.backstop_on_gpu;
+        let guess = |capacity: usize| (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        // The passes' reach, and their work with its cube, grows with the move they assume:
+        // twice the last step's longest move (within the limit), which consecutive steps of a
+        // stroke rarely exceed.
+        let clamp_within = clamp_within
+            .filter(|_| deforms && self.proximity_on_gpu && self.clamp_ahead)
+            .map(|limit| match self.last_move {
+                0.0 => limit,
+                last => (AHEAD_MOVE_GROWTH * last).min(limit),
+            });
         let (gpu, step) = (&self.gpu, &mut self.step);
         let r = GpuKernels::prepare(
             gpu,
             (&mut self.resident, &mut self.uploads),
             mesh,
             cell_size(state),
-            TableUse::Select {
-                radius: dab.brush.radius,
+            match clamp_within {
+                Some(_) => TableUse::Proximity,
+                None => TableUse::Select {
+                    radius: dab.brush.radius,
+                },
             },
         )?;
+        let capacity = r.selection.capacity;
+        let guess = guess(capacity);
+        // The rings of the guessed slots must fit one binding (`moving_entries` writes them).
+        let clamp_within = clamp_within
+            .filter(|_| ring_bytes(guess) <= gpu.limits.max_storage_buffer_binding_size);
+        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
+        if deforms {
+            step.targets.reserve(gpu, target_bytes)?;
+        }
+        if clamp_within.is_some() {
+            r.ensure_topology(gpu, mesh)?;
+            step.moving
+                .reserve(gpu, (guess * std::mem::size_of::<MovingVertex>()) as u64)?;
+            step.ring_slots.reserve(gpu, ring_bytes(guess))?;
+            step.reserve_clamp(gpu, guess, filter)?;
+        }
+        let r = &*r;
         let mut encoder = gpu.encoder("select and deform");
         record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
-        let capacity = r.selection.capacity;
-        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
         let inputs = SelectionBuffers {
             positions: &r.vertices.positions,
             normals: &r.normals,
@@ -711,7 +802,6 @@ impl GpuKernels {
         };
         let mut params = deform_params(dab, guess);
         let sum_bytes = (FRAME_SUM_WORDS * 4) as u64;
-        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
         let mut extra = Vec::new();
         let sums_from_selection = match source {
             FrameSource::Selection { normal } => {
@@ -739,7 +829,6 @@ impl GpuKernels {
             FrameSource::Dab => None,
         };
         if deforms {
-            step.targets.reserve(gpu, target_bytes)?;
             record_deform(
                 gpu,
                 &mut encoder,
@@ -754,27 +843,76 @@ impl GpuKernels {
             )?;
             extra.push((step.targets.buffer(), target_bytes));
         }
+        let clamp_read = match clamp_within {
+            Some(limit) => {
+                let Some(topology) = &r.topology else {
+                    unreachable!("made resident above");
+                };
+                encoder.clear_buffer(&step.ring_overflows, 0, None);
+                record_moving_entries(
+                    gpu,
+                    &mut encoder,
+                    &EntryBuffers {
+                        positions: &r.vertices.positions,
+                        layers: &r.vertices.layers,
+                        selected: &r.selection.selected,
+                        selection_count: &r.selection.count,
+                        topology: &topology.buffer,
+                    },
+                    &entry_params(guess, state.ring, topology.layout.vertex_rows_base),
+                    &BuiltEntryBuffers {
+                        moving: step.moving.buffer(),
+                        rings: step.ring_slots.buffer(),
+                        overflows: &step.ring_overflows,
+                    },
+                )?;
+                // No vertex moves farther than the limit, so no edge grows by more than twice
+                // it.
+                let bounds = PassBounds {
+                    count: guess,
+                    step_move: limit,
+                    moved_edge: state.max_edge + 2.0 * limit,
+                    counted_by: Some(&r.selection.count),
+                };
+                let read = record_clamp(gpu, &mut encoder, (r, step), state, &bounds, filter)?;
+                extra.push((&step.ring_overflows, 4));
+                extra.push((step.finals.buffer(), read.finals_bytes));
+                if let Some(pair_bytes) = read.pair_bytes {
+                    extra.push((&step.pair_count, 4));
+                    extra.push((step.pairs.buffer(), pair_bytes));
+                }
+                Some((limit, read))
+            }
+            None => None,
+        };
         let read = r
             .selection
             .submit_and_read(gpu, encoder, &mut step.readback, guess, &extra)?;
         let list = read.list;
         let count = list.len();
-        // The extra parts in the order pushed: the sums (at a sample's start), the targets.
-        let (sum_part, target_part) = read.extra.split_at(if sums_from_selection.is_some() {
-            sum_bytes as usize
-        } else {
-            0
-        });
+        // The extra parts in the order pushed: the sums (at a sample's start), the targets,
+        // then what the passes left.
+        let mut rest = read.extra.as_slice();
+        let mut take = |bytes: u64| {
+            let (part, after) = rest.split_at(bytes as usize);
+            rest = after;
+            part
+        };
         let frame = match sums_from_selection {
-            Some(normal) => frame_of_sums(&bytemuck::pod_read_unaligned(sum_part), dab, normal),
+            Some(normal) => {
+                frame_of_sums(&bytemuck::pod_read_unaligned(take(sum_bytes)), dab, normal)
+            }
             None => dab.frame,
         };
         let whole_list = read.head == count;
+        let target_part = if deforms { take(target_bytes) } else { &[] };
         let head_targets: Vec<Vec3> = if deforms && whole_list {
             bytemuck::pod_collect_to_vec(&target_part[..count * 12])
         } else {
             Vec::new()
         };
+        let ring_overflows = clamp_read.map(|_| u32::from_le_bytes(take(4).try_into().unwrap()));
+        let clamp_data = rest;
         self.last_selection = count;
         // The kernels appended in whatever order their threads ran; the pipeline works in
         // vertex order (its sums and the CPU's agree then), the targets permuted alike.
@@ -784,13 +922,47 @@ impl GpuKernels {
             .iter()
             .map(|&i| (list[i].vertex, list[i].weight))
             .collect();
-        let targets = match (deforms && count > 0, whole_list) {
+        let targets: Option<Vec<Vec3>> = match (deforms && count > 0, whole_list) {
             (false, _) => None,
             (true, true) => Some(order.iter().map(|&i| head_targets[i]).collect()),
-            (true, false) => {
+            (true, false) => None,
+        };
+        let longest = targets
+            .as_ref()
+            .map(|targets| longest_move(mesh, &selection, targets));
+        if let Some(longest) = longest {
+            self.last_move = longest;
+        }
+        if let Some((assumed, clamp_read)) = clamp_read {
+            let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+            // Within the assumed move, which is within the step limit: one step, which moves
+            // the selection to exactly these targets.
+            let kept = targets
+                .as_ref()
+                .filter(|_| ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed));
+            match kept {
+                Some(targets) => {
+                    let (finals, backstop) = step.parse_clamp(clamp_data, guess, clamp_read);
+                    self.ahead = Some(ClampedAhead {
+                        vertices,
+                        targets: targets.clone(),
+                        finals: order.iter().map(|&i| finals[i]).collect(),
+                        backstop,
+                    });
+                }
+                None => {
+                    // The passes moved what they were wrong about: back to the mesh.
+                    self.uploads.dropped_ahead += 1;
+                    upload_rows(gpu, &r.vertices.positions, mesh.positions(), &vertices);
+                }
+            }
+        }
+        let targets = match (deforms && count > 0, targets) {
+            (true, None) => {
                 let dab = Dab { frame, ..*dab };
                 Some(self.gpu_deform(state, mesh, &dab, &selection)?)
             }
+            (_, targets) => targets,
         };
         Ok(Deformed {
             selection,
@@ -800,14 +972,10 @@ impl GpuKernels {
         })
     }
 
-    /// The proximity passes of one step on the GPU, as [`clamp_moves`] runs them: targets
-    /// placed, a first pass against every face, then passes against the faces pulled-back
-    /// vertices moved until one pulls nothing (the GPU sizes each pass from the last), the last
-    /// sending what still collides back to its start; then, unless turned off, the backstop
-    /// filter (`wgsl/backstop.wgsl`) over the faces that moved. Returns the final positions, and
-    /// the filter's undecided pairs (or `Backstop::Gather` when it did not run or they
-    /// overflowed its room).
-    /// One submission, one read-back.
+    /// The proximity passes of one step on the GPU, as [`clamp_moves`] runs them, over entries
+    /// and rings the host builds (`moving_vertices`); see [`record_clamp`]. Returns the final
+    /// positions, and the filter's undecided pairs (or `Backstop::Gather` when it did not run
+    /// or they overflowed its room). One submission, one read-back.
     fn gpu_clamp(
         &mut self,
         state: &StrokeState<'_>,
@@ -820,6 +988,7 @@ impl GpuKernels {
             return Ok((Vec::new(), Backstop::Undecided(Vec::new())));
         }
         self.check_injected_failure()?;
+        let filter = self.backstop_on_gpu;
         let (gpu, step) = (&self.gpu, &mut self.step);
         let r = GpuKernels::prepare(
             gpu,
@@ -828,212 +997,51 @@ impl GpuKernels {
             cell_size(state),
             TableUse::Proximity,
         )?;
-        if r.topology.is_none() {
-            let packed =
-                PackedTopology::with_room(mesh, face_capacity(mesh.face_count()), r.capacity);
-            r.topology = Some(ResidentTopology {
-                buffer: packed.upload(gpu)?,
-                layout: packed.layout,
-            });
-        }
-        let hashed = r.hashed();
-        let Some(ResidentTopology {
-            buffer: topology,
-            layout,
-        }) = &r.topology
-        else {
-            unreachable!("uploaded just above");
-        };
+        r.ensure_topology(gpu, mesh)?;
         let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         let (moving, rings) = moving_vertices(mesh, &vertices, before, state.ring);
         let count = moving.len();
         step.moving.upload(gpu, &moving)?;
         step.rings.upload(gpu, &rings)?;
         step.targets.upload(gpu, targets)?;
-        // No upload: `apply_moves` zeroes each entry's amount when it places the targets.
-        step.pulls
-            .reserve(gpu, (count * std::mem::size_of::<u32>()) as u64)?;
-        let bytes = (count * std::mem::size_of::<Vec3>()) as u64;
-        step.finals.reserve(gpu, bytes)?;
-
-        let step_move = crate::geom::largest_move(before, targets);
-        let first = pass_params(
-            (
-                state.collision_distance,
-                state.max_edge,
-                hashed.drift + step_move,
-            ),
-            hashed.table.inv_cell_size,
-            hashed.table.table_size,
+        let bounds = PassBounds {
             count,
-            layout.vertex_rows_base,
-        );
-        // Vertices moved or changed since the main table was built are filed in the overlay:
-        // each invocation walks its cell there too, and leaves them out of the main table.
-        let overlay = hashed.overlay();
-        let params = |all_faces: bool| ProximityParams {
-            all_faces: all_faces as u32,
-            overlay: overlay.is_some() as u32,
-            overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
-            ..first
+            step_move: crate::geom::largest_move(before, targets),
+            moved_edge: if filter {
+                moved_edge_bound(mesh, &vertices, before, targets)
+            } else {
+                0.0
+            },
+            counted_by: None,
         };
-        check_invocations(&params(true))?;
-        let invocations = count * first.cells_per_entry as usize;
-        // Without an overlay its bindings are never read: the main table's stand in.
-        let proximity = ProximityBuffers {
-            positions: &r.vertices.positions,
-            offsets: &hashed.table.offsets,
-            entries: &hashed.table.entries,
-            topology,
-            moving: step.moving.buffer(),
-            rings: step.rings.buffer(),
-            marks: &r.marks,
-            overlay_marks: &hashed.marks,
-            overlay_offsets: overlay.map_or(&hashed.table.offsets, |o| o.table.offsets),
-            overlay_entries: overlay.map_or(&hashed.table.entries, |o| o.table.entries),
-        };
-        let apply = ApplyMovesBuffers {
-            moving: step.moving.buffer(),
-            targets: step.targets.buffer(),
-            pulls: step.pulls.buffer(),
-            positions: &r.vertices.positions,
-            marks: &r.marks,
-            next_count: &step.next_count,
-            finals: step.finals.buffer(),
-        };
-        let pulls = step.pulls.buffer();
-        let apply_params = |mode| ApplyParams {
-            next_invocations: invocations as u32,
-            ..ApplyParams::new(count, mode)
-        };
+        step.reserve_clamp(gpu, count, filter)?;
         let mut encoder = gpu.encoder("clamp");
-        record_apply_moves(
-            gpu,
-            &mut encoder,
-            &apply,
-            &ApplyParams::new(count, ApplyMode::Place),
-            None,
-        )?;
-        for pass in 0..MAX_PASSES {
-            // The first pass is sized by the host; later ones by the pass before, so that
-            // they shrink to nothing once a pass pulls nothing back.
-            let (sized, apply_sized) = if pass > 0 {
-                (Some(&step.pass_args), Some(&step.apply_args))
-            } else {
-                (None, None)
-            };
-            record_proximity(
-                gpu,
-                &mut encoder,
-                &proximity,
-                &params(pass == 0),
-                pulls,
-                sized,
-            )?;
-            encoder.clear_buffer(&step.next_count, 0, None);
-            let mode = if pass + 1 == MAX_PASSES {
-                ApplyMode::PullLast
-            } else {
-                ApplyMode::Pull
-            };
-            record_apply_moves(gpu, &mut encoder, &apply, &apply_params(mode), apply_sized)?;
-            // Both sizes from the one count: all invocations, or none after a quiet pass.
-            record_dispatch_args(
-                gpu,
-                &mut encoder,
-                &step.next_count,
-                (invocations, 1),
-                PROXIMITY_WORKGROUP_SIZE,
-                &step.pass_args,
-            )?;
-            record_dispatch_args(
-                gpu,
-                &mut encoder,
-                &step.next_count,
-                (count, 1),
-                APPLY_WORKGROUP_SIZE,
-                &step.apply_args,
-            )?;
-        }
-        record_apply_moves(
-            gpu,
-            &mut encoder,
-            &apply,
-            &ApplyParams::new(count, ApplyMode::Gather),
-            None,
-        )?;
-        let mut parts = vec![(step.finals.buffer(), bytes)];
-        let capacity = step.pair_capacity;
-        if self.backstop_on_gpu {
-            let moved_edge = moved_edge_bound(mesh, &vertices, before, targets);
-            let params = BackstopParams {
-                overlay: overlay.is_some() as u32,
-                overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
-                ..backstop_params(
-                    (state.max_edge, moved_edge),
-                    (hashed.drift, step_move),
-                    (hashed.table.inv_cell_size, hashed.table.table_size),
-                    count,
-                    layout.vertex_rows_base,
-                    capacity,
-                )
-            };
-            let pair_bytes = (capacity * std::mem::size_of::<[u32; 2]>()) as u64;
-            step.pairs.reserve(gpu, pair_bytes)?;
-            // The map from vertex to moved entry lives in the marks for the filter's while.
-            record_apply_moves(
-                gpu,
-                &mut encoder,
-                &apply,
-                &ApplyParams::new(count, ApplyMode::MarkMoved),
-                None,
-            )?;
-            encoder.clear_buffer(&step.pair_count, 0, None);
-            record_backstop(
-                gpu,
-                &mut encoder,
-                &BackstopBuffers {
-                    positions: &r.vertices.positions,
-                    offsets: &hashed.table.offsets,
-                    entries: &hashed.table.entries,
-                    topology,
-                    moving: step.moving.buffer(),
-                    moved: &r.marks,
-                    overlay_marks: &hashed.marks,
-                    overlay_offsets: proximity.overlay_offsets,
-                    overlay_entries: proximity.overlay_entries,
-                },
-                &params,
-                (step.pairs.buffer(), &step.pair_count),
-            )?;
-            record_apply_moves(
-                gpu,
-                &mut encoder,
-                &apply,
-                &ApplyParams::new(count, ApplyMode::Clear),
-                None,
-            )?;
+        let read = record_clamp(gpu, &mut encoder, (r, step), state, &bounds, filter)?;
+        let mut parts = vec![(step.finals.buffer(), read.finals_bytes)];
+        if let Some(pair_bytes) = read.pair_bytes {
             parts.push((&step.pair_count, 4));
             parts.push((step.pairs.buffer(), pair_bytes));
         }
         let data = step.readback.read_back_parts(gpu, encoder, &parts)?;
-        let finals = bytemuck::pod_collect_to_vec(&data[..bytes as usize]);
-        if !self.backstop_on_gpu {
-            return Ok((finals, Backstop::Gather));
+        let (finals, backstop) = step.parse_clamp(&data, count, read);
+        tally(&mut self.filter, &backstop, filter);
+        Ok((finals, backstop))
+    }
+
+    /// Drops the passes a merged submission ran ahead when the pipeline did not take them:
+    /// the GPU's positions of those vertices go back to the mesh's.
+    fn drop_ahead(&mut self, mesh: &Mesh) {
+        if let Some(ahead) = self.ahead.take() {
+            self.uploads.dropped_ahead += 1;
+            if let Some(r) = self.resident.as_ref() {
+                upload_rows(
+                    &self.gpu,
+                    &r.vertices.positions,
+                    mesh.positions(),
+                    &ahead.vertices,
+                );
+            }
         }
-        let at = bytes as usize;
-        let found =
-            u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as usize;
-        if found > capacity {
-            // Room for them next time; this step's backstop searches on the CPU.
-            step.pair_capacity = found.next_power_of_two();
-            self.filter.overflowed += 1;
-            return Ok((finals, Backstop::Gather));
-        }
-        self.filter.filtered += 1;
-        self.filter.undecided_pairs += found;
-        let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
-        Ok((finals, Backstop::Undecided(pairs)))
     }
 
     /// Sends the rows the pipeline changed, and notes how far they may have drifted.
@@ -1107,6 +1115,272 @@ pub fn resident_bytes(mesh: &Mesh) -> u64 {
     v * (3 * 12 + 4 + 4 + 4 + 4 + 8 + 4 + 4 + 4 * 4 + 2 * 4 * row_words) + f * 4 * 4
 }
 
+/// How a step's proximity passes are sized: `count` slots of the step's moving list, no move
+/// longer than `step_move`, no edge after the step longer than `moved_edge` (read by the
+/// filter only); when `counted_by` holds the selection count the slots were built from
+/// (`moving_entries`), the first pass is sized from it by the GPU, vacant slots left out.
+struct PassBounds<'a> {
+    count: usize,
+    step_move: f32,
+    moved_edge: f32,
+    counted_by: Option<&'a wgpu::Buffer>,
+}
+
+/// What a recorded clamp leaves to read back after it: the finals, and with the filter its
+/// pair count and pairs.
+#[derive(Debug, Clone, Copy)]
+struct ClampRead {
+    finals_bytes: u64,
+    pair_bytes: Option<u64>,
+}
+
+impl StepBuffers {
+    /// Room for a clamp over `count` slots (`record_clamp`), before its buffers are borrowed.
+    fn reserve_clamp(
+        &mut self,
+        gpu: &GpuContext,
+        count: usize,
+        filter: bool,
+    ) -> Result<(), GpuError> {
+        self.pulls
+            .reserve(gpu, (count * std::mem::size_of::<u32>()) as u64)?;
+        self.finals
+            .reserve(gpu, (count * std::mem::size_of::<Vec3>()) as u64)?;
+        if filter {
+            let pair_bytes = (self.pair_capacity * std::mem::size_of::<[u32; 2]>()) as u64;
+            self.pairs.reserve(gpu, pair_bytes)?;
+        }
+        Ok(())
+    }
+
+    /// The finals of a clamp over `count` slots and what it leaves the backstop, from the
+    /// bytes read back (finals first, then the filter's count and pairs). An overflow of the
+    /// pairs' room grows it for the next step.
+    fn parse_clamp(&mut self, data: &[u8], count: usize, read: ClampRead) -> (Vec<Vec3>, Backstop) {
+        let at = read.finals_bytes as usize;
+        let finals = bytemuck::pod_collect_to_vec(&data[..count * std::mem::size_of::<Vec3>()]);
+        if read.pair_bytes.is_none() {
+            return (finals, Backstop::Gather);
+        }
+        let found =
+            u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as usize;
+        if found > self.pair_capacity {
+            // Room for them next time; this step's backstop searches on the CPU.
+            self.pair_capacity = found.next_power_of_two();
+            return (finals, Backstop::Gather);
+        }
+        let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
+        (finals, Backstop::Undecided(pairs))
+    }
+}
+
+/// Counts what the filter left the CPU (`filter`: it ran).
+fn tally(stats: &mut BackstopFilter, backstop: &Backstop, filter: bool) {
+    match backstop {
+        Backstop::Undecided(pairs) => {
+            stats.filtered += 1;
+            stats.undecided_pairs += pairs.len();
+        }
+        _ if filter => stats.overflowed += 1,
+        _ => {}
+    }
+}
+
+/// Records the proximity passes of one step, as [`clamp_moves`] runs them, over the slots of
+/// `step.moving` (their rings in `step.ring_slots` when the GPU built them, else in
+/// `step.rings`) and targets in `step.targets`: targets placed, a first pass against every
+/// face, then passes against the faces pulled-back vertices moved until one pulls nothing (the
+/// GPU sizes each pass from the last), the last sending what still collides back to its
+/// start; final positions gathered; then, with `filter`, the backstop filter
+/// (`wgsl/backstop.wgsl`) over the faces that moved. Buffers reserved beforehand
+/// (`StepBuffers::reserve_clamp`); the topology resident.
+fn record_clamp(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (r, step): (&Resident, &StepBuffers),
+    state: &StrokeState<'_>,
+    bounds: &PassBounds<'_>,
+    filter: bool,
+) -> Result<ClampRead, GpuError> {
+    let hashed = r.hashed();
+    let Some(ResidentTopology {
+        buffer: topology,
+        layout,
+    }) = &r.topology
+    else {
+        unreachable!("the caller made the topology resident");
+    };
+    let count = bounds.count;
+    let first = pass_params(
+        (
+            state.collision_distance,
+            state.max_edge,
+            hashed.drift + bounds.step_move,
+        ),
+        hashed.table.inv_cell_size,
+        hashed.table.table_size,
+        count,
+        layout.vertex_rows_base,
+    );
+    // Vertices moved or changed since the main table was built are filed in the overlay:
+    // each invocation walks its cell there too, and leaves them out of the main table.
+    let overlay = hashed.overlay();
+    let params = |all_faces: bool| ProximityParams {
+        all_faces: all_faces as u32,
+        overlay: overlay.is_some() as u32,
+        overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
+        ..first
+    };
+    check_invocations(&params(true))?;
+    let invocations = count * first.cells_per_entry as usize;
+    let rings = match bounds.counted_by {
+        Some(_) => step.ring_slots.buffer(),
+        None => step.rings.buffer(),
+    };
+    // Without an overlay its bindings are never read: the main table's stand in.
+    let proximity = ProximityBuffers {
+        positions: &r.vertices.positions,
+        offsets: &hashed.table.offsets,
+        entries: &hashed.table.entries,
+        topology,
+        moving: step.moving.buffer(),
+        rings,
+        marks: &r.marks,
+        overlay_marks: &hashed.marks,
+        overlay_offsets: overlay.map_or(&hashed.table.offsets, |o| o.table.offsets),
+        overlay_entries: overlay.map_or(&hashed.table.entries, |o| o.table.entries),
+    };
+    let apply = ApplyMovesBuffers {
+        moving: step.moving.buffer(),
+        targets: step.targets.buffer(),
+        pulls: step.pulls.buffer(),
+        positions: &r.vertices.positions,
+        marks: &r.marks,
+        next_count: &step.next_count,
+        finals: step.finals.buffer(),
+    };
+    let pulls = step.pulls.buffer();
+    let apply_params = |mode| ApplyParams {
+        next_invocations: invocations as u32,
+        ..ApplyParams::new(count, mode)
+    };
+    record_apply_moves(
+        gpu,
+        encoder,
+        &apply,
+        &ApplyParams::new(count, ApplyMode::Place),
+        None,
+    )?;
+    for pass in 0..MAX_PASSES {
+        // The first pass is sized by the host, or from the selection count; later ones by the
+        // pass before, so that they shrink to nothing once a pass pulls nothing back.
+        let (sized, apply_sized) = match (pass, bounds.counted_by) {
+            (0, None) => (None, None),
+            (0, Some(selection_count)) => {
+                record_dispatch_args(
+                    gpu,
+                    encoder,
+                    selection_count,
+                    (count, first.cells_per_entry),
+                    PROXIMITY_WORKGROUP_SIZE,
+                    &step.pass_args,
+                )?;
+                (Some(&step.pass_args), None)
+            }
+            _ => (Some(&step.pass_args), Some(&step.apply_args)),
+        };
+        record_proximity(gpu, encoder, &proximity, &params(pass == 0), pulls, sized)?;
+        encoder.clear_buffer(&step.next_count, 0, None);
+        let mode = if pass + 1 == MAX_PASSES {
+            ApplyMode::PullLast
+        } else {
+            ApplyMode::Pull
+        };
+        record_apply_moves(gpu, encoder, &apply, &apply_params(mode), apply_sized)?;
+        // Both sizes from the one count: all invocations, or none after a quiet pass.
+        record_dispatch_args(
+            gpu,
+            encoder,
+            &step.next_count,
+            (invocations, 1),
+            PROXIMITY_WORKGROUP_SIZE,
+            &step.pass_args,
+        )?;
+        record_dispatch_args(
+            gpu,
+            encoder,
+            &step.next_count,
+            (count, 1),
+            APPLY_WORKGROUP_SIZE,
+            &step.apply_args,
+        )?;
+    }
+    record_apply_moves(
+        gpu,
+        encoder,
+        &apply,
+        &ApplyParams::new(count, ApplyMode::Gather),
+        None,
+    )?;
+    let finals_bytes = (count * std::mem::size_of::<Vec3>()) as u64;
+    if !filter {
+        return Ok(ClampRead {
+            finals_bytes,
+            pair_bytes: None,
+        });
+    }
+    let capacity = step.pair_capacity;
+    let params = BackstopParams {
+        overlay: overlay.is_some() as u32,
+        overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
+        ..backstop_params(
+            (state.max_edge, bounds.moved_edge),
+            (hashed.drift, bounds.step_move),
+            (hashed.table.inv_cell_size, hashed.table.table_size),
+            count,
+            layout.vertex_rows_base,
+            capacity,
+        )
+    };
+    // The map from vertex to moved entry lives in the marks for the filter's while.
+    record_apply_moves(
+        gpu,
+        encoder,
+        &apply,
+        &ApplyParams::new(count, ApplyMode::MarkMoved),
+        None,
+    )?;
+    encoder.clear_buffer(&step.pair_count, 0, None);
+    record_backstop(
+        gpu,
+        encoder,
+        &BackstopBuffers {
+            positions: &r.vertices.positions,
+            offsets: &hashed.table.offsets,
+            entries: &hashed.table.entries,
+            topology,
+            moving: step.moving.buffer(),
+            moved: &r.marks,
+            overlay_marks: &hashed.marks,
+            overlay_offsets: proximity.overlay_offsets,
+            overlay_entries: proximity.overlay_entries,
+        },
+        &params,
+        (step.pairs.buffer(), &step.pair_count),
+    )?;
+    record_apply_moves(
+        gpu,
+        encoder,
+        &apply,
+        &ApplyParams::new(count, ApplyMode::Clear),
+        None,
+    )?;
+    Ok(ClampRead {
+        finals_bytes,
+        pair_bytes: Some((capacity * std::mem::size_of::<[u32; 2]>()) as u64),
+    })
+}
+
 /// Records a selection under `dab` into the resident selection buffers.
 fn record_brush_selection(
     gpu: &GpuContext,
@@ -1176,7 +1450,7 @@ impl StepKernels for GpuKernels {
     fn select(&mut self, state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
         // The selection alone: the same submission as with a deformation, less its passes.
         let alone = (FrameSource::Dab, false);
-        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, alone))
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, alone, None))
             .map(|selected| selected.selection)
             .unwrap_or_else(|| CpuKernels.select(state, mesh, dab))
     }
@@ -1188,7 +1462,20 @@ impl StepKernels for GpuKernels {
         dab: &Dab,
         how: (FrameSource, bool),
     ) -> Deformed {
-        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how))
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, None))
+            .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
+    }
+
+    fn select_deform_and_clamp(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        source: FrameSource,
+        step_limit: f32,
+    ) -> Deformed {
+        let how = (source, true);
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(step_limit)))
             .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
     }
 
@@ -1212,6 +1499,24 @@ impl StepKernels for GpuKernels {
         before: &[Vec3],
     ) -> Backstop {
         let (selection, targets, _) = moves;
+        if let Some(ahead) = self.ahead.take() {
+            let same = ahead.targets.as_slice() == targets
+                && selection
+                    .iter()
+                    .map(|&(v, _)| v)
+                    .eq(ahead.vertices.iter().copied());
+            if same {
+                self.uploads.clamped_ahead += 1;
+                tally(&mut self.filter, &ahead.backstop, self.backstop_on_gpu);
+                let positions = mesh.positions_mut();
+                for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
+                    positions[v as usize] = p;
+                }
+                return ahead.backstop;
+            }
+            self.ahead = Some(ahead);
+            self.drop_ahead(mesh);
+        }
         if self.proximity_on_gpu
             && let Some((finals, backstop)) =
                 self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
@@ -1226,6 +1531,7 @@ impl StepKernels for GpuKernels {
     }
 
     fn moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {
+        self.drop_ahead(mesh);
         if self.failed.is_none() {
             self.gpu_moved(mesh, vertices, max_move);
         }
@@ -1238,6 +1544,7 @@ impl StepKernels for GpuKernels {
     }
 
     fn remeshed(&mut self, mesh: &Mesh, since: MeshVersion, changed: &[u32]) {
+        self.drop_ahead(mesh);
         if self.failed.is_none() {
             self.gpu_remeshed(mesh, since, changed);
         }

@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::kernels::{CpuKernels, Deformed, FrameSource, StepKernels};
-use super::step::{Region, StrokeState, brush_frame, collide_with, paint};
+use super::step::{Region, StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
 use super::{
     BackstopFilter, PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline,
     StrokeHook, StrokeReport, Uploads,
@@ -27,9 +27,6 @@ pub enum Search {
     /// By scanning every vertex and face: slow, obviously right, the reference.
     Scan,
 }
-
-/// Steps per sample are capped; a sample asking for more is a runaway brush.
-const MAX_STEPS_PER_SAMPLE: usize = 256;
 
 pub struct CpuPipeline {
     settings: PipelineSettings,
@@ -357,17 +354,18 @@ impl SculptPipeline for CpuPipeline {
                         deform_millis: 0.0,
                     }
                 }
-                _ => self.kernels.select_and_deform(
-                    &state,
-                    mesh,
-                    &probe,
-                    (
-                        FrameSource::Selection {
-                            normal: sample.normal,
-                        },
-                        deforms,
-                    ),
-                ),
+                _ => {
+                    let source = FrameSource::Selection {
+                        normal: sample.normal,
+                    };
+                    if deforms {
+                        self.kernels
+                            .select_deform_and_clamp(&state, mesh, &probe, source, step_limit)
+                    } else {
+                        self.kernels
+                            .select_and_deform(&state, mesh, &probe, (source, false))
+                    }
+                }
             };
             let Deformed {
                 selection: first_selection,
@@ -407,13 +405,7 @@ impl SculptPipeline for CpuPipeline {
                 Some(targets) => targets,
                 None => self.kernels.deform(&state, mesh, &whole, &first_selection),
             };
-            let longest_move = first_selection
-                .iter()
-                .zip(&full)
-                .map(|(&(v, _), q)| mesh.positions()[v as usize].distance(*q))
-                .fold(0.0f32, f32::max);
-            let steps =
-                ((longest_move / step_limit).ceil() as usize).clamp(1, MAX_STEPS_PER_SAMPLE);
+            let steps = steps_for(longest_move(mesh, &first_selection, &full), step_limit);
             times.deformation += millis(started);
             moved_in_sample.clear();
 
@@ -441,11 +433,12 @@ impl SculptPipeline for CpuPipeline {
                     times.deformation += millis(started);
                     (first_selection.clone(), targets)
                 } else {
-                    let step_pass = self.kernels.select_and_deform(
+                    let step_pass = self.kernels.select_deform_and_clamp(
                         &state,
                         mesh,
                         &dab,
-                        (FrameSource::Dab, true),
+                        FrameSource::Dab,
+                        step_limit,
                     );
                     times.selection += millis(started) - step_pass.deform_millis;
                     times.deformation += step_pass.deform_millis;

@@ -61,6 +61,22 @@ pub trait StepKernels: Send {
             deform_millis: started.elapsed().as_secs_f64() * 1e3,
         }
     }
+    /// [`StepKernels::select_and_deform`] for a deforming brush, and, from kernels that run
+    /// the proximity passes ([`StepKernels::collides_on_gpu`]), the step's passes and backstop
+    /// filter in the same submission, on the assumption that the moves make one step of at most
+    /// `step_limit` ([`steps_for`](super::step::steps_for) gives 1): the pipeline's [`StepKernels::clamp`] of exactly
+    /// these moves then takes that result instead of running the passes. Where the assumption
+    /// fails the kernels drop the result, and clamp whatever moves the pipeline settles on.
+    fn select_deform_and_clamp(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        source: FrameSource,
+        _step_limit: f32,
+    ) -> Deformed {
+        self.select_and_deform(state, mesh, dab, (source, true))
+    }
     /// Where the brush moves each selected vertex.
     fn deform(
         &mut self,
@@ -145,6 +161,12 @@ pub struct Uploads {
     /// Blocking read-backs: submissions whose results the CPU waited for (per sample, the
     /// round trips a hardware GPU pays beside its kernels).
     pub read_backs: usize,
+    /// Steps whose proximity passes ran in the submission that selected and deformed
+    /// ([`StepKernels::select_deform_and_clamp`]), and those whose passes so run were dropped
+    /// (the step was longer than assumed, the selection outgrew its guessed length, or a ring
+    /// its room).
+    pub clamped_ahead: usize,
+    pub dropped_ahead: usize,
 }
 
 /// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.

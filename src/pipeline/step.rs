@@ -76,6 +76,25 @@ pub fn frame_of_sums(sums: &cpu::FrameSums, probe: &Dab, normal: Option<Vec3>) -
     }
 }
 
+/// Steps per sample are capped: a sample asking for more is a runaway brush, and moves farther
+/// than this many steps of `max_step` in this many.
+pub const MAX_STEPS_PER_SAMPLE: usize = 256;
+
+/// The steps a sample whose longest move is `longest_move` takes, each of at most
+/// `step_limit` (Algorithm 2 splits a motion so that no step crosses a layer).
+pub fn steps_for(longest_move: f32, step_limit: f32) -> usize {
+    ((longest_move / step_limit).ceil() as usize).clamp(1, MAX_STEPS_PER_SAMPLE)
+}
+
+/// The longest move from each selected vertex's position in `mesh` to its target.
+pub fn longest_move(mesh: &Mesh, selection: &[(u32, f32)], targets: &[Vec3]) -> f32 {
+    selection
+        .iter()
+        .zip(targets)
+        .map(|(&(v, _), q)| mesh.positions()[v as usize].distance(*q))
+        .fold(0.0f32, f32::max)
+}
+
 /// A vertex already within the collision distance of a face is pulled back when its move
 /// takes it closer by more than this share of the distance. A move along the face (a grab
 /// carrying a patch over another layer) keeps the distance in exact arithmetic, and in floats
