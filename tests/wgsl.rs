@@ -402,34 +402,26 @@ fn proximity_and_normal_structs_match_naga_layout() {
             _pad1
         }
     );
-    assert_layout!(
-        "proximity",
-        MovingVertex {
-            start,
-            vertex,
-            layer,
-            ring_start,
-            ring_end,
-            _pad
-        }
-    );
+    // Every kernel that reads the moving list declares it alike.
+    for kernel in ["proximity", "apply_moves", "moving_entries", "backstop"] {
+        assert_layout!(
+            kernel,
+            MovingVertex {
+                start,
+                vertex,
+                layer,
+                ring_start,
+                ring_end,
+                _pad
+            }
+        );
+    }
     assert_layout!(
         "apply_moves",
         ApplyParams {
             count,
             mode,
             next_invocations,
-            _pad
-        }
-    );
-    assert_layout!(
-        "apply_moves",
-        MovingVertex {
-            start,
-            vertex,
-            layer,
-            ring_start,
-            ring_end,
             _pad
         }
     );
@@ -441,17 +433,6 @@ fn proximity_and_normal_structs_match_naga_layout() {
             ring,
             ring_stride,
             vertex_rows_base
-        }
-    );
-    assert_layout!(
-        "moving_entries",
-        MovingVertex {
-            start,
-            vertex,
-            layer,
-            ring_start,
-            ring_end,
-            _pad
         }
     );
     assert_layout!("moving_entries", SelectedVertex { vertex, weight });
@@ -473,17 +454,6 @@ fn proximity_and_normal_structs_match_naga_layout() {
             face_reach,
             _pad1,
             _pad2
-        }
-    );
-    assert_layout!(
-        "backstop",
-        MovingVertex {
-            start,
-            vertex,
-            layer,
-            ring_start,
-            ring_end,
-            _pad
         }
     );
     assert_layout!(
