@@ -950,6 +950,8 @@ impl GpuKernels {
                         backstop,
                     });
                 }
+                // Nothing selected: nothing moved, nothing to drop.
+                None if vertices.is_empty() => {}
                 None => {
                     // The passes moved what they were wrong about: back to the mesh.
                     self.uploads.dropped_ahead += 1;
