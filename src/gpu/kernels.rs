@@ -752,11 +752,10 @@ impl GpuKernels {
         self.check_injected_failure()?;
         self.drop_ahead(mesh);
         let filter = self.backstop_on_gpu;
-        let guess = |capacity: usize| (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
         // The passes' reach, and their work with its cube, grows with the move they assume:
         // twice the last step's longest move (within the limit), which consecutive steps of a
         // stroke rarely exceed.
-        let clamp_within = clamp_within
+        let assumed_move = clamp_within
             .filter(|_| deforms && self.proximity_on_gpu && self.clamp_ahead)
             .map(|limit| match self.last_move {
                 0.0 => limit,
@@ -768,7 +767,7 @@ impl GpuKernels {
             (&mut self.resident, &mut self.uploads),
             mesh,
             cell_size(state),
-            match clamp_within {
+            match assumed_move {
                 Some(_) => TableUse::Proximity,
                 None => TableUse::Select {
                     radius: dab.brush.radius,
@@ -776,15 +775,15 @@ impl GpuKernels {
             },
         )?;
         let capacity = r.selection.capacity;
-        let guess = guess(capacity);
+        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
         // The rings of the guessed slots must fit one binding (`moving_entries` writes them).
-        let clamp_within = clamp_within
+        let assumed_move = assumed_move
             .filter(|_| ring_bytes(guess) <= gpu.limits.max_storage_buffer_binding_size);
         let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
         if deforms {
             step.targets.reserve(gpu, target_bytes)?;
         }
-        if clamp_within.is_some() {
+        if assumed_move.is_some() {
             r.ensure_topology(gpu, mesh)?;
             step.moving
                 .reserve(gpu, (guess * std::mem::size_of::<MovingVertex>()) as u64)?;
@@ -843,7 +842,7 @@ impl GpuKernels {
             )?;
             extra.push((step.targets.buffer(), target_bytes));
         }
-        let clamp_read = match clamp_within {
+        let clamp_read = match assumed_move {
             Some(limit) => {
                 let Some(topology) = &r.topology else {
                     unreachable!("made resident above");
@@ -952,11 +951,8 @@ impl GpuKernels {
                 }
                 // Nothing selected: nothing moved, nothing to drop.
                 None if vertices.is_empty() => {}
-                None => {
-                    // The passes moved what they were wrong about: back to the mesh.
-                    self.uploads.dropped_ahead += 1;
-                    upload_rows(gpu, &r.vertices.positions, mesh.positions(), &vertices);
-                }
+                // The passes moved what they were wrong about.
+                None => put_back(gpu, Some(r), &mut self.uploads, mesh, &vertices),
             }
         }
         let targets = match (deforms && count > 0, targets) {
@@ -1034,15 +1030,14 @@ impl GpuKernels {
     /// the GPU's positions of those vertices go back to the mesh's.
     fn drop_ahead(&mut self, mesh: &Mesh) {
         if let Some(ahead) = self.ahead.take() {
-            self.uploads.dropped_ahead += 1;
-            if let Some(r) = self.resident.as_ref() {
-                upload_rows(
-                    &self.gpu,
-                    &r.vertices.positions,
-                    mesh.positions(),
-                    &ahead.vertices,
-                );
-            }
+            let resident = self.resident.as_ref();
+            put_back(
+                &self.gpu,
+                resident,
+                &mut self.uploads,
+                mesh,
+                &ahead.vertices,
+            );
         }
     }
 
@@ -1173,6 +1168,21 @@ impl StepBuffers {
         }
         let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
         (finals, Backstop::Undecided(pairs))
+    }
+}
+
+/// Puts the GPU's positions of `vertices` back to the mesh's where passes run ahead wrote them
+/// and the pipeline did not take them (counted as dropped).
+fn put_back(
+    gpu: &GpuContext,
+    resident: Option<&Resident>,
+    uploads: &mut Uploads,
+    mesh: &Mesh,
+    vertices: &[u32],
+) {
+    uploads.dropped_ahead += 1;
+    if let Some(r) = resident {
+        upload_rows(gpu, &r.vertices.positions, mesh.positions(), vertices);
     }
 }
 
@@ -1516,8 +1526,14 @@ impl StepKernels for GpuKernels {
                 }
                 return ahead.backstop;
             }
-            self.ahead = Some(ahead);
-            self.drop_ahead(mesh);
+            let resident = self.resident.as_ref();
+            put_back(
+                &self.gpu,
+                resident,
+                &mut self.uploads,
+                mesh,
+                &ahead.vertices,
+            );
         }
         if self.proximity_on_gpu
             && let Some((finals, backstop)) =
