@@ -1590,6 +1590,95 @@ fn check_vertex_normals(binding: Binding) {
     eprintln!("vertex_normals: largest deviation GPU vs mirror {worst:e}");
 }
 
+#[test]
+fn moved_normals_match_cpu_mirror_and_the_mesh() {
+    check_moved_normals(Binding::Whole);
+}
+
+#[test]
+fn moved_normals_read_a_topology_split_over_several_bindings() {
+    check_moved_normals(Binding::Paged);
+}
+
+fn check_moved_normals(binding: Binding) {
+    // Moving lists over a seeded shuffle of the bumpy sheets' vertices at awkward sizes (the
+    // largest folded into two dimensions): about half the entries moved off their start, one
+    // slot in seven vacant. The mirror against `Mesh::recompute_normals_at` of every corner of
+    // the faces around the moved vertices; the GPU against the mirror; every other normal must
+    // stay as it was (stale, here).
+    let start = bumpy_sheets();
+    let mut gpu = match binding {
+        Binding::Whole => gpu(),
+        Binding::Paged => {
+            let unpaged = 12 * start.vertex_count() as u64;
+            let topology = slayer::gpu::PackedTopology::of(&start).words.len() as u64 * 4;
+            gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
+        }
+    };
+    let order = shuffled((0..start.vertex_count() as u32).collect(), 602);
+    let topology = slayer::gpu::PackedTopology::of(&start);
+    let mut rng = ChaCha8Rng::seed_from_u64(603);
+    let mut worst = 0.0f32;
+    let mut refreshed_any = false;
+    for (k, &size) in SIZES.iter().enumerate() {
+        if k + 1 == SIZES.len() {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        let mut mesh = start.clone();
+        let mut moving = Vec::with_capacity(size);
+        let mut moved = Vec::new();
+        for (slot, &v) in order[..size].iter().enumerate() {
+            let vertex = if slot % 7 == 6 { INVALID } else { v };
+            moving.push(slayer::gpu::MovingVertex {
+                start: start.positions()[v as usize].to_array(),
+                vertex,
+                ..Default::default()
+            });
+            // Vacant slots move too: their vertex's normals must stay all the same.
+            if rng.random_bool(0.5) {
+                mesh.positions_mut()[v as usize].z += rng.random_range(-0.01..0.01);
+                if vertex != INVALID {
+                    moved.push(v);
+                }
+            }
+        }
+        let mut corners: Vec<u32> = moved
+            .iter()
+            .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
+            .collect();
+        corners.sort_unstable();
+        corners.dedup();
+        refreshed_any |= !corners.is_empty();
+        let mut reference = mesh.clone();
+        reference.recompute_normals_at(&corners);
+        let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+        let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
+        let params = slayer::gpu::NormalParams {
+            count: size as u32,
+            vertex_rows_base: topology.layout.vertex_rows_base,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        slayer::cpu::moved_normals(&params, &flat, &topology.words, &moving, &mut mirror);
+        let mirror: Vec<Vec3> = mirror.chunks(3).map(Vec3::from_slice).collect();
+        assert_eq!(mirror, reference.normals(), "mirror at size {size}");
+        let actual = slayer::gpu::run_moved_normals(&gpu, &mesh, &moving).expect("GPU run");
+        let off = worst_relative(&actual, &mirror, 1.0);
+        assert!(
+            off <= NORMAL_TOLERANCE,
+            "GPU off the mirror by {off:e} at size {size}"
+        );
+        for (v, (a, m)) in actual.iter().zip(&mirror).enumerate() {
+            if corners.binary_search(&(v as u32)).is_err() {
+                assert_eq!(a, m, "normal of vertex {v} changed at size {size}");
+            }
+        }
+        worst = worst.max(off);
+    }
+    assert!(refreshed_any);
+    eprintln!("moved_normals: largest deviation GPU vs mirror {worst:e}");
+}
+
 /// Random moving entries over distinct vertices of `vertex_count`, with targets, verdicts (about
 /// half pulled) and marks, for `apply_moves`.
 #[allow(clippy::type_complexity)]

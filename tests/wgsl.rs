@@ -403,7 +403,13 @@ fn proximity_and_normal_structs_match_naga_layout() {
         }
     );
     // Every kernel that reads the moving list declares it alike.
-    for kernel in ["proximity", "apply_moves", "moving_entries", "backstop"] {
+    for kernel in [
+        "proximity",
+        "apply_moves",
+        "moving_entries",
+        "backstop",
+        "moved_normals",
+    ] {
         assert_layout!(
             kernel,
             MovingVertex {
@@ -456,15 +462,17 @@ fn proximity_and_normal_structs_match_naga_layout() {
             _pad2
         }
     );
-    assert_layout!(
-        "vertex_normals",
-        NormalParams {
-            count,
-            vertex_rows_base,
-            _pad0,
-            _pad1
-        }
-    );
+    for kernel in ["vertex_normals", "moved_normals"] {
+        assert_layout!(
+            kernel,
+            NormalParams {
+                count,
+                vertex_rows_base,
+                _pad0,
+                _pad1
+            }
+        );
+    }
 }
 
 #[test]
@@ -476,6 +484,7 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
         ("proximity", 2),
         ("backstop", 1),
         ("vertex_normals", 1),
+        ("moved_normals", 1),
         ("deform", 1),
         ("moving_entries", 1),
     ];

@@ -1,12 +1,11 @@
-// Vertex normals of the region a step touched, as `Mesh::recompute_normals_at` computes them:
-// the sum of the incident faces' cross products (area-weighted), in fan order, normalized; +Z
-// where the sum vanishes or is not finite. One invocation per listed vertex, each writing only
-// its own normal, so a vertex listed twice writes the same value twice. Face normals are not
-// stored anywhere (the CPU recomputes them inline too), so no separate face pass is needed.
+// Vertex normals of listed vertices (shared/normals: as `Mesh::recompute_normals_at` computes
+// them). One invocation per listed vertex, each writing only its own normal, so a vertex listed
+// twice writes the same value twice.
 // CPU mirror: src/cpu/vertex_normals.rs.
 
 #import shared/grid
 #import shared/pages
+#import shared/normals
 #paged topology 1
 
 struct NormalParams {
@@ -20,8 +19,6 @@ struct NormalParams {
 }
 
 const WORKGROUP_SIZE: u32 = 64u;
-// Largest finite f32: WGSL has no isfinite.
-const MAX_F32: f32 = 3.40282347e38;
 
 @group(0) @binding(0) var<uniform> params: NormalParams;
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
@@ -45,23 +42,7 @@ fn main(
         return;
     }
     let v = vertices[i];
-    let row = params.vertex_rows_base + 2u * v;
-    let first = topology(row);
-    let last = first + topology(row + 1u);
-    var sum = vec3<f32>(0.0);
-    for (var k = first; k < last; k++) {
-        let f = topology(k);
-        let a = position(topology(4u * f));
-        let b = position(topology(4u * f + 1u));
-        let c = position(topology(4u * f + 2u));
-        sum += cross(b - a, c - a);
-    }
-    // glam's try_normalize: the reciprocal of sqrt(dot) must be finite and positive.
-    let rcp = 1.0 / sqrt(dot(sum, sum));
-    var n = vec3<f32>(0.0, 0.0, 1.0);
-    if rcp <= MAX_F32 && rcp > 0.0 {
-        n = sum * rcp;
-    }
+    let n = vertex_normal(v, params.vertex_rows_base);
     normals[3u * v] = n.x;
     normals[3u * v + 1u] = n.y;
     normals[3u * v + 2u] = n.z;

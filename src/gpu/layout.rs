@@ -255,11 +255,11 @@ pub struct PulledVertex {
     pub pulled: u32,
 }
 
-/// `NormalParams` in `wgsl/vertex_normals.wgsl`.
+/// `NormalParams` in `wgsl/vertex_normals.wgsl` and `wgsl/moved_normals.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct NormalParams {
-    /// Vertices listed.
+    /// Vertices listed (`vertex_normals`), or slots of the moving list (`moved_normals`).
     pub count: u32,
     /// Where the per-vertex (start, length) entries of the vertex→faces rows begin in the
     /// packed topology.

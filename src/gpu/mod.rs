@@ -72,5 +72,7 @@ pub use select::{
     falloff_code, record_select, run_select, run_select_with_overlay, select_params,
 };
 pub use topology::{FACE_WORDS, PackedTopology, TopologyLayout};
-pub use vertex_normals::{record_vertex_normals, run_vertex_normals};
+pub use vertex_normals::{
+    record_moved_normals, record_vertex_normals, run_moved_normals, run_vertex_normals,
+};
 pub use vertices::VertexBuffers;

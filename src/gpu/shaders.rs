@@ -17,6 +17,10 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/pages", include_str!("../../wgsl/shared/pages.wgsl")),
     ("shared/fixed", include_str!("../../wgsl/shared/fixed.wgsl")),
     (
+        "shared/normals",
+        include_str!("../../wgsl/shared/normals.wgsl"),
+    ),
+    (
         PAGED_ARRAY,
         include_str!("../../wgsl/shared/paged_array.wgsl"),
     ),
@@ -49,6 +53,10 @@ pub const KERNELS: &[(&str, &str)] = &[
     (
         "vertex_normals",
         include_str!("../../wgsl/vertex_normals.wgsl"),
+    ),
+    (
+        "moved_normals",
+        include_str!("../../wgsl/moved_normals.wgsl"),
     ),
 ];
 

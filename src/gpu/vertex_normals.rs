@@ -1,10 +1,11 @@
-//! Host side of `wgsl/vertex_normals.wgsl`: normals of the vertices a step moved (and their
-//! neighbours, whose faces moved too), recomputed on the GPU so the per-sample loop never waits
-//! for the CPU.
+//! Host side of `wgsl/vertex_normals.wgsl` (the normals of listed vertices) and of
+//! `wgsl/moved_normals.wgsl` (those a step's moves changed, found from its moving list):
+//! normals recomputed on the GPU so that a stroke's next sample, recorded in the same
+//! submission, needs nothing from the CPU.
 
 use glam::Vec3;
 
-use super::{GpuContext, GpuError, NormalParams, PackedTopology, Workgroups};
+use super::{GpuContext, GpuError, MovingVertex, NormalParams, PackedTopology, Workgroups};
 use crate::mesh::Mesh;
 
 const WORKGROUP_SIZE: u32 = 64;
@@ -65,6 +66,64 @@ pub fn run_vertex_normals(
         topology.layout.vertex_rows_base,
         &listed,
         vertices.len(),
+        &normals,
+    )?;
+    gpu.queue.submit([encoder.finish()]);
+    gpu.read_buffer(&normals, mesh.vertex_count())
+}
+
+/// Records the pass rewriting the normals around the entries of the first `slots` slots of
+/// `moving` that are away from their start in `positions`.
+pub fn record_moved_normals(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (positions, topology): (&wgpu::Buffer, &wgpu::Buffer),
+    vertex_rows_base: u32,
+    (moving, slots): (&wgpu::Buffer, usize),
+    normals: &wgpu::Buffer,
+) -> Result<(), GpuError> {
+    let params = NormalParams {
+        count: slots as u32,
+        vertex_rows_base,
+        _pad0: 0,
+        _pad1: 0,
+    };
+    let pipeline = gpu.compute_pipeline("moved_normals")?;
+    let uniform = gpu.uniform_buffer("moved_normals params", &params);
+    gpu.record_paged_dispatch(
+        encoder,
+        &pipeline,
+        "moved_normals",
+        &[&uniform, positions, moving, normals],
+        &[topology],
+        Workgroups::Cover {
+            invocations: slots,
+            workgroup_size: WORKGROUP_SIZE,
+        },
+    );
+    Ok(())
+}
+
+/// `mesh`'s normals with those around the moved entries of `moving` recomputed on the GPU
+/// (an entry moved when `mesh` has its vertex away from the entry's start).
+pub fn run_moved_normals(
+    gpu: &GpuContext,
+    mesh: &Mesh,
+    moving: &[MovingVertex],
+) -> Result<Vec<Vec3>, GpuError> {
+    gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
+    let topology = PackedTopology::of(mesh);
+    let positions = gpu.storage_buffer("positions", mesh.positions(), false);
+    let topology_buffer = topology.upload(gpu)?;
+    let moving_buffer = gpu.storage_buffer("moving list", moving, false);
+    let normals = gpu.storage_buffer("normals", mesh.normals(), true);
+    let mut encoder = gpu.encoder("moved_normals");
+    record_moved_normals(
+        gpu,
+        &mut encoder,
+        (&positions, &topology_buffer),
+        topology.layout.vertex_rows_base,
+        (&moving_buffer, moving.len()),
         &normals,
     )?;
     gpu.queue.submit([encoder.finish()]);
