@@ -97,6 +97,57 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     }
 }
 
+/// A stroke's samples run ahead several to a submission (selection, frame, deformation, moving
+/// entries, proximity passes, filter and the normals each sample turned, each sample reading
+/// what the one before left on the GPU): the pipeline takes them as it would have asked for
+/// them, with the CPU pipeline's result, fewer read-backs than samples, and the GPU's copy the
+/// mesh row for row after the stroke.
+#[test]
+fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
+    let (start, strokes) = plaster_and_strokes(1);
+    let edge = start.mean_edge_length();
+    let settings = PipelineSettings {
+        remeshing: Remeshing::Off,
+        ..PipelineSettings::default()
+    };
+    let (mut on_cpu, mut on_gpu) = (start.clone(), start.clone());
+    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let mut kernels = all_on_gpu();
+    kernels.set_run_ahead(true);
+    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut gpu_collisions = 0;
+    let mut samples = 0;
+    for stroke in &strokes {
+        let report = pipeline.apply_stroke(&mut on_gpu, stroke).unwrap();
+        gpu_collisions += report.clamped;
+        samples += report.samples;
+    }
+    assert_eq!(pipeline.kernel_failure(), None);
+    // Before the check, which reads the whole copy back.
+    let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
+    pipeline.check_kernel_copy(&on_gpu).unwrap();
+    let deviation = largest_deviation(&on_cpu, &on_gpu);
+    eprintln!(
+        "{samples} samples: max deviation {deviation:e} ({:.2e} L), collisions cpu \
+         {cpu_collisions} gpu {gpu_collisions}; {uploads:?}",
+        deviation / edge
+    );
+    assert!(
+        uploads.batches > 0 && uploads.samples_ahead > uploads.batches,
+        "{uploads:?}"
+    );
+    assert!(
+        uploads.read_backs < samples,
+        "{uploads:?}, {samples} samples"
+    );
+    assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
+    assert!(cpu_collisions > 0, "the stroke collides");
+    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
+    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
+    on_gpu.validate().unwrap();
+    assert_eq!(find_intersections(&on_gpu).total(), 0);
+}
+
 /// With remeshing after every stroke the GPU's copy is patched where remeshing changed the mesh
 /// (rows of changed vertices, their neighbours and faces), never sent whole again, and after
 /// every stroke it is the mesh row for row; the vertices remeshing changed are filed in the

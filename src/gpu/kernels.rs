@@ -30,7 +30,8 @@
 //! that moves farther, or takes several steps, or outgrows the guessed list or the rings'
 //! room, drops those passes and runs them in a second submission over the host's entries once
 //! its moves are known. The proximity passes run here on hardware adapters; see
-//! [`GpuKernels::new`].
+//! [`GpuKernels::new`]. There, several samples of a stroke run ahead in one submission
+//! (`run_ahead`), while the pipeline takes them as predicted.
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
 //! adapter's limits, a mesh past our memory budget) is not fatal: the kernels keep why and finish on the CPU, and the mesh —
@@ -52,14 +53,18 @@ use super::{
     record_deform, record_dispatch_args, record_moving_entries, record_proximity, record_select,
     ring_bytes, smoothing_neighbours, table_size_for,
 };
-use crate::brush::Dab;
+use crate::brush::{Dab, DabFrame};
+
+mod run_ahead;
 use crate::cpu::FRAME_SUM_WORDS;
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::step::{
     Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region, frame_flags,
     frame_of_sums, longest_move,
 };
-use crate::pipeline::{BackstopFilter, CpuKernels, Deformed, FrameSource, StepKernels, Uploads};
+use crate::pipeline::{
+    BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
+};
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -447,7 +452,6 @@ struct StepBuffers {
     /// The brush frame's sums, and its dispatch sized from the selection count.
     frame_sums: wgpu::Buffer,
     frame_args: wgpu::Buffer,
-    readback: ReusableBuffer,
 }
 
 impl StepBuffers {
@@ -470,7 +474,6 @@ impl StepBuffers {
             apply_args: indirect_args_buffer(gpu, "apply pass sizes"),
             frame_sums: frame_sums_buffer(gpu),
             frame_args: indirect_args_buffer(gpu, "brush frame sizes"),
-            readback: ReusableBuffer::readback("step readback"),
         }
     }
 }
@@ -487,8 +490,13 @@ pub struct GpuKernels {
     /// Whether a step's proximity passes may run in the submission that selected and
     /// deformed (`select_deform_and_clamp`; `SLAYER_GPU_AHEAD=0` turns it off).
     clamp_ahead: bool,
+    /// Whether, with those, several samples of a stroke run ahead in one submission
+    /// (`run_ahead`; see [`GpuKernels::set_run_ahead`]).
+    run_ahead: bool,
     resident: Option<Resident>,
     step: StepBuffers,
+    /// Where every submission's results are copied to be mapped.
+    readback: ReusableBuffer,
     /// Set once the GPU failed: why. Everything after runs on the CPU.
     failed: Option<String>,
     /// Test hook: fail as a lost device would after this many more GPU calls.
@@ -499,6 +507,19 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
+    /// The samples the pipeline said it will start this stroke (`upcoming`), and the index of
+    /// the one after the last it took from a submission that ran several ahead.
+    plan: Vec<SampleProbe>,
+    plan_next: usize,
+    /// How many samples the next run ahead records, and how many of the last run the pipeline
+    /// took (`run_ahead`).
+    run_length: usize,
+    run_taken: usize,
+    /// Samples run ahead in such a submission, waiting for the pipeline (`run_ahead`).
+    queued: run_ahead::Queue,
+    /// The vertices and final positions of the last step taken from passes run ahead, to see
+    /// whether the pipeline kept them (`moved`).
+    taken: Option<(Vec<u32>, Vec<Vec3>)>,
 }
 
 /// A merged submission's passes assume moves up to this many times the last step's longest.
@@ -528,7 +549,10 @@ impl GpuKernels {
             proximity_on_gpu: forced || !gpu.adapter.software,
             backstop_on_gpu: std::env::var("SLAYER_GPU_BACKSTOP").map_or(true, |v| v != "0"),
             clamp_ahead: std::env::var("SLAYER_GPU_AHEAD").map_or(true, |v| v != "0"),
+            run_ahead: std::env::var("SLAYER_GPU_RUN_AHEAD")
+                .map_or(!gpu.adapter.software, |v| v == "1"),
             step: StepBuffers::new(&gpu),
+            readback: ReusableBuffer::readback("step readback"),
             gpu,
             resident: None,
             failed: None,
@@ -537,6 +561,12 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
+            plan: Vec::new(),
+            plan_next: 0,
+            run_length: 0,
+            run_taken: 0,
+            queued: run_ahead::Queue::new(),
+            taken: None,
         }
     }
 
@@ -547,6 +577,14 @@ impl GpuKernels {
 
     pub fn proximity_on_gpu(&self) -> bool {
         self.proximity_on_gpu
+    }
+
+    /// With the proximity passes on the GPU, runs several samples of a stroke ahead in one
+    /// submission (`true`) or one submission per step. On by default on hardware adapters;
+    /// on lavapipe (`SLAYER_GPU_RUN_AHEAD=1` turns it on) the passes of a run, sized for the
+    /// drift of the samples before them, cost several times what they cost apart.
+    pub fn set_run_ahead(&mut self, on: bool) {
+        self.run_ahead = on;
     }
 
     /// With the proximity passes on the GPU, filters the exact backstop's pairs there too
@@ -683,7 +721,8 @@ impl GpuKernels {
         }
         self.check_injected_failure()?;
         self.drop_ahead(mesh);
-        let (gpu, step) = (&self.gpu, &mut self.step);
+        self.drop_queued(mesh);
+        let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
             (&mut self.resident, &mut self.uploads),
@@ -721,9 +760,7 @@ impl GpuKernels {
             &deform_params(dab, entries.len()),
             step.targets.buffer(),
         )?;
-        let data =
-            step.readback
-                .read_back_parts(gpu, encoder, &[(step.targets.buffer(), bytes)])?;
+        let data = readback.read_back_parts(gpu, encoder, &[(step.targets.buffer(), bytes)])?;
         Ok(bytemuck::pod_collect_to_vec(&data))
     }
 
@@ -751,6 +788,7 @@ impl GpuKernels {
     ) -> Result<Deformed, GpuError> {
         self.check_injected_failure()?;
         self.drop_ahead(mesh);
+        self.drop_queued(mesh);
         let filter = self.backstop_on_gpu;
         // The passes' reach, and their work with its cube, grows with the move they assume:
         // twice the last step's longest move (within the limit), which consecutive steps of a
@@ -761,7 +799,7 @@ impl GpuKernels {
                 0.0 => limit,
                 last => (AHEAD_MOVE_GROWTH * last).min(limit),
             });
-        let (gpu, step) = (&self.gpu, &mut self.step);
+        let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
             (&mut self.resident, &mut self.uploads),
@@ -779,173 +817,68 @@ impl GpuKernels {
         // The rings of the guessed slots must fit one binding (`moving_entries` writes them).
         let assumed_move = assumed_move
             .filter(|_| ring_bytes(guess) <= gpu.limits.max_storage_buffer_binding_size);
-        let target_bytes = (guess * std::mem::size_of::<Vec3>()) as u64;
-        if deforms {
-            step.targets.reserve(gpu, target_bytes)?;
-        }
-        if assumed_move.is_some() {
-            r.ensure_topology(gpu, mesh)?;
-            step.moving
-                .reserve(gpu, (guess * std::mem::size_of::<MovingVertex>()) as u64)?;
-            step.ring_slots.reserve(gpu, ring_bytes(guess))?;
-            step.reserve_clamp(gpu, guess, filter)?;
-        }
+        step.reserve_sample(
+            gpu,
+            (r, mesh),
+            guess,
+            deforms,
+            assumed_move.is_some(),
+            filter,
+        )?;
         let r = &*r;
         let mut encoder = gpu.encoder("select and deform");
-        record_brush_selection(gpu, &mut encoder, r, state.active, dab)?;
-        let inputs = SelectionBuffers {
-            positions: &r.vertices.positions,
-            normals: &r.normals,
-            selected: &r.selection.selected,
-            selection_count: &r.selection.count,
-        };
-        let mut params = deform_params(dab, guess);
-        let sum_bytes = (FRAME_SUM_WORDS * 4) as u64;
-        let mut extra = Vec::new();
-        let sums_from_selection = match source {
-            FrameSource::Selection { normal } => {
-                params.frame = frame_flags(normal);
-                params.normal = normal.unwrap_or(Vec3::Z).to_array();
-                record_dispatch_args(
-                    gpu,
-                    &mut encoder,
-                    &r.selection.count,
-                    (capacity, 1),
-                    FRAME_WORKGROUP_SIZE,
-                    &step.frame_args,
-                )?;
-                record_brush_frame(
-                    gpu,
-                    &mut encoder,
-                    &inputs,
-                    &frame_params(dab.frame.center, dab.brush.radius, capacity),
-                    &step.frame_sums,
-                    Workgroups::Indirect(&step.frame_args),
-                )?;
-                extra.push((&step.frame_sums, sum_bytes));
-                Some(normal)
-            }
-            FrameSource::Dab => None,
-        };
-        if deforms {
-            record_deform(
-                gpu,
-                &mut encoder,
-                &DeformBuffers {
-                    selection: inputs,
-                    neighbour_rows: &r.neighbour_table,
-                    neighbours: &r.neighbours,
-                    frame_sums: &step.frame_sums,
-                },
-                &params,
-                step.targets.buffer(),
-            )?;
-            extra.push((step.targets.buffer(), target_bytes));
-        }
-        let clamp_read = match assumed_move {
-            Some(limit) => {
-                let Some(topology) = &r.topology else {
-                    unreachable!("made resident above");
-                };
-                encoder.clear_buffer(&step.ring_overflows, 0, None);
-                record_moving_entries(
-                    gpu,
-                    &mut encoder,
-                    &EntryBuffers {
-                        positions: &r.vertices.positions,
-                        layers: &r.vertices.layers,
-                        selected: &r.selection.selected,
-                        selection_count: &r.selection.count,
-                        topology: &topology.buffer,
-                    },
-                    &entry_params(guess, state.ring, topology.layout.vertex_rows_base),
-                    &BuiltEntryBuffers {
-                        moving: step.moving.buffer(),
-                        rings: step.ring_slots.buffer(),
-                        overflows: &step.ring_overflows,
-                    },
-                )?;
-                // No vertex moves farther than the limit, so no edge grows by more than twice
-                // it.
-                let bounds = PassBounds {
-                    count: guess,
-                    step_move: limit,
-                    moved_edge: state.max_edge + 2.0 * limit,
-                    counted_by: Some(&r.selection.count),
-                };
-                let read = record_clamp(gpu, &mut encoder, (r, step), state, &bounds, filter)?;
-                extra.push((&step.ring_overflows, 4));
-                extra.push((step.finals.buffer(), read.finals_bytes));
-                if let Some(pair_bytes) = read.pair_bytes {
-                    extra.push((&step.pair_count, 4));
-                    extra.push((step.pairs.buffer(), pair_bytes));
-                }
-                Some((limit, read))
-            }
-            None => None,
-        };
+        let ahead = assumed_move.map(|assumed_move| AheadBounds {
+            assumed_move,
+            drift: r.hashed().drift,
+        });
+        let recorded = record_sample(
+            gpu,
+            &mut encoder,
+            (r, step),
+            state,
+            dab,
+            (source, deforms),
+            guess,
+            ahead,
+            filter,
+        )?;
         let read = r
             .selection
-            .submit_and_read(gpu, encoder, &mut step.readback, guess, &extra)?;
+            .submit_and_read(gpu, encoder, readback, guess, &recorded.parts)?;
         let list = read.list;
         let count = list.len();
-        // The extra parts in the order pushed: the sums (at a sample's start), the targets,
-        // then what the passes left.
-        let mut rest = read.extra.as_slice();
-        let mut take = |bytes: u64| {
-            let (part, after) = rest.split_at(bytes as usize);
-            rest = after;
-            part
-        };
-        let frame = match sums_from_selection {
-            Some(normal) => {
-                frame_of_sums(&bytemuck::pod_read_unaligned(take(sum_bytes)), dab, normal)
-            }
-            None => dab.frame,
-        };
         let whole_list = read.head == count;
-        let target_part = if deforms { take(target_bytes) } else { &[] };
-        let head_targets: Vec<Vec3> = if deforms && whole_list {
-            bytemuck::pod_collect_to_vec(&target_part[..count * 12])
-        } else {
-            Vec::new()
-        };
-        let ring_overflows = clamp_read.map(|_| u32::from_le_bytes(take(4).try_into().unwrap()));
-        let clamp_data = rest;
+        let layout = recorded.layout;
+        let parts = layout.split(&read.extra, dab);
         self.last_selection = count;
-        // The kernels appended in whatever order their threads ran; the pipeline works in
-        // vertex order (its sums and the CPU's agree then), the targets permuted alike.
-        let mut order: Vec<usize> = (0..list.len()).collect();
-        order.sort_unstable_by_key(|&i| list[i].vertex);
-        let selection: Vec<(u32, f32)> = order
-            .iter()
-            .map(|&i| (list[i].vertex, list[i].weight))
-            .collect();
-        let targets: Option<Vec<Vec3>> = match (deforms && count > 0, whole_list) {
-            (false, _) => None,
-            (true, true) => Some(order.iter().map(|&i| head_targets[i]).collect()),
-            (true, false) => None,
-        };
+        let (order, selection) = in_vertex_order(&list);
+        let targets: Option<Vec<Vec3>> = (deforms && count > 0 && whole_list).then(|| {
+            permuted(
+                &order,
+                &bytemuck::pod_collect_to_vec(&parts.targets[..count * 12]),
+            )
+        });
+        let frame = parts.frame;
         let longest = targets
             .as_ref()
             .map(|targets| longest_move(mesh, &selection, targets));
         if let Some(longest) = longest {
             self.last_move = longest;
         }
-        if let Some((assumed, clamp_read)) = clamp_read {
+        if let (Some(assumed), Some(clamp_read)) = (assumed_move, layout.clamp) {
             let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
             // Within the assumed move, which is within the step limit: one step, which moves
             // the selection to exactly these targets.
-            let kept = targets
-                .as_ref()
-                .filter(|_| ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed));
+            let kept = targets.as_ref().filter(|_| {
+                parts.ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed)
+            });
             match kept {
                 Some(targets) => {
-                    let (finals, backstop) = step.parse_clamp(clamp_data, guess, clamp_read);
+                    let (finals, backstop) = step.parse_clamp(parts.clamp, guess, clamp_read);
                     self.ahead = Some(ClampedAhead {
                         vertices,
                         targets: targets.clone(),
-                        finals: order.iter().map(|&i| finals[i]).collect(),
+                        finals: permuted(&order, &finals),
                         backstop,
                     });
                 }
@@ -987,7 +920,7 @@ impl GpuKernels {
         }
         self.check_injected_failure()?;
         let filter = self.backstop_on_gpu;
-        let (gpu, step) = (&self.gpu, &mut self.step);
+        let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
             (&mut self.resident, &mut self.uploads),
@@ -1010,6 +943,7 @@ impl GpuKernels {
             } else {
                 0.0
             },
+            drift: r.hashed().drift,
             counted_by: None,
         };
         step.reserve_clamp(gpu, count, filter)?;
@@ -1020,16 +954,18 @@ impl GpuKernels {
             parts.push((&step.pair_count, 4));
             parts.push((step.pairs.buffer(), pair_bytes));
         }
-        let data = step.readback.read_back_parts(gpu, encoder, &parts)?;
+        let data = readback.read_back_parts(gpu, encoder, &parts)?;
         let (finals, backstop) = step.parse_clamp(&data, count, read);
         tally(&mut self.filter, &backstop, filter);
         Ok((finals, backstop))
     }
 
     /// Drops the passes a merged submission ran ahead when the pipeline did not take them:
-    /// the GPU's positions of those vertices go back to the mesh's.
+    /// the GPU's positions of those vertices go back to the mesh's. Samples queued after them
+    /// were recorded on their moves, and go too.
     fn drop_ahead(&mut self, mesh: &Mesh) {
         if let Some(ahead) = self.ahead.take() {
+            self.drop_queued(mesh);
             let resident = self.resident.as_ref();
             put_back(
                 &self.gpu,
@@ -1120,6 +1056,8 @@ struct PassBounds<'a> {
     count: usize,
     step_move: f32,
     moved_edge: f32,
+    /// How far any vertex may be from where the table filed it.
+    drift: f32,
     counted_by: Option<&'a wgpu::Buffer>,
 }
 
@@ -1132,6 +1070,31 @@ struct ClampRead {
 }
 
 impl StepBuffers {
+    /// Room for [`record_sample`] over `guess` slots (with `ahead`, its passes too: the
+    /// topology made resident).
+    fn reserve_sample(
+        &mut self,
+        gpu: &GpuContext,
+        (r, mesh): (&mut Resident, &Mesh),
+        guess: usize,
+        deforms: bool,
+        ahead: bool,
+        filter: bool,
+    ) -> Result<(), GpuError> {
+        if deforms {
+            self.targets
+                .reserve(gpu, (guess * std::mem::size_of::<Vec3>()) as u64)?;
+        }
+        if ahead {
+            r.ensure_topology(gpu, mesh)?;
+            self.moving
+                .reserve(gpu, (guess * std::mem::size_of::<MovingVertex>()) as u64)?;
+            self.ring_slots.reserve(gpu, ring_bytes(guess))?;
+            self.reserve_clamp(gpu, guess, filter)?;
+        }
+        Ok(())
+    }
+
     /// Room for a clamp over `count` slots (`record_clamp`), before its buffers are borrowed.
     fn reserve_clamp(
         &mut self,
@@ -1156,14 +1119,16 @@ impl StepBuffers {
     fn parse_clamp(&mut self, data: &[u8], count: usize, read: ClampRead) -> (Vec<Vec3>, Backstop) {
         let at = read.finals_bytes as usize;
         let finals = bytemuck::pod_collect_to_vec(&data[..count * std::mem::size_of::<Vec3>()]);
-        if read.pair_bytes.is_none() {
+        let Some(pair_bytes) = read.pair_bytes else {
             return (finals, Backstop::Gather);
-        }
+        };
         let found =
             u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as usize;
-        if found > self.pair_capacity {
+        // The room the recording had (a later recording may have more).
+        let room = pair_bytes as usize / std::mem::size_of::<[u32; 2]>();
+        if found > room {
             // Room for them next time; this step's backstop searches on the CPU.
-            self.pair_capacity = found.next_power_of_two();
+            self.pair_capacity = self.pair_capacity.max(found.next_power_of_two());
             return (finals, Backstop::Gather);
         }
         let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
@@ -1171,8 +1136,8 @@ impl StepBuffers {
     }
 }
 
-/// Puts the GPU's positions of `vertices` back to the mesh's where passes run ahead wrote them
-/// and the pipeline did not take them (counted as dropped).
+/// Puts the GPU's rows of `vertices` back to the mesh's where passes run ahead wrote them and
+/// the pipeline did not take them (counted as dropped).
 fn put_back(
     gpu: &GpuContext,
     resident: Option<&Resident>,
@@ -1181,9 +1146,7 @@ fn put_back(
     vertices: &[u32],
 ) {
     uploads.dropped_ahead += 1;
-    if let Some(r) = resident {
-        upload_rows(gpu, &r.vertices.positions, mesh.positions(), vertices);
-    }
+    run_ahead::put_back_rows(gpu, resident, mesh, vertices);
 }
 
 /// Counts what the filter left the CPU (`filter`: it ran).
@@ -1227,7 +1190,7 @@ fn record_clamp(
         (
             state.collision_distance,
             state.max_edge,
-            hashed.drift + bounds.step_move,
+            bounds.drift + bounds.step_move,
         ),
         hashed.table.inv_cell_size,
         hashed.table.table_size,
@@ -1347,7 +1310,7 @@ fn record_clamp(
         overlay_mask: overlay.map_or(0, |o| o.table.table_size - 1),
         ..backstop_params(
             (state.max_edge, bounds.moved_edge),
-            (hashed.drift, bounds.step_move),
+            (bounds.drift, bounds.step_move),
             (hashed.table.inv_cell_size, hashed.table.table_size),
             count,
             layout.vertex_rows_base,
@@ -1393,6 +1356,214 @@ fn record_clamp(
     })
 }
 
+/// How a sample's passes, recorded before its moves are known, are sized: for moves up to
+/// `assumed_move`, over a table whose vertices may have drifted `drift` from where they were
+/// filed.
+#[derive(Debug, Clone, Copy)]
+struct AheadBounds {
+    assumed_move: f32,
+    drift: f32,
+}
+
+/// What [`record_sample`] leaves to read back after the selection's count and list: `parts`,
+/// in order, and how to split them.
+struct RecordedSample<'b> {
+    parts: Vec<(&'b wgpu::Buffer, u64)>,
+    layout: SampleLayout,
+}
+
+/// How a recorded sample's parts split.
+#[derive(Debug, Clone, Copy)]
+struct SampleLayout {
+    /// The sample's own normal when the frame is summed from the selection.
+    frame_from_selection: Option<Option<Vec3>>,
+    target_bytes: u64,
+    clamp: Option<ClampRead>,
+}
+
+/// A recorded sample's bytes after the selection list, split.
+struct SampleBytes<'d> {
+    frame: DabFrame,
+    /// `target_bytes` of targets, in the list's order (empty for a brush that does not move).
+    targets: &'d [u8],
+    /// Rings `moving_entries` cut short, where the passes ran.
+    ring_overflows: Option<u32>,
+    /// The rest: what `StepBuffers::parse_clamp` reads.
+    clamp: &'d [u8],
+}
+
+impl SampleLayout {
+    fn split<'d>(&self, mut rest: &'d [u8], dab: &Dab) -> SampleBytes<'d> {
+        let mut take = |bytes: u64| {
+            let (part, after) = rest.split_at(bytes as usize);
+            rest = after;
+            part
+        };
+        let frame = match self.frame_from_selection {
+            Some(normal) => {
+                let sums = take((FRAME_SUM_WORDS * 4) as u64);
+                frame_of_sums(&bytemuck::pod_read_unaligned(sums), dab, normal)
+            }
+            None => dab.frame,
+        };
+        let targets = take(self.target_bytes);
+        let ring_overflows = self
+            .clamp
+            .map(|_| u32::from_le_bytes(take(4).try_into().expect("four bytes")));
+        SampleBytes {
+            frame,
+            targets,
+            ring_overflows,
+            clamp: rest,
+        }
+    }
+}
+
+/// Records one sample's step into `encoder`: selection under `dab` (into the resident list),
+/// at a sample's start the brush frame summed from it, with `deforms` the deformation of the
+/// first `guess` entries, and with `ahead` `moving_entries` and the step's proximity passes
+/// and filter over those slots. `state.max_edge` bounds the edges at the step's start. The
+/// buffers are reserved beforehand.
+#[allow(clippy::too_many_arguments)]
+fn record_sample<'b>(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (r, step): (&'b Resident, &'b StepBuffers),
+    state: &StrokeState<'_>,
+    dab: &Dab,
+    (source, deforms): (FrameSource, bool),
+    guess: usize,
+    ahead: Option<AheadBounds>,
+    filter: bool,
+) -> Result<RecordedSample<'b>, GpuError> {
+    let drift = ahead.map_or(r.hashed().drift, |a| a.drift);
+    record_brush_selection(gpu, encoder, r, state.active, dab, drift)?;
+    let capacity = r.selection.capacity;
+    let inputs = SelectionBuffers {
+        positions: &r.vertices.positions,
+        normals: &r.normals,
+        selected: &r.selection.selected,
+        selection_count: &r.selection.count,
+    };
+    let mut params = deform_params(dab, guess);
+    let mut parts = Vec::new();
+    let frame_from_selection = match source {
+        FrameSource::Selection { normal } => {
+            params.frame = frame_flags(normal);
+            params.normal = normal.unwrap_or(Vec3::Z).to_array();
+            record_dispatch_args(
+                gpu,
+                encoder,
+                &r.selection.count,
+                (capacity, 1),
+                FRAME_WORKGROUP_SIZE,
+                &step.frame_args,
+            )?;
+            record_brush_frame(
+                gpu,
+                encoder,
+                &inputs,
+                &frame_params(dab.frame.center, dab.brush.radius, capacity),
+                &step.frame_sums,
+                Workgroups::Indirect(&step.frame_args),
+            )?;
+            parts.push((&step.frame_sums, (FRAME_SUM_WORDS * 4) as u64));
+            Some(normal)
+        }
+        FrameSource::Dab => None,
+    };
+    let target_bytes = if deforms {
+        (guess * std::mem::size_of::<Vec3>()) as u64
+    } else {
+        0
+    };
+    if deforms {
+        record_deform(
+            gpu,
+            encoder,
+            &DeformBuffers {
+                selection: inputs,
+                neighbour_rows: &r.neighbour_table,
+                neighbours: &r.neighbours,
+                frame_sums: &step.frame_sums,
+            },
+            &params,
+            step.targets.buffer(),
+        )?;
+        parts.push((step.targets.buffer(), target_bytes));
+    }
+    let mut clamp = None;
+    if let Some(AheadBounds {
+        assumed_move,
+        drift,
+    }) = ahead
+    {
+        let Some(topology) = &r.topology else {
+            unreachable!("the caller made the topology resident");
+        };
+        encoder.clear_buffer(&step.ring_overflows, 0, None);
+        record_moving_entries(
+            gpu,
+            encoder,
+            &EntryBuffers {
+                positions: &r.vertices.positions,
+                layers: &r.vertices.layers,
+                selected: &r.selection.selected,
+                selection_count: &r.selection.count,
+                topology: &topology.buffer,
+            },
+            &entry_params(guess, state.ring, topology.layout.vertex_rows_base),
+            &BuiltEntryBuffers {
+                moving: step.moving.buffer(),
+                rings: step.ring_slots.buffer(),
+                overflows: &step.ring_overflows,
+            },
+        )?;
+        // No vertex moves farther than assumed, so no edge grows by more than twice that.
+        let bounds = PassBounds {
+            count: guess,
+            step_move: assumed_move,
+            moved_edge: state.max_edge + 2.0 * assumed_move,
+            drift,
+            counted_by: Some(&r.selection.count),
+        };
+        let read = record_clamp(gpu, encoder, (r, step), state, &bounds, filter)?;
+        parts.push((&step.ring_overflows, 4));
+        parts.push((step.finals.buffer(), read.finals_bytes));
+        if let Some(pair_bytes) = read.pair_bytes {
+            parts.push((&step.pair_count, 4));
+            parts.push((step.pairs.buffer(), pair_bytes));
+        }
+        clamp = Some(read);
+    }
+    Ok(RecordedSample {
+        parts,
+        layout: SampleLayout {
+            frame_from_selection,
+            target_bytes,
+            clamp,
+        },
+    })
+}
+
+/// The order that sorts a selection list by vertex, and the list so sorted: the kernels append
+/// in whatever order their threads ran; the pipeline works in vertex order (its sums and the
+/// CPU's agree then).
+fn in_vertex_order(list: &[SelectedVertex]) -> (Vec<usize>, Vec<(u32, f32)>) {
+    let mut order: Vec<usize> = (0..list.len()).collect();
+    order.sort_unstable_by_key(|&i| list[i].vertex);
+    let selection = order
+        .iter()
+        .map(|&i| (list[i].vertex, list[i].weight))
+        .collect();
+    (order, selection)
+}
+
+/// `values` (one per list entry) permuted as [`in_vertex_order`] sorted the list.
+fn permuted<T: Copy>(order: &[usize], values: &[T]) -> Vec<T> {
+    order.iter().map(|&i| values[i]).collect()
+}
+
 /// Records a selection under `dab` into the resident selection buffers.
 fn record_brush_selection(
     gpu: &GpuContext,
@@ -1400,6 +1571,7 @@ fn record_brush_selection(
     r: &Resident,
     active: &[bool],
     dab: &Dab,
+    drift: f32,
 ) -> Result<(), GpuError> {
     let hashed = r.hashed();
     let active_words: Vec<u32> = active.iter().map(|&a| a as u32).collect();
@@ -1413,7 +1585,7 @@ fn record_brush_selection(
         &HashedVertices {
             table: &hashed.table,
             positions: &hashed.positions,
-            drift: hashed.drift,
+            drift,
             overlay: hashed.overlay(),
         },
         &BrushSphere {
@@ -1487,8 +1659,31 @@ impl StepKernels for GpuKernels {
         step_limit: f32,
     ) -> Deformed {
         let how = (source, true);
+        // At a sample's start: the sample run ahead, or a run of the samples planned from it.
+        if let FrameSource::Selection { normal } = source {
+            let probe = (*dab, normal);
+            if let Some(deformed) = self.take_queued(mesh, &probe) {
+                return deformed;
+            }
+            let runs_ahead = self.proximity_on_gpu
+                && self.clamp_ahead
+                && self.run_ahead
+                && self.failed.is_none();
+            if let Some(from) = self.planned(&probe).filter(|_| runs_ahead) {
+                self.on_gpu(|k| k.gpu_run_ahead(state, mesh, from, step_limit));
+                if let Some(deformed) = self.take_queued(mesh, &probe) {
+                    return deformed;
+                }
+            }
+        }
         self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(step_limit)))
             .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
+    }
+
+    fn upcoming(&mut self, mesh: &Mesh, probes: &[SampleProbe]) {
+        self.drop_queued(mesh);
+        self.plan = probes.to_vec();
+        self.plan_next = 0;
     }
 
     fn deform(
@@ -1524,8 +1719,10 @@ impl StepKernels for GpuKernels {
                 for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
                     positions[v as usize] = p;
                 }
+                self.taken = Some((ahead.vertices, ahead.finals));
                 return ahead.backstop;
             }
+            self.drop_queued(mesh);
             let resident = self.resident.as_ref();
             put_back(
                 &self.gpu,
@@ -1550,6 +1747,7 @@ impl StepKernels for GpuKernels {
 
     fn moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {
         self.drop_ahead(mesh);
+        self.check_taken(mesh);
         if self.failed.is_none() {
             self.gpu_moved(mesh, vertices, max_move);
         }
@@ -1563,6 +1761,7 @@ impl StepKernels for GpuKernels {
 
     fn remeshed(&mut self, mesh: &Mesh, since: MeshVersion, changed: &[u32]) {
         self.drop_ahead(mesh);
+        self.drop_queued(mesh);
         if self.failed.is_none() {
             self.gpu_remeshed(mesh, since, changed);
         }

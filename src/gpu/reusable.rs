@@ -101,11 +101,33 @@ impl ReusableBuffer {
     ) -> Result<Vec<u8>, GpuError> {
         let total: u64 = parts.iter().map(|&(_, bytes)| bytes).sum();
         self.reserve(gpu, total)?;
-        let mut at = 0;
+        self.record_copies(&mut encoder, parts, 0);
+        self.submit_and_map(gpu, encoder, total)
+    }
+
+    /// Records copies of the first bytes of each part one after another into this buffer from
+    /// byte `at`, and returns where they end: the parts as they are at this point of the
+    /// encoder, which may overwrite them after.
+    pub fn record_copies(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        parts: &[(&wgpu::Buffer, u64)],
+        mut at: u64,
+    ) -> u64 {
         for &(source, bytes) in parts {
             encoder.copy_buffer_to_buffer(source, 0, self.buffer(), at, bytes);
             at += bytes;
         }
+        at
+    }
+
+    /// Submits `encoder`, which copied `total` bytes into this (read-back) buffer, and maps them.
+    pub fn submit_and_map(
+        &self,
+        gpu: &GpuContext,
+        encoder: wgpu::CommandEncoder,
+        total: u64,
+    ) -> Result<Vec<u8>, GpuError> {
         gpu.queue.submit([encoder.finish()]);
         let mut data = gpu.map_read(self.buffer())?;
         data.truncate(total as usize);

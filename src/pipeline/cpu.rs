@@ -6,13 +6,13 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::kernels::{CpuKernels, Deformed, FrameSource, StepKernels};
+use super::kernels::{CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{Region, StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
 use super::{
     BackstopFilter, PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline,
     StrokeHook, StrokeReport, Uploads,
 };
-use crate::brush::{BrushKind, Dab, DabFrame, Stroke, resample};
+use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::geom::largest_move;
 use crate::grid::SpatialHash;
@@ -212,6 +212,22 @@ fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
     }
 }
 
+/// The dab a sample starts with: at the sample's position, moving from the previous sample's,
+/// its frame still to be taken from the selection.
+fn probe_at(stroke: &Stroke, sample: &Sample, previous: Option<Vec3>) -> Dab {
+    Dab {
+        brush: stroke.brush,
+        frame: DabFrame {
+            center: sample.position,
+            normal: Vec3::Z,
+            plane_point: sample.position,
+            motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
+        },
+        pressure: sample.pressure,
+        share: 1.0,
+    }
+}
+
 fn millis(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
@@ -304,6 +320,22 @@ impl SculptPipeline for CpuPipeline {
         let mut previous: Option<Vec3> = None;
         let mut captured: Option<Vec<(u32, f32)>> = None;
         let is_grab = stroke.brush.kind == BrushKind::Grab;
+        let deforms = stroke.brush.kind.deforms();
+        // Kernels may run the samples ahead while each is one step that nothing else touches
+        // between: not a grab (it moves what its first sample caught), not with remeshing
+        // between samples.
+        let plans_ahead = deforms && !is_grab && self.settings.remeshing != Remeshing::AfterSample;
+        if plans_ahead {
+            let probes: Vec<SampleProbe> = samples
+                .iter()
+                .scan(None, |previous, sample| {
+                    let probe = probe_at(stroke, sample, *previous);
+                    *previous = Some(sample.position);
+                    Some((probe, sample.normal))
+                })
+                .collect();
+            self.kernels.upcoming(mesh, &probes);
+        }
 
         let use_grid = self.search == Search::Grid;
         let parallel = self.parallel;
@@ -328,19 +360,8 @@ impl SculptPipeline for CpuPipeline {
                 (parallel, distance, ring, max_edge),
             );
             let started = Instant::now();
-            let probe = Dab {
-                brush: stroke.brush,
-                frame: DabFrame {
-                    center: sample.position,
-                    normal: Vec3::Z,
-                    plane_point: sample.position,
-                    motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
-                },
-                pressure: sample.pressure,
-                share: 1.0,
-            };
+            let probe = probe_at(stroke, sample, previous);
             previous = Some(sample.position);
-            let deforms = stroke.brush.kind.deforms();
             // A grab keeps the vertices it caught at its first sample; anything else selects
             // anew, and the kernels take the frame and the whole sample's targets with it (on
             // the GPU in one submission, booked under selection: it cannot be split).
@@ -535,6 +556,9 @@ impl SculptPipeline for CpuPipeline {
             }
         }
 
+        if plans_ahead {
+            self.kernels.upcoming(mesh, &[]);
+        }
         touched_list.sort_unstable();
         for &v in &touched_list {
             touched[v as usize] = false;

@@ -77,6 +77,11 @@ pub trait StepKernels: Send {
     ) -> Deformed {
         self.select_and_deform(state, mesh, dab, (source, true))
     }
+    /// The samples the stroke is about to start, in order, each as the pipeline will pass it to
+    /// [`StepKernels::select_deform_and_clamp`] at the sample's start; empty when the stroke is
+    /// done. Kernels that can (the GPU's) run several of them ahead in one submission, and
+    /// answer from that while the pipeline takes exactly what they predicted.
+    fn upcoming(&mut self, _mesh: &Mesh, _probes: &[SampleProbe]) {}
     /// Where the brush moves each selected vertex.
     fn deform(
         &mut self,
@@ -123,6 +128,10 @@ pub trait StepKernels: Send {
     }
 }
 
+/// A sample's start as the pipeline asks for it: the probe dab (the frame still to be taken
+/// from the selection) and the sample's own normal, if any.
+pub type SampleProbe = (Dab, Option<Vec3>);
+
 /// Where [`StepKernels::select_and_deform`] takes the brush frame from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FrameSource {
@@ -167,6 +176,10 @@ pub struct Uploads {
     /// its room).
     pub clamped_ahead: usize,
     pub dropped_ahead: usize,
+    /// Submissions that ran several samples of a stroke ahead, and the samples taken from them
+    /// as predicted ([`StepKernels::upcoming`]).
+    pub batches: usize,
+    pub samples_ahead: usize,
 }
 
 /// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.

@@ -13,7 +13,9 @@ mod kernels;
 pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
-pub use kernels::{BackstopFilter, CpuKernels, Deformed, FrameSource, StepKernels, Uploads};
+pub use kernels::{
+    BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
+};
 
 use serde::Serialize;
 use thiserror::Error;

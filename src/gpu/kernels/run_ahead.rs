@@ -1,0 +1,324 @@
+//! A stroke's samples recorded ahead, several in one submission. The pipeline tells the
+//! kernels the samples it will ask for ([`StepKernels::upcoming`]); at a sample's start the
+//! kernels record that sample and the next ones one after another — each one's selection,
+//! brush frame, deformation, moving entries, proximity passes, backstop filter and the normals
+//! its moves turned (`moved_normals`), each reading the positions and normals the one before
+//! left on the GPU — copy each one's results aside, and read them all back in one map. The
+//! pipeline then takes them one by one as if each had been a submission of its own.
+//!
+//! What the GPU ran is what the pipeline would have asked for only while its predictions
+//! hold: each sample one step within the move its passes were sized for (checked against the
+//! mesh when the pipeline reaches the sample), its selection within the guessed list and its
+//! rings within their room (checked when read back), and the exact backstop undoing nothing
+//! (checked when the pipeline reports the sample's moves). From the first sample where one
+//! fails, the rest are dropped: the rows they wrote go back to the mesh's (positions, and the
+//! normals around them), and the pipeline goes on one submission per step from there.
+//!
+//! [`StepKernels::upcoming`]: crate::pipeline::StepKernels::upcoming
+
+use std::collections::VecDeque;
+
+use glam::Vec3;
+
+use super::{
+    AHEAD_MOVE_GROWTH, AheadBounds, ClampedAhead, GpuKernels, Resident, SampleLayout,
+    SelectedVertex, StrokeState, TableUse, cell_size, in_vertex_order, permuted, record_sample,
+};
+use crate::gpu::reusable::Patches;
+use crate::gpu::{GpuContext, GpuError, SELECTION_GUESS, record_moved_normals, ring_bytes};
+use crate::mesh::Mesh;
+use crate::pipeline::step::longest_move;
+use crate::pipeline::{Deformed, FrameSource, SampleProbe};
+
+/// At most this many samples in one submission: the read-back grows with each, and a sample
+/// the pipeline does not take as predicted wastes the work of those after it. A run starts at
+/// two samples and doubles after every run taken whole; a run cut short makes the next one as
+/// long as what was taken of it (at least two).
+pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
+const FIRST_SAMPLES_AHEAD: usize = 2;
+
+/// The samples of one submission may together move vertices this many cells from where the
+/// table filed them: every query's reach grows by that drift (the passes' work with its cube),
+/// and the table is refiled only between submissions. With steps of a cell (plaster, 2K faces)
+/// that is runs of three samples.
+const DRIFT_AHEAD_CELLS: f32 = 2.0;
+
+/// A sample recorded ahead, waiting for the pipeline to reach it.
+pub(super) struct QueuedSample {
+    /// Where it is in the plan, and the probe the pipeline will ask with.
+    index: usize,
+    probe: SampleProbe,
+    deformed: Deformed,
+    /// The step's passes; `None` when nothing was selected.
+    ahead: Option<ClampedAhead>,
+    /// The longest move the passes were sized for.
+    assumed_move: f32,
+}
+
+/// The vertices a queued sample's passes may have moved.
+fn moved_by(sample: &QueuedSample) -> &[u32] {
+    sample.ahead.as_ref().map_or(&[], |a| a.vertices.as_slice())
+}
+
+impl GpuKernels {
+    /// Where the sample the pipeline starts with `probe` is in the plan, looking from the
+    /// sample after the last one taken ahead; `None` when it is not planned or is the last.
+    pub(super) fn planned(&self, probe: &SampleProbe) -> Option<usize> {
+        let from = self.plan_next.min(self.plan.len());
+        self.plan[from..]
+            .iter()
+            .position(|p| p == probe)
+            .map(|at| from + at)
+            .filter(|&at| at + 1 < self.plan.len())
+    }
+
+    /// Records the planned samples from `from` on in one submission (as many as
+    /// [`MAX_SAMPLES_AHEAD`] and the table's drift allow; nothing when that is fewer than
+    /// two) and queues what each left for the pipeline. The passes are sized as a single
+    /// step's would be ([`AHEAD_MOVE_GROWTH`] times the last move, within `limit`), the step
+    /// of each later sample starting from edges and a drift grown by the samples before it.
+    pub(super) fn gpu_run_ahead(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        from: usize,
+        limit: f32,
+    ) -> Result<(), GpuError> {
+        self.check_injected_failure()?;
+        self.drop_ahead(mesh);
+        let filter = self.backstop_on_gpu;
+        let assumed_move = match self.last_move {
+            0.0 => limit,
+            last => (AHEAD_MOVE_GROWTH * last).min(limit),
+        };
+        let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
+        let r = GpuKernels::prepare(
+            gpu,
+            (&mut self.resident, &mut self.uploads),
+            mesh,
+            cell_size(state),
+            TableUse::Proximity,
+        )?;
+        let capacity = r.selection.capacity;
+        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        let drift = r.hashed().drift;
+        let cell = 1.0 / r.hashed().table.inv_cell_size;
+        // Sample j starts from a drift of `drift + j · assumed_move`.
+        let by_drift = ((DRIFT_AHEAD_CELLS * cell - drift).max(0.0) / assumed_move) as usize + 1;
+        let count = (self.plan.len() - from)
+            .min(
+                self.run_length
+                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
+            )
+            .min(by_drift);
+        if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
+            return Ok(());
+        }
+        step.reserve_sample(gpu, (r, mesh), guess, true, true, filter)?;
+        let r = &*r;
+        let Some(topology) = &r.topology else {
+            unreachable!("reserve_sample made the topology resident");
+        };
+        let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
+        let mut encoder = gpu.encoder("samples ahead");
+        let mut layout = None;
+        let mut sample_bytes = 0;
+        for j in 0..count {
+            let (dab, normal) = self.plan[from + j];
+            // Every step before this one moved vertices by at most the assumed move, and
+            // lengthened edges by at most twice that.
+            let grown = j as f32 * assumed_move;
+            let state = StrokeState {
+                max_edge: state.max_edge + 2.0 * grown,
+                ..*state
+            };
+            let recorded = record_sample(
+                gpu,
+                &mut encoder,
+                (r, step),
+                &state,
+                &dab,
+                (FrameSource::Selection { normal }, true),
+                guess,
+                Some(AheadBounds {
+                    assumed_move,
+                    drift: drift + grown,
+                }),
+                filter,
+            )?;
+            record_moved_normals(
+                gpu,
+                &mut encoder,
+                (&r.vertices.positions, &topology.buffer),
+                topology.layout.vertex_rows_base,
+                (step.moving.buffer(), guess),
+                &r.normals,
+            )?;
+            let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
+            parts.extend_from_slice(&recorded.parts);
+            if j == 0 {
+                // Every sample leaves the same parts.
+                sample_bytes = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>();
+                readback.reserve(gpu, sample_bytes * count as u64)?;
+                layout = Some(recorded.layout);
+            }
+            readback.record_copies(&mut encoder, &parts, j as u64 * sample_bytes);
+        }
+        let data = readback.submit_and_map(gpu, encoder, sample_bytes * count as u64)?;
+        let layout: SampleLayout = layout.expect("at least two samples recorded");
+        self.uploads.batches += 1;
+        self.run_taken = 0;
+
+        let mut dropped_from = None;
+        for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
+            let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
+                .min(capacity);
+            let head = found.min(guess);
+            let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
+            let (dab, normal) = self.plan[from + j];
+            let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
+            let (order, selection) = in_vertex_order(&list);
+            self.last_selection = self.last_selection.max(found);
+            if found > guess || parts.ring_overflows != Some(0) || dropped_from.is_some() {
+                // This sample's passes ran on a cut list or cut rings, and the later ones on
+                // what they left: put back everything each moved.
+                if dropped_from.is_none() {
+                    self.run_length = j.max(FIRST_SAMPLES_AHEAD);
+                }
+                dropped_from.get_or_insert(j);
+                let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+                if !vertices.is_empty() {
+                    self.uploads.dropped_ahead += 1;
+                    put_back_rows(gpu, Some(r), mesh, &vertices);
+                }
+                continue;
+            }
+            let ahead = (!selection.is_empty()).then(|| {
+                let targets: Vec<Vec3> = permuted(
+                    &order,
+                    &bytemuck::pod_collect_to_vec(&parts.targets[..found * 12]),
+                );
+                let clamp = layout.clamp.expect("passes recorded");
+                let (finals, backstop) = step.parse_clamp(parts.clamp, guess, clamp);
+                ClampedAhead {
+                    vertices: selection.iter().map(|&(v, _)| v).collect(),
+                    targets,
+                    finals: permuted(&order, &finals),
+                    backstop,
+                }
+            });
+            self.queued.push_back(QueuedSample {
+                index: from + j,
+                probe: (dab, normal),
+                deformed: Deformed {
+                    targets: ahead.as_ref().map(|a| a.targets.clone()),
+                    selection,
+                    frame: parts.frame,
+                    deform_millis: 0.0,
+                },
+                ahead,
+                assumed_move,
+            });
+        }
+        Ok(())
+    }
+
+    /// The queued sample the pipeline starts with `probe`, when it is the next one queued and
+    /// its moves are one step within what its passes assumed, from where the mesh is now. Any
+    /// other probe, or moves past the assumption, drop the queue.
+    /// A sample dropped for moving too far is not run ahead again: the pipeline takes it one
+    /// submission per step, and the next sample starts a new run sized from its move.
+    pub(super) fn take_queued(&mut self, mesh: &Mesh, probe: &SampleProbe) -> Option<Deformed> {
+        if self.failed.is_some() {
+            self.queued.clear();
+            return None;
+        }
+        let head = self.queued.front()?;
+        if head.probe != *probe {
+            self.drop_queued(mesh);
+            return None;
+        }
+        let longest = head
+            .ahead
+            .as_ref()
+            .map(|ahead| longest_move(mesh, &head.deformed.selection, &ahead.targets));
+        self.plan_next = head.index + 1;
+        if let Some(longest) = longest {
+            self.last_move = longest;
+            // A NaN move does not fit either.
+            let fits = longest <= head.assumed_move;
+            if !fits {
+                self.drop_queued(mesh);
+                return None;
+            }
+        }
+        let sample = self.queued.pop_front()?;
+        self.run_taken += 1;
+        if self.queued.is_empty() {
+            // The whole run was taken as predicted.
+            self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
+        }
+        self.uploads.samples_ahead += 1;
+        self.ahead = sample.ahead;
+        Some(sample.deformed)
+    }
+
+    /// Drops every queued sample: the rows their passes wrote go back to the mesh's.
+    pub(super) fn drop_queued(&mut self, mesh: &Mesh) {
+        let queued = std::mem::take(&mut self.queued);
+        if !queued.is_empty() {
+            self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
+        }
+        let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
+        if vertices.is_empty() {
+            return;
+        }
+        vertices.sort_unstable();
+        vertices.dedup();
+        self.uploads.dropped_ahead += queued.iter().filter(|s| s.ahead.is_some()).count();
+        put_back_rows(&self.gpu, self.resident.as_ref(), mesh, &vertices);
+    }
+
+    /// After the pipeline reported a step's moves: when they are not what the passes ran ahead
+    /// left (the exact backstop undid some), the samples queued after were recorded on the
+    /// wrong positions and are dropped.
+    pub(super) fn check_taken(&mut self, mesh: &Mesh) {
+        let Some((vertices, finals)) = self.taken.take() else {
+            return;
+        };
+        let positions = mesh.positions();
+        let as_predicted = vertices
+            .iter()
+            .zip(&finals)
+            .all(|(&v, &p)| positions[v as usize] == p);
+        if !as_predicted {
+            self.drop_queued(mesh);
+        }
+    }
+}
+
+/// Puts the GPU's rows of `vertices` — positions, and the normals of every corner of the faces
+/// around them, which `moved_normals` may have rewritten — back to the mesh's, in one upload.
+pub(super) fn put_back_rows(
+    gpu: &GpuContext,
+    resident: Option<&Resident>,
+    mesh: &Mesh,
+    vertices: &[u32],
+) {
+    let Some(r) = resident else {
+        return;
+    };
+    let mut corners: Vec<u32> = vertices
+        .iter()
+        .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
+        .collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let mut patches = Patches::default();
+    patches.rows(&r.vertices.positions, mesh.positions(), vertices);
+    patches.rows(&r.normals, mesh.normals(), &corners);
+    patches.submit(gpu);
+}
+
+/// The queue of samples recorded ahead, oldest first.
+pub(super) type Queue = VecDeque<QueuedSample>;
