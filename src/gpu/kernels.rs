@@ -795,10 +795,7 @@ impl GpuKernels {
         // stroke rarely exceed.
         let assumed_move = clamp_within
             .filter(|_| deforms && self.proximity_on_gpu && self.clamp_ahead)
-            .map(|limit| match self.last_move {
-                0.0 => limit,
-                last => (AHEAD_MOVE_GROWTH * last).min(limit),
-            });
+            .map(|limit| self.assumed_move(limit));
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
@@ -813,7 +810,7 @@ impl GpuKernels {
             },
         )?;
         let capacity = r.selection.capacity;
-        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        let guess = selection_guess(self.last_selection, capacity);
         // The rings of the guessed slots must fit one binding (`moving_entries` writes them).
         let assumed_move = assumed_move
             .filter(|_| ring_bytes(guess) <= gpu.limits.max_storage_buffer_binding_size);
@@ -958,6 +955,15 @@ impl GpuKernels {
         let (finals, backstop) = step.parse_clamp(&data, count, read);
         tally(&mut self.filter, &backstop, filter);
         Ok((finals, backstop))
+    }
+
+    /// The longest move passes recorded before the moves are known are sized for: twice the
+    /// last step's longest move, within the step `limit` (the limit before the first).
+    fn assumed_move(&self, limit: f32) -> f32 {
+        match self.last_move {
+            0.0 => limit,
+            last => (AHEAD_MOVE_GROWTH * last).min(limit),
+        }
     }
 
     /// Drops the passes a merged submission ran ahead when the pipeline did not take them:
@@ -1134,6 +1140,12 @@ impl StepBuffers {
         let pairs = bytemuck::pod_collect_to_vec(&data[at + 4..at + 4 + 8 * found]);
         (finals, Backstop::Undecided(pairs))
     }
+}
+
+/// The head of the selection list read back with its count: twice the `last` selection,
+/// within the list's `capacity`.
+fn selection_guess(last: usize, capacity: usize) -> usize {
+    (2 * last).max(SELECTION_GUESS).min(capacity)
 }
 
 /// Puts the GPU's rows of `vertices` back to the mesh's where passes run ahead wrote them and

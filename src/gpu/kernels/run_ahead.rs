@@ -21,11 +21,11 @@ use std::collections::VecDeque;
 use glam::Vec3;
 
 use super::{
-    AHEAD_MOVE_GROWTH, AheadBounds, ClampedAhead, GpuKernels, Resident, SampleLayout,
-    SelectedVertex, StrokeState, TableUse, cell_size, in_vertex_order, permuted, record_sample,
+    AheadBounds, ClampedAhead, GpuKernels, Resident, SampleLayout, SelectedVertex, StrokeState,
+    TableUse, cell_size, in_vertex_order, permuted, record_sample, selection_guess,
 };
 use crate::gpu::reusable::Patches;
-use crate::gpu::{GpuContext, GpuError, SELECTION_GUESS, record_moved_normals, ring_bytes};
+use crate::gpu::{GpuContext, GpuError, record_moved_normals, ring_bytes};
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
 use crate::pipeline::{Deformed, FrameSource, SampleProbe};
@@ -87,10 +87,7 @@ impl GpuKernels {
         self.check_injected_failure()?;
         self.drop_ahead(mesh);
         let filter = self.backstop_on_gpu;
-        let assumed_move = match self.last_move {
-            0.0 => limit,
-            last => (AHEAD_MOVE_GROWTH * last).min(limit),
-        };
+        let assumed_move = self.assumed_move(limit);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
@@ -100,7 +97,7 @@ impl GpuKernels {
             TableUse::Proximity,
         )?;
         let capacity = r.selection.capacity;
-        let guess = (2 * self.last_selection).max(SELECTION_GUESS).min(capacity);
+        let guess = selection_guess(self.last_selection, capacity);
         let drift = r.hashed().drift;
         let cell = 1.0 / r.hashed().table.inv_cell_size;
         // Sample j starts from a drift of `drift + j · assumed_move`.
