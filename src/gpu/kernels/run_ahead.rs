@@ -75,8 +75,8 @@ impl GpuKernels {
     /// Records the planned samples from `from` on in one submission (as many as
     /// [`MAX_SAMPLES_AHEAD`] and the table's drift allow; nothing when that is fewer than
     /// two) and queues what each left for the pipeline. The passes are sized as a single
-    /// step's would be ([`AHEAD_MOVE_GROWTH`] times the last move, within `limit`), the step
-    /// of each later sample starting from edges and a drift grown by the samples before it.
+    /// step's would be (`assumed_move`: twice the last move, within `limit`), the step of each
+    /// later sample starting from edges and a drift grown by the samples before it.
     pub(super) fn gpu_run_ahead(
         &mut self,
         state: &StrokeState<'_>,
