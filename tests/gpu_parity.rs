@@ -13,7 +13,7 @@ use slayer::gpu::{
     smoothing_neighbours, table_size_for,
 };
 use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
-use slayer::mesh::{INVALID, VertexFlags};
+use slayer::mesh::{INVALID, Mesh, VertexFlags};
 
 fn gpu() -> GpuContext {
     let gpu = GpuContext::new(AdapterChoice {
@@ -1529,6 +1529,19 @@ fn proximity_reads_a_topology_split_over_several_bindings() {
 /// multiply-adds.
 const NORMAL_TOLERANCE: f32 = 1e-6;
 
+/// The adapter for a normals kernel over `mesh`: with `Binding::Paged`, a binding limit that
+/// keeps positions and normals (12 bytes a vertex) whole and splits the topology.
+fn gpu_for_normals(binding: Binding, mesh: &Mesh) -> GpuContext {
+    match binding {
+        Binding::Whole => gpu(),
+        Binding::Paged => {
+            let unpaged = 12 * mesh.vertex_count() as u64;
+            let topology = slayer::gpu::PackedTopology::of(mesh).words.len() as u64 * 4;
+            gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
+        }
+    }
+}
+
 #[test]
 fn vertex_normals_match_cpu_mirror_and_the_mesh() {
     check_vertex_normals(Binding::Whole);
@@ -1545,15 +1558,7 @@ fn check_vertex_normals(binding: Binding) {
     // into two dimensions. The mirror against `Mesh::recompute_normals_at`, the GPU against
     // the mirror; unlisted normals must stay as they were.
     let mut mesh = bumpy_sheets();
-    let mut gpu = match binding {
-        Binding::Whole => gpu(),
-        Binding::Paged => {
-            // Whole: positions and normals, 12 bytes a vertex.
-            let unpaged = 12 * mesh.vertex_count() as u64;
-            let topology = slayer::gpu::PackedTopology::of(&mesh).words.len() as u64 * 4;
-            gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
-        }
-    };
+    let mut gpu = gpu_for_normals(binding, &mesh);
     let mut rng = ChaCha8Rng::seed_from_u64(600);
     for p in mesh.positions_mut() {
         p.z += rng.random_range(-0.01..0.01);
@@ -1607,14 +1612,7 @@ fn check_moved_normals(binding: Binding) {
     // the faces around the moved vertices; the GPU against the mirror; every other normal must
     // stay as it was (stale, here).
     let start = bumpy_sheets();
-    let mut gpu = match binding {
-        Binding::Whole => gpu(),
-        Binding::Paged => {
-            let unpaged = 12 * start.vertex_count() as u64;
-            let topology = slayer::gpu::PackedTopology::of(&start).words.len() as u64 * 4;
-            gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
-        }
-    };
+    let mut gpu = gpu_for_normals(binding, &start);
     let order = shuffled((0..start.vertex_count() as u32).collect(), 602);
     let topology = slayer::gpu::PackedTopology::of(&start);
     let mut rng = ChaCha8Rng::seed_from_u64(603);

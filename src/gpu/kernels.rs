@@ -720,8 +720,7 @@ impl GpuKernels {
             return Ok(Vec::new());
         }
         self.check_injected_failure()?;
-        self.drop_ahead(mesh);
-        self.drop_queued(mesh);
+        self.drop_all_ahead(mesh);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
@@ -787,8 +786,7 @@ impl GpuKernels {
         clamp_within: Option<f32>,
     ) -> Result<Deformed, GpuError> {
         self.check_injected_failure()?;
-        self.drop_ahead(mesh);
-        self.drop_queued(mesh);
+        self.drop_all_ahead(mesh);
         let filter = self.backstop_on_gpu;
         // The passes' reach, and their work with its cube, grows with the move they assume:
         // twice the last step's longest move (within the limit), which consecutive steps of a
@@ -981,6 +979,13 @@ impl GpuKernels {
                 &ahead.vertices,
             );
         }
+    }
+
+    /// Drops whatever ran ahead — the passes of one step and the samples queued — when the
+    /// pipeline asks for something else.
+    fn drop_all_ahead(&mut self, mesh: &Mesh) {
+        self.drop_ahead(mesh);
+        self.drop_queued(mesh);
     }
 
     /// Sends the rows the pipeline changed, and notes how far they may have drifted.
@@ -1718,13 +1723,15 @@ impl StepKernels for GpuKernels {
         before: &[Vec3],
     ) -> Backstop {
         let (selection, targets, _) = moves;
-        if let Some(ahead) = self.ahead.take() {
-            let same = ahead.targets.as_slice() == targets
+        let same = self.ahead.as_ref().is_some_and(|ahead| {
+            ahead.targets.as_slice() == targets
                 && selection
                     .iter()
                     .map(|&(v, _)| v)
-                    .eq(ahead.vertices.iter().copied());
-            if same {
+                    .eq(ahead.vertices.iter().copied())
+        });
+        match self.ahead.take() {
+            Some(ahead) if same => {
                 self.uploads.clamped_ahead += 1;
                 tally(&mut self.filter, &ahead.backstop, self.backstop_on_gpu);
                 let positions = mesh.positions_mut();
@@ -1734,15 +1741,11 @@ impl StepKernels for GpuKernels {
                 self.taken = Some((ahead.vertices, ahead.finals));
                 return ahead.backstop;
             }
-            self.drop_queued(mesh);
-            let resident = self.resident.as_ref();
-            put_back(
-                &self.gpu,
-                resident,
-                &mut self.uploads,
-                mesh,
-                &ahead.vertices,
-            );
+            // Passes run ahead for other moves: dropped, with the samples queued after them.
+            not_these => {
+                self.ahead = not_these;
+                self.drop_ahead(mesh);
+            }
         }
         if self.proximity_on_gpu
             && let Some((finals, backstop)) =
@@ -1772,8 +1775,7 @@ impl StepKernels for GpuKernels {
     }
 
     fn remeshed(&mut self, mesh: &Mesh, since: MeshVersion, changed: &[u32]) {
-        self.drop_ahead(mesh);
-        self.drop_queued(mesh);
+        self.drop_all_ahead(mesh);
         if self.failed.is_none() {
             self.gpu_remeshed(mesh, since, changed);
         }

@@ -85,7 +85,7 @@ impl GpuKernels {
         limit: f32,
     ) -> Result<(), GpuError> {
         self.check_injected_failure()?;
-        self.drop_ahead(mesh);
+        self.drop_all_ahead(mesh);
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
