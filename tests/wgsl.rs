@@ -11,8 +11,8 @@ use slayer::gpu::shaders::{
 };
 use slayer::gpu::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, ProximityParams,
-    SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
+    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, OverlayParams,
+    ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -409,6 +409,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
         "moving_entries",
         "backstop",
         "moved_normals",
+        "overlay_members",
     ] {
         assert_layout!(
             kernel,
@@ -470,6 +471,17 @@ fn proximity_and_normal_structs_match_naga_layout() {
                 vertex_rows_base,
                 _pad0,
                 _pad1
+            }
+        );
+    }
+    for kernel in ["overlay_members", "overlay_keys", "overlay_entries"] {
+        assert_layout!(
+            kernel,
+            OverlayParams {
+                count,
+                room,
+                table_mask,
+                inv_cell_size
             }
         );
     }

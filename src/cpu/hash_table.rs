@@ -4,8 +4,10 @@
 
 use glam::Vec3;
 
-use super::{cell_counts, cell_keys, scan, scan_add, scatter};
-use crate::gpu::{CellKeyParams, CountParams, CsrTable, SCAN_BLOCK};
+use super::{
+    OverlaySlots, cell_counts, cell_keys, overlay_entries, overlay_keys, scan, scan_add, scatter,
+};
+use crate::gpu::{CellKeyParams, CountParams, CsrTable, OverlayParams, SCAN_BLOCK};
 
 /// Exclusive prefix sum in place, by the same levels of blocks as `record_exclusive_scan`.
 pub fn exclusive_scan(values: &mut [u32]) {
@@ -45,5 +47,36 @@ pub fn hash_table(
     exclusive_scan(&mut offsets);
     let mut entries = vec![0u32; offsets[table_size as usize] as usize];
     scatter(&params, &keys, &ranks, &offsets, &mut entries);
+    CsrTable { offsets, entries }
+}
+
+/// The overlay table of `slots` (`params.room` of them; `table_mask`, `inv_cell_size` its
+/// table's), as `src/gpu/overlay.rs` rebuilds it on the GPU: keys and flags per slot, the
+/// counting sort over every slot of the room, slots turned into vertex ids.
+pub fn overlay_slot_table(params: &OverlayParams, slots: &OverlaySlots) -> CsrTable {
+    let room = params.room as usize;
+    let over_slots = OverlayParams {
+        count: params.room,
+        ..*params
+    };
+    let mut keys = vec![0u32; room];
+    let mut flags = vec![0u32; room];
+    overlay_keys(
+        &over_slots,
+        &slots.members,
+        slots.member_count,
+        &slots.filed_at,
+        &mut keys,
+        &mut flags,
+    );
+    let count = CountParams::new(room);
+    let table_size = params.table_mask as usize + 1;
+    let mut offsets = vec![0u32; table_size + 1];
+    let mut ranks = vec![0u32; room];
+    cell_counts(&count, &keys, &flags, &mut offsets, &mut ranks);
+    exclusive_scan(&mut offsets);
+    let mut entries = vec![0u32; offsets[table_size] as usize];
+    scatter(&count, &keys, &ranks, &offsets, &mut entries);
+    overlay_entries(&over_slots, &slots.members, &offsets, &mut entries);
     CsrTable { offsets, entries }
 }

@@ -102,26 +102,14 @@ impl GpuHashTable {
             inv_cell_size,
             table_size,
         )?;
-        let per_vertex = gpu.uniform_buffer("hash params", &CountParams::new(vertex_count));
-        let cell_counts = gpu.compute_pipeline("cell_counts")?;
-        gpu.record_dispatch(
+        record_counting_sort(
+            gpu,
             encoder,
-            &cell_counts,
-            "cell_counts",
-            &[&per_vertex, &keys, flags, &offsets, &ranks],
+            (&keys, flags, &ranks),
+            (&offsets, &entries),
             vertex_count,
-            WORKGROUP_SIZE,
-        );
-        record_exclusive_scan(gpu, encoder, &offsets, table_size as usize + 1)?;
-        let scatter = gpu.compute_pipeline("scatter")?;
-        gpu.record_dispatch(
-            encoder,
-            &scatter,
-            "scatter",
-            &[&per_vertex, &keys, &ranks, &offsets, &entries],
-            vertex_count,
-            WORKGROUP_SIZE,
-        );
+            table_size,
+        )?;
         Ok(GpuHashTable {
             table_size,
             inv_cell_size,
@@ -139,6 +127,40 @@ impl GpuHashTable {
         let entries = gpu.read_buffer(&self.entries, filed)?;
         Ok(CsrTable { offsets, entries })
     }
+}
+
+/// Records the counting sort of `count` items by their `keys` (those whose `flags` say dead left
+/// out; `ranks` is scratch of `count` words) into a table of `table_size` buckets: `offsets`,
+/// zero on entry, becomes the bucket starts and `entries` the item indices, bucket by bucket.
+pub fn record_counting_sort(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (keys, flags, ranks): (&wgpu::Buffer, &wgpu::Buffer, &wgpu::Buffer),
+    (offsets, entries): (&wgpu::Buffer, &wgpu::Buffer),
+    count: usize,
+    table_size: u32,
+) -> Result<(), GpuError> {
+    let per_item = gpu.uniform_buffer("hash params", &CountParams::new(count));
+    let cell_counts = gpu.compute_pipeline("cell_counts")?;
+    gpu.record_dispatch(
+        encoder,
+        &cell_counts,
+        "cell_counts",
+        &[&per_item, keys, flags, offsets, ranks],
+        count,
+        WORKGROUP_SIZE,
+    );
+    record_exclusive_scan(gpu, encoder, offsets, table_size as usize + 1)?;
+    let scatter = gpu.compute_pipeline("scatter")?;
+    gpu.record_dispatch(
+        encoder,
+        &scatter,
+        "scatter",
+        &[&per_item, keys, ranks, offsets, entries],
+        count,
+        WORKGROUP_SIZE,
+    );
+    Ok(())
 }
 
 /// Builds the table for `positions` and per-vertex flag bits on the GPU and reads it back.

@@ -267,3 +267,18 @@ pub struct NormalParams {
     pub _pad0: u32,
     pub _pad1: u32,
 }
+
+/// `OverlayParams` in `wgsl/shared/overlay.wgsl` (`overlay_members`, `overlay_keys`,
+/// `overlay_entries`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct OverlayParams {
+    /// Invocations: slots of the moving list (`overlay_members`), of the member list (the
+    /// others).
+    pub count: u32,
+    /// Slots the member list has room for.
+    pub room: u32,
+    /// Overlay table size minus one.
+    pub table_mask: u32,
+    pub inv_cell_size: f32,
+}

@@ -51,14 +51,18 @@ pub use hash_table::{
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, ProximityParams,
-    PulledVertex, SelectParams, SelectedVertex,
+    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, OverlayParams,
+    ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
 pub use moving_entries::{
     BuiltEntries, BuiltEntryBuffers, ENTRIES_WORKGROUP_SIZE, EntryBuffers, RING_STRIDE,
     entry_params, record_moving_entries, ring_bytes, run_moving_entries,
 };
-pub use overlay::{Filing, OverlayBuffers, TableBuffers, overlay_limit, overlay_table};
+pub use overlay::{
+    Filed, Filing, OverlayBuffers, SlotBuffers, TableBuffers, overlay_limit, overlay_table,
+    overlay_table_sized, record_overlay_members, record_overlay_table, run_overlay_members,
+    run_overlay_table,
+};
 pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};
 pub use proximity::{
     PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,

@@ -21,6 +21,10 @@ pub const SHARED: &[(&str, &str)] = &[
         include_str!("../../wgsl/shared/normals.wgsl"),
     ),
     (
+        "shared/overlay",
+        include_str!("../../wgsl/shared/overlay.wgsl"),
+    ),
+    (
         PAGED_ARRAY,
         include_str!("../../wgsl/shared/paged_array.wgsl"),
     ),
@@ -57,6 +61,15 @@ pub const KERNELS: &[(&str, &str)] = &[
     (
         "moved_normals",
         include_str!("../../wgsl/moved_normals.wgsl"),
+    ),
+    (
+        "overlay_members",
+        include_str!("../../wgsl/overlay_members.wgsl"),
+    ),
+    ("overlay_keys", include_str!("../../wgsl/overlay_keys.wgsl")),
+    (
+        "overlay_entries",
+        include_str!("../../wgsl/overlay_entries.wgsl"),
     ),
 ];
 
