@@ -46,10 +46,11 @@ use super::{
     FRAME_WORKGROUP_SIZE, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
     MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
     ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, Workgroups,
+    Filed, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, Workgroups,
     backstop_params, check_invocations, deform_params, entry_params, frame_params,
     frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
     overlay_table, pass_params, record_apply_moves, record_backstop, record_brush_frame,
+    record_overlay_members, record_overlay_table,
     record_deform, record_dispatch_args, record_moving_entries, record_proximity, record_select,
     ring_bytes, smoothing_neighbours, table_size_for,
 };
@@ -121,15 +122,32 @@ struct Hashed {
     overlay: Option<Overlay>,
     /// Vertices moved since the last filing (unsorted, may repeat).
     moved: Vec<u32>,
+    /// The GPU refiled the overlay since the host did (samples run ahead): `overlay.members`
+    /// and the marks no longer say what it holds, so the host refiles before the next use.
+    filed_on_gpu: bool,
 }
 
 /// The overlay table and its members.
 struct Overlay {
-    /// Ascending vertex ids.
+    /// Ascending vertex ids, as the host filed them; slot + 1 is each one's mark.
     members: Vec<u32>,
     table_size: u32,
     offsets: ReusableBuffer,
     entries: ReusableBuffer,
+    /// The members in slots, for refiling on the GPU (`super::overlay`).
+    slots: SlotBuffers,
+}
+
+impl Overlay {
+    fn empty() -> Overlay {
+        Overlay {
+            members: Vec::new(),
+            table_size: 0,
+            offsets: ReusableBuffer::storage("overlay offsets"),
+            entries: ReusableBuffer::storage("overlay entries"),
+            slots: SlotBuffers::default(),
+        }
+    }
 }
 
 impl Hashed {
@@ -140,12 +158,7 @@ impl Hashed {
     /// when they pass [`overlay_limit`] (or the overlay's buffers the adapter's limits):
     /// rebuild the main table instead.
     fn refile(&mut self, gpu: &GpuContext, mesh: &Mesh, changed: &[u32]) -> bool {
-        let overlay = self.overlay.get_or_insert_with(|| Overlay {
-            members: Vec::new(),
-            table_size: 0,
-            offsets: ReusableBuffer::storage("overlay offsets"),
-            entries: ReusableBuffer::storage("overlay entries"),
-        });
+        let overlay = self.overlay.get_or_insert_with(Overlay::empty);
         let mut members = std::mem::take(&mut self.moved);
         members.extend_from_slice(&overlay.members);
         members.extend_from_slice(changed);
@@ -163,13 +176,76 @@ impl Hashed {
         }
         let mut patches = Patches::default();
         patches.rows(&self.positions, mesh.positions(), &members);
-        for &v in &members {
-            patches.write(&self.marks, v as usize, &[1u32]);
+        for (slot, &v) in members.iter().enumerate() {
+            patches.write(&self.marks, v as usize, &[slot as u32 + 1]);
         }
         patches.submit(gpu);
         overlay.members = members;
         self.drift = 0.0;
+        self.filed_on_gpu = false;
         true
+    }
+
+    /// Makes the overlay ready to be refiled on the GPU in slots with room for `room`
+    /// members, its table sized for them; the host's filing is then out of date until it
+    /// refiles. Record [`Hashed::record_gpu_table`] before the overlay is next read.
+    fn start_gpu_filing(&mut self, gpu: &GpuContext, room: usize) -> Result<(), GpuError> {
+        self.filed_on_gpu = true;
+        let overlay = self.overlay.get_or_insert_with(Overlay::empty);
+        let room = room.max(overlay.members.len());
+        let table_size = table_size_for(room);
+        overlay.slots.start(gpu, &overlay.members, room)?;
+        // Grown buffers lose their contents: the table is rebuilt from the slots first.
+        overlay.offsets.reserve(gpu, 4 * (table_size as u64 + 1))?;
+        overlay.entries.reserve(gpu, 4 * room as u64)?;
+        overlay.table_size = table_size;
+        Ok(())
+    }
+
+    /// Records the rebuild of the overlay table from its slots ([`Hashed::start_gpu_filing`]).
+    fn record_gpu_table(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<(), GpuError> {
+        let (Some(overlay), Some(table)) = (&self.overlay, self.overlay()) else {
+            unreachable!("start_gpu_filing made the overlay");
+        };
+        let inv_cell_size = self.table.inv_cell_size;
+        record_overlay_table(
+            gpu,
+            encoder,
+            &overlay.slots,
+            &self.positions,
+            table.table,
+            inv_cell_size,
+        )
+    }
+
+    /// Records the filing of the entries of the first `slots` slots of `moving` that are away
+    /// from their start in `positions` where they are, and the rebuild of the table.
+    fn record_gpu_filing(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        positions: &wgpu::Buffer,
+        (moving, slots): (&wgpu::Buffer, usize),
+    ) -> Result<(), GpuError> {
+        let Some(overlay) = &self.overlay else {
+            unreachable!("start_gpu_filing made the overlay");
+        };
+        let filed = Filed {
+            marks: &self.marks,
+            filed_at: &self.positions,
+        };
+        record_overlay_members(
+            gpu,
+            encoder,
+            (positions, moving, slots),
+            &overlay.slots,
+            filed,
+        )?;
+        self.record_gpu_table(gpu, encoder)
     }
 
     /// Notes that `vertices` moved by at most `max_move`: they are filed anew at the next
@@ -625,7 +701,9 @@ impl GpuKernels {
         let stale = table_use.drift_limit(cell).is_some_and(|limit| {
             r.hashed
                 .as_ref()
-                .is_none_or(|h| h.drift > limit || h.table.inv_cell_size != 1.0 / cell)
+                .is_none_or(|h| {
+                    h.drift > limit || h.filed_on_gpu || h.table.inv_cell_size != 1.0 / cell
+                })
         });
         // Drift is undone by filing the moved vertices in the overlay; the table is rebuilt
         // over every vertex only when there is none yet, its cells changed size, or the
@@ -667,6 +745,7 @@ impl GpuKernels {
                 drift: 0.0,
                 overlay: None,
                 moved: Vec::new(),
+                filed_on_gpu: false,
             });
         }
         Ok(r)

@@ -37,12 +37,6 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
 
-/// The samples of one submission may together move vertices this many cells from where the
-/// table filed them: every query's reach grows by that drift (the passes' work with its cube),
-/// and the table is refiled only between submissions. With steps of a cell (plaster, 2K faces)
-/// that is runs of three samples.
-const DRIFT_AHEAD_CELLS: f32 = 2.0;
-
 /// A sample recorded ahead, waiting for the pipeline to reach it.
 pub(super) struct QueuedSample {
     /// Where it is in the plan, and the probe the pipeline will ask with.
@@ -98,35 +92,41 @@ impl GpuKernels {
         )?;
         let capacity = r.selection.capacity;
         let guess = selection_guess(self.last_selection, capacity);
+        // Each sample's moved vertices are filed in the overlay on the GPU before the next
+        // (`Hashed::record_gpu_filing`): every sample queries with the drift of the first.
         let drift = r.hashed().drift;
-        let cell = 1.0 / r.hashed().table.inv_cell_size;
-        // Sample j starts from a drift of `drift + j · assumed_move`.
-        let by_drift = ((DRIFT_AHEAD_CELLS * cell - drift).max(0.0) / assumed_move) as usize + 1;
-        let count = (self.plan.len() - from)
-            .min(
-                self.run_length
-                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
-            )
-            .min(by_drift);
+        let count = (self.plan.len() - from).min(
+            self.run_length
+                .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
+        );
         if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
             return Ok(());
         }
         step.reserve_sample(gpu, (r, mesh), guess, true, true, filter)?;
+        // Room for the overlay's members and for every slot of the moving lists of the samples
+        // that file theirs (all but the last); no more than the vertices there are.
+        let room = (r.hashed().overlay.as_ref().map_or(0, |o| o.members.len())
+            + (count - 1) * guess)
+            .min(r.vertices.count);
+        let Some(hashed) = &mut r.hashed else {
+            unreachable!("prepare built the hash table");
+        };
+        hashed.start_gpu_filing(gpu, room)?;
         let r = &*r;
         let Some(topology) = &r.topology else {
             unreachable!("reserve_sample made the topology resident");
         };
         let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
         let mut encoder = gpu.encoder("samples ahead");
+        r.hashed().record_gpu_table(gpu, &mut encoder)?;
         let mut layout = None;
         let mut sample_bytes = 0;
         for j in 0..count {
             let (dab, normal) = self.plan[from + j];
             // Every step before this one moved vertices by at most the assumed move, and
             // lengthened edges by at most twice that.
-            let grown = j as f32 * assumed_move;
             let state = StrokeState {
-                max_edge: state.max_edge + 2.0 * grown,
+                max_edge: state.max_edge + 2.0 * j as f32 * assumed_move,
                 ..*state
             };
             let recorded = record_sample(
@@ -139,7 +139,7 @@ impl GpuKernels {
                 guess,
                 Some(AheadBounds {
                     assumed_move,
-                    drift: drift + grown,
+                    drift,
                 }),
                 filter,
             )?;
@@ -151,6 +151,14 @@ impl GpuKernels {
                 (step.moving.buffer(), guess),
                 &r.normals,
             )?;
+            if j + 1 < count {
+                r.hashed().record_gpu_filing(
+                    gpu,
+                    &mut encoder,
+                    &r.vertices.positions,
+                    (step.moving.buffer(), guess),
+                )?;
+            }
             let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
             parts.extend_from_slice(&recorded.parts);
             if j == 0 {
@@ -167,6 +175,8 @@ impl GpuKernels {
         self.run_taken = 0;
 
         let mut dropped_from = None;
+        // What the GPU filed, for the host's next filing to hold too.
+        let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
             let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
                 .min(capacity);
@@ -175,6 +185,9 @@ impl GpuKernels {
             let (dab, normal) = self.plan[from + j];
             let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
             let (order, selection) = in_vertex_order(&list);
+            if j + 1 < count {
+                filed_on_gpu.extend(list.iter().map(|s| s.vertex));
+            }
             self.last_selection = self.last_selection.max(found);
             if found > guess || parts.ring_overflows != Some(0) || dropped_from.is_some() {
                 // This sample's passes ran on a cut list or cut rings, and the later ones on
@@ -216,6 +229,9 @@ impl GpuKernels {
                 ahead,
                 assumed_move,
             });
+        }
+        if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
+            hashed.moved.extend_from_slice(&filed_on_gpu);
         }
         Ok(())
     }
