@@ -17,7 +17,8 @@
 //! - the hash table: built once; the vertices moved or changed since are filed in its overlay
 //!   (`super::overlay`) and refiled when they drift farther than the use tolerates — queries
 //!   grow their reach by the drift until then (`select`, `proximity`); rebuilt over every
-//!   vertex only when the overlay passes its limit;
+//!   vertex only when the overlay passes its limit; between samples run ahead, the GPU files
+//!   each sample's moved vertices in the overlay itself, and the host refiles after;
 //! - per-step buffers: grown when a step needs more, never reallocated otherwise.
 //!
 //! A step is one submission with one blocking read-back where it can be: selection and
@@ -43,16 +44,16 @@ use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
     BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
-    FRAME_WORKGROUP_SIZE, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
+    FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
     MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
     ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    Filed, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers, Workgroups,
-    backstop_params, check_invocations, deform_params, entry_params, frame_params,
+    SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
+    Workgroups, backstop_params, check_invocations, deform_params, entry_params, frame_params,
     frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
     overlay_table, pass_params, record_apply_moves, record_backstop, record_brush_frame,
-    record_overlay_members, record_overlay_table,
-    record_deform, record_dispatch_args, record_moving_entries, record_proximity, record_select,
-    ring_bytes, smoothing_neighbours, table_size_for,
+    record_deform, record_dispatch_args, record_moving_entries, record_overlay_members,
+    record_overlay_table, record_proximity, record_select, ring_bytes, smoothing_neighbours,
+    table_size_for,
 };
 use crate::brush::{Dab, DabFrame};
 
@@ -114,7 +115,7 @@ struct Hashed {
     table: GpuHashTable,
     /// Where each vertex was filed: at the build, or for the overlay's members at their filing.
     positions: wgpu::Buffer,
-    /// Per vertex: nonzero when filed in the overlay.
+    /// Per vertex: its slot in the overlay + 1 (`super::overlay`), 0 when not filed there.
     marks: wgpu::Buffer,
     /// How far any vertex may have moved since it was filed.
     drift: f32,
@@ -699,11 +700,9 @@ impl GpuKernels {
     ) -> Result<&'a mut Resident, GpuError> {
         let r = GpuKernels::sync(gpu, (resident, uploads), mesh)?;
         let stale = table_use.drift_limit(cell).is_some_and(|limit| {
-            r.hashed
-                .as_ref()
-                .is_none_or(|h| {
-                    h.drift > limit || h.filed_on_gpu || h.table.inv_cell_size != 1.0 / cell
-                })
+            r.hashed.as_ref().is_none_or(|h| {
+                h.drift > limit || h.filed_on_gpu || h.table.inv_cell_size != 1.0 / cell
+            })
         });
         // Drift is undone by filing the moved vertices in the overlay; the table is rebuilt
         // over every vertex only when there is none yet, its cells changed size, or the
@@ -1758,7 +1757,7 @@ impl StepKernels for GpuKernels {
         // At a sample's start: the sample run ahead, or a run of the samples planned from it.
         if let FrameSource::Selection { normal } = source {
             let probe = (*dab, normal);
-            if let Some(deformed) = self.take_queued(mesh, &probe) {
+            if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
                 return deformed;
             }
             let runs_ahead = self.proximity_on_gpu
@@ -1767,7 +1766,7 @@ impl StepKernels for GpuKernels {
                 && self.failed.is_none();
             if let Some(from) = self.planned(&probe).filter(|_| runs_ahead) {
                 self.on_gpu(|k| k.gpu_run_ahead(state, mesh, from, step_limit));
-                if let Some(deformed) = self.take_queued(mesh, &probe) {
+                if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
                     return deformed;
                 }
             }

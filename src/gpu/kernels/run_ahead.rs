@@ -1,14 +1,18 @@
 //! A stroke's samples recorded ahead, several in one submission. The pipeline tells the
 //! kernels the samples it will ask for ([`StepKernels::upcoming`]); at a sample's start the
 //! kernels record that sample and the next ones one after another — each one's selection,
-//! brush frame, deformation, moving entries, proximity passes, backstop filter and the normals
-//! its moves turned (`moved_normals`), each reading the positions and normals the one before
-//! left on the GPU — copy each one's results aside, and read them all back in one map. The
-//! pipeline then takes them one by one as if each had been a submission of its own.
+//! brush frame, deformation, moving entries, proximity passes, backstop filter, the normals
+//! its moves turned (`moved_normals`) and the filing of its moved vertices in the hash table's
+//! overlay (`overlay_members`, then the overlay rebuilt from its slots), each reading the
+//! positions, normals and table the one before left on the GPU — copy each one's results
+//! aside, and read them all back in one map. The pipeline then takes them one by one as if each
+//! had been a submission of its own. Because each sample files what it moved, every sample of a
+//! run queries the table with the first one's drift, however long the run.
 //!
 //! What the GPU ran is what the pipeline would have asked for only while its predictions
-//! hold: each sample one step within the move its passes were sized for (checked against the
-//! mesh when the pipeline reaches the sample), its selection within the guessed list and its
+//! hold: each sample one step within the move its passes were sized for and the mesh's edges
+//! within the bound they were sized for (checked against the mesh and the pipeline's edge
+//! bound when the pipeline reaches the sample), its selection within the guessed list and its
 //! rings within their room (checked when read back), and the exact backstop undoing nothing
 //! (checked when the pipeline reports the sample's moves). From the first sample where one
 //! fails, the rest are dropped: the rows they wrote go back to the mesh's (positions, and the
@@ -37,6 +41,14 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
 
+/// A run's later samples assume the mesh's longest edge grows by at most this share of the
+/// assumed move per sample before them, and are dropped when the pipeline's edge bound at their
+/// start says otherwise. A step lengthens an edge by at most twice its longest move, but the
+/// passes' reach grows with the edge bound (their work with its cube): plaster at 2K faces,
+/// steps of a cell, grew its longest edge by 0 to 0.32 of the step limit a sample; assuming the
+/// worst case (2) made a run of four samples cost three times one assuming this share.
+const EDGE_GROWTH_AHEAD: f32 = 0.5;
+
 /// A sample recorded ahead, waiting for the pipeline to reach it.
 pub(super) struct QueuedSample {
     /// Where it is in the plan, and the probe the pipeline will ask with.
@@ -47,6 +59,8 @@ pub(super) struct QueuedSample {
     ahead: Option<ClampedAhead>,
     /// The longest move the passes were sized for.
     assumed_move: f32,
+    /// The bound on the mesh's edges at the sample's start the passes were sized for.
+    max_edge: f32,
 }
 
 /// The vertices a queued sample's passes may have moved.
@@ -66,11 +80,11 @@ impl GpuKernels {
             .filter(|&at| at + 1 < self.plan.len())
     }
 
-    /// Records the planned samples from `from` on in one submission (as many as
-    /// [`MAX_SAMPLES_AHEAD`] and the table's drift allow; nothing when that is fewer than
-    /// two) and queues what each left for the pipeline. The passes are sized as a single
-    /// step's would be (`assumed_move`: twice the last move, within `limit`), the step of each
-    /// later sample starting from edges and a drift grown by the samples before it.
+    /// Records the planned samples from `from` on in one submission (as many as the run's
+    /// length, at most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
+    /// what each left for the pipeline. The passes are sized as a single step's would be
+    /// (`assumed_move`: twice the last move, within `limit`), each later sample's from edges
+    /// grown by [`EDGE_GROWTH_AHEAD`] of that move per sample before it.
     pub(super) fn gpu_run_ahead(
         &mut self,
         state: &StrokeState<'_>,
@@ -119,14 +133,15 @@ impl GpuKernels {
         let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
         let mut encoder = gpu.encoder("samples ahead");
         r.hashed().record_gpu_table(gpu, &mut encoder)?;
+        // The edges as the samples before sample j may have lengthened them (checked when the
+        // pipeline reaches it).
+        let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
         let mut layout = None;
         let mut sample_bytes = 0;
         for j in 0..count {
             let (dab, normal) = self.plan[from + j];
-            // Every step before this one moved vertices by at most the assumed move, and
-            // lengthened edges by at most twice that.
             let state = StrokeState {
-                max_edge: state.max_edge + 2.0 * j as f32 * assumed_move,
+                max_edge: edge_bound(j),
                 ..*state
             };
             let recorded = record_sample(
@@ -228,6 +243,7 @@ impl GpuKernels {
                 },
                 ahead,
                 assumed_move,
+                max_edge: edge_bound(j),
             });
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
@@ -237,17 +253,25 @@ impl GpuKernels {
     }
 
     /// The queued sample the pipeline starts with `probe`, when it is the next one queued and
-    /// its moves are one step within what its passes assumed, from where the mesh is now. Any
-    /// other probe, or moves past the assumption, drop the queue.
+    /// its moves are one step within what its passes assumed, from where the mesh is now, and
+    /// the pipeline's bound on the edges (`max_edge`) within theirs. Any other probe, or moves
+    /// or edges past the assumption, drop the queue.
     /// A sample dropped for moving too far is not run ahead again: the pipeline takes it one
     /// submission per step, and the next sample starts a new run sized from its move.
-    pub(super) fn take_queued(&mut self, mesh: &Mesh, probe: &SampleProbe) -> Option<Deformed> {
+    pub(super) fn take_queued(
+        &mut self,
+        mesh: &Mesh,
+        probe: &SampleProbe,
+        max_edge: f32,
+    ) -> Option<Deformed> {
         if self.failed.is_some() {
             self.queued.clear();
             return None;
         }
         let head = self.queued.front()?;
-        if head.probe != *probe {
+        // A NaN bound does not fit either.
+        let edges_fit = max_edge <= head.max_edge;
+        if head.probe != *probe || !edges_fit {
             self.drop_queued(mesh);
             return None;
         }
