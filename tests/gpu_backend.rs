@@ -114,6 +114,8 @@ fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
     let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
     let mut kernels = all_on_gpu();
     kernels.set_run_ahead(true);
+    // What the GPU files between samples is read back and checked before the host refiles.
+    kernels.set_check_filing(true);
     let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
     let mut gpu_collisions = 0;
     let mut samples = 0;

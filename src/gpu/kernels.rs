@@ -43,19 +43,20 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
-    BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
-    FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
-    MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
-    ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
-    Workgroups, backstop_params, check_invocations, deform_params, entry_params, frame_params,
-    frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
-    overlay_table, pass_params, record_apply_moves, record_backstop, record_brush_frame,
-    record_deform, record_dispatch_args, record_moving_entries, record_overlay_members,
-    record_overlay_table, record_proximity, record_select, ring_bytes, smoothing_neighbours,
-    table_size_for,
+    BackstopParams, BrushSphere, BuiltEntryBuffers, CsrTable, DeformBuffers, EntryBuffers,
+    FACE_WORDS, FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection,
+    HashedVertices, MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE,
+    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
+    SelectionBuffers, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout,
+    VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params, entry_params,
+    frame_params, frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices,
+    overlay_limit, overlay_table, pass_params, record_apply_moves, record_backstop,
+    record_brush_frame, record_deform, record_dispatch_args, record_moving_entries,
+    record_overlay_members, record_overlay_table, record_proximity, record_select, ring_bytes,
+    smoothing_neighbours, table_size_for,
 };
 use crate::brush::{Dab, DabFrame};
+use crate::grid::{cell_coordinates, hash_cell};
 
 mod run_ahead;
 use crate::cpu::FRAME_SUM_WORDS;
@@ -126,6 +127,10 @@ struct Hashed {
     /// The GPU refiled the overlay since the host did (samples run ahead): `overlay.members`
     /// and the marks no longer say what it holds, so the host refiles before the next use.
     filed_on_gpu: bool,
+    /// While the GPU's filing is in place and no sample run ahead was dropped since: how far
+    /// any vertex may be from where it is filed — the drift the run's queries assumed, plus
+    /// the moves taken since that the GPU did not file. `None` when unknown.
+    gpu_drift: Option<f32>,
 }
 
 /// The overlay table and its members.
@@ -184,6 +189,7 @@ impl Hashed {
         overlay.members = members;
         self.drift = 0.0;
         self.filed_on_gpu = false;
+        self.gpu_drift = None;
         true
     }
 
@@ -192,6 +198,7 @@ impl Hashed {
     /// refiles. Record [`Hashed::record_gpu_table`] before the overlay is next read.
     fn start_gpu_filing(&mut self, gpu: &GpuContext, room: usize) -> Result<(), GpuError> {
         self.filed_on_gpu = true;
+        self.gpu_drift = Some(self.drift);
         let overlay = self.overlay.get_or_insert_with(Overlay::empty);
         let room = room.max(overlay.members.len());
         let table_size = table_size_for(room);
@@ -249,10 +256,76 @@ impl Hashed {
         self.record_gpu_table(gpu, encoder)
     }
 
+    /// Reads the filing back and checks that queries find every live vertex of `mesh`: a
+    /// marked one in the overlay bucket of where it is filed (its mark naming its slot when
+    /// the host filed it), another in the main table's; and, while the host's filing is
+    /// current, each filed within the drift of where it is.
+    fn check(&self, gpu: &GpuContext, mesh: &Mesh) -> Result<(), String> {
+        let n = mesh.vertex_count();
+        let fail = |e: GpuError| e.to_string();
+        let filed_at: Vec<Vec3> = gpu.read_buffer(&self.positions, n).map_err(fail)?;
+        let marks: Vec<u32> = gpu.read_buffer(&self.marks, n).map_err(fail)?;
+        let main = self.table.read(gpu).map_err(fail)?;
+        let overlay = match &self.overlay {
+            Some(o) => {
+                let offsets: Vec<u32> = gpu
+                    .read_buffer(o.offsets.buffer(), o.table_size as usize + 1)
+                    .map_err(fail)?;
+                let filed = offsets[o.table_size as usize] as usize;
+                let entries = gpu.read_buffer(o.entries.buffer(), filed).map_err(fail)?;
+                Some(CsrTable { offsets, entries })
+            }
+            None => None,
+        };
+        let inv = self.table.inv_cell_size;
+        for v in (0..n as u32).filter(|&v| !mesh.is_vertex_dead(v)) {
+            let at = filed_at[v as usize];
+            let (table, which) = match (&overlay, marks[v as usize]) {
+                (_, 0) => (&main, "main table"),
+                (Some(o), _) => (o, "overlay"),
+                (None, _) => return Err(format!("vertex {v} is marked with no overlay")),
+            };
+            let bucket = hash_cell(cell_coordinates(at, inv), table.table_size() as u32);
+            if !table.bucket(bucket).contains(&v) {
+                return Err(format!("vertex {v} is not in its {which} bucket"));
+            }
+            let bound = match (self.filed_on_gpu, self.gpu_drift) {
+                (false, _) => self.drift,
+                (true, Some(bound)) => bound,
+                (true, None) => continue,
+            };
+            let drift = at.distance(mesh.positions()[v as usize]);
+            if drift > bound * (1.0 + 1e-5) + 1e-6 {
+                return Err(format!(
+                    "vertex {v} drifted {drift} from its filing, past {bound}"
+                ));
+            }
+            if self.filed_on_gpu {
+                continue;
+            }
+            if let (Some(o), m @ 1..) = (&self.overlay, marks[v as usize])
+                && o.members.get(m as usize - 1) != Some(&v)
+            {
+                return Err(format!("the mark of vertex {v} names another's slot"));
+            }
+        }
+        Ok(())
+    }
+
     /// Notes that `vertices` moved by at most `max_move`: they are filed anew at the next
-    /// refiling, and until then queries reach that much farther.
-    fn note_moved(&mut self, vertices: &[u32], max_move: f32, vertex_count: usize) {
+    /// refiling, and until then queries reach that much farther. `filed_on_gpu`: a sample run
+    /// ahead that filed them there already.
+    fn note_moved(
+        &mut self,
+        vertices: &[u32],
+        max_move: f32,
+        vertex_count: usize,
+        filed_on_gpu: bool,
+    ) {
         self.drift += max_move;
+        if !filed_on_gpu && let Some(bound) = &mut self.gpu_drift {
+            *bound += max_move;
+        }
         self.moved.extend_from_slice(vertices);
         let limit = overlay_limit(vertex_count);
         if self.moved.len() > limit {
@@ -461,6 +534,9 @@ impl Resident {
                 return Err(format!("smoothing neighbours of vertex {v} differ"));
             }
         }
+        if let Some(hashed) = &self.hashed {
+            hashed.check(gpu, mesh)?;
+        }
         let Some(topology) = &self.topology else {
             return Ok(());
         };
@@ -597,6 +673,14 @@ pub struct GpuKernels {
     /// The vertices and final positions of the last step taken from passes run ahead, to see
     /// whether the pipeline kept them (`moved`).
     taken: Option<(Vec<u32>, Vec<Vec3>)>,
+    /// The sample taken last was filed in the overlay on the GPU as it ran ahead.
+    taken_filed: bool,
+    /// Check the GPU's filing before the host replaces it (`set_check_filing`), and what the
+    /// first check found wrong.
+    check_filing: bool,
+    filing_error: Option<String>,
+    /// Read-backs the checks made, left out of [`Uploads::read_backs`].
+    check_read_backs: usize,
 }
 
 /// A merged submission's passes assume moves up to this many times the last step's longest.
@@ -644,6 +728,10 @@ impl GpuKernels {
             run_taken: 0,
             queued: run_ahead::Queue::new(),
             taken: None,
+            taken_filed: false,
+            check_filing: false,
+            filing_error: None,
+            check_read_backs: 0,
         }
     }
 
@@ -659,9 +747,28 @@ impl GpuKernels {
     /// With the proximity passes on the GPU, runs several samples of a stroke ahead in one
     /// submission (`true`) or one submission per step. On by default on hardware adapters;
     /// on lavapipe (`SLAYER_GPU_RUN_AHEAD=1` turns it on) the passes of a run, sized for the
-    /// drift of the samples before them, cost several times what they cost apart.
+    /// move they assume rather than the one made, cost several times what they cost apart.
     pub fn set_run_ahead(&mut self, on: bool) {
         self.run_ahead = on;
+    }
+
+    /// Before the host refiles over what the GPU filed while samples ran ahead, reads that
+    /// filing back and checks it against the mesh (`Hashed::check`); the first fault is
+    /// reported by `check_copy`. A validator for tests: it reads the whole filing back.
+    pub fn set_check_filing(&mut self, on: bool) {
+        self.check_filing = on;
+    }
+
+    /// See [`GpuKernels::set_check_filing`]: called before anything may refile.
+    fn check_gpu_filing(&mut self, mesh: &Mesh) {
+        let Some(h) = self.resident.as_ref().and_then(|r| r.hashed.as_ref()) else {
+            return;
+        };
+        if self.check_filing && h.filed_on_gpu && self.filing_error.is_none() {
+            let before = self.gpu.read_backs();
+            self.filing_error = h.check(&self.gpu, mesh).err();
+            self.check_read_backs += self.gpu.read_backs() - before;
+        }
     }
 
     /// With the proximity passes on the GPU, filters the exact backstop's pairs there too
@@ -745,6 +852,7 @@ impl GpuKernels {
                 overlay: None,
                 moved: Vec::new(),
                 filed_on_gpu: false,
+                gpu_drift: None,
             });
         }
         Ok(r)
@@ -864,6 +972,7 @@ impl GpuKernels {
         clamp_within: Option<f32>,
     ) -> Result<Deformed, GpuError> {
         self.check_injected_failure()?;
+        self.check_gpu_filing(mesh);
         self.drop_all_ahead(mesh);
         let filter = self.backstop_on_gpu;
         // The passes' reach, and their work with its cube, grows with the move they assume:
@@ -1072,8 +1181,9 @@ impl GpuKernels {
             return;
         };
         upload_rows(&self.gpu, &r.vertices.positions, mesh.positions(), vertices);
+        let filed = std::mem::take(&mut self.taken_filed);
         if let Some(h) = r.hashed.as_mut() {
-            h.note_moved(vertices, max_move, mesh.vertex_count());
+            h.note_moved(vertices, max_move, mesh.vertex_count(), filed);
         }
         r.version.positions = mesh.version().positions;
     }
@@ -1754,6 +1864,7 @@ impl StepKernels for GpuKernels {
         step_limit: f32,
     ) -> Deformed {
         let how = (source, true);
+        self.taken_filed = false;
         // At a sample's start: the sample run ahead, or a run of the samples planned from it.
         if let FrameSource::Selection { normal } = source {
             let probe = (*dab, normal);
@@ -1861,7 +1972,7 @@ impl StepKernels for GpuKernels {
 
     fn uploads(&self) -> Option<Uploads> {
         Some(Uploads {
-            read_backs: self.gpu.read_backs(),
+            read_backs: self.gpu.read_backs() - self.check_read_backs,
             ..self.uploads
         })
     }
@@ -1871,6 +1982,9 @@ impl StepKernels for GpuKernels {
     }
 
     fn check_copy(&self, mesh: &Mesh) -> Result<(), String> {
+        if let Some(error) = &self.filing_error {
+            return Err(format!("the GPU's filing of samples run ahead: {error}"));
+        }
         match &self.resident {
             Some(r) if r.version == mesh.version() => r.check(&self.gpu, mesh),
             Some(_) => Err("the GPU copy is behind the mesh".into()),

@@ -61,6 +61,9 @@ pub(super) struct QueuedSample {
     assumed_move: f32,
     /// The bound on the mesh's edges at the sample's start the passes were sized for.
     max_edge: f32,
+    /// Its moved vertices were filed in the overlay on the GPU (every sample of a run but the
+    /// last).
+    filed: bool,
 }
 
 /// The vertices a queued sample's passes may have moved.
@@ -93,6 +96,7 @@ impl GpuKernels {
         limit: f32,
     ) -> Result<(), GpuError> {
         self.check_injected_failure()?;
+        self.check_gpu_filing(mesh);
         self.drop_all_ahead(mesh);
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
@@ -244,10 +248,15 @@ impl GpuKernels {
                 ahead,
                 assumed_move,
                 max_edge: edge_bound(j),
+                filed: j + 1 < count,
             });
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
+            if dropped_from.is_some() {
+                // Filed where the dropped samples put them.
+                hashed.gpu_drift = None;
+            }
         }
         Ok(())
     }
@@ -297,6 +306,7 @@ impl GpuKernels {
         }
         self.uploads.samples_ahead += 1;
         self.ahead = sample.ahead;
+        self.taken_filed = sample.filed;
         Some(sample.deformed)
     }
 
@@ -313,6 +323,10 @@ impl GpuKernels {
         vertices.sort_unstable();
         vertices.dedup();
         self.uploads.dropped_ahead += queued.iter().filter(|s| s.ahead.is_some()).count();
+        if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
+            // Filed where the dropped samples put them.
+            hashed.gpu_drift = None;
+        }
         put_back_rows(&self.gpu, self.resident.as_ref(), mesh, &vertices);
     }
 
