@@ -122,11 +122,21 @@ impl GpuHashTable {
 
     /// Copies the table back.
     pub fn read(&self, gpu: &GpuContext) -> Result<CsrTable, GpuError> {
-        let offsets: Vec<u32> = gpu.read_buffer(&self.offsets, self.table_size as usize + 1)?;
-        let filed = offsets[self.table_size as usize] as usize;
-        let entries = gpu.read_buffer(&self.entries, filed)?;
-        Ok(CsrTable { offsets, entries })
+        read_table(gpu, (&self.offsets, &self.entries), self.table_size)
     }
+}
+
+/// Copies back a table of `table_size` buckets from its `offsets` and `entries` buffers (the
+/// main table's or the overlay's): the offsets, then as many entries as they say are filed.
+pub fn read_table(
+    gpu: &GpuContext,
+    (offsets, entries): (&wgpu::Buffer, &wgpu::Buffer),
+    table_size: u32,
+) -> Result<CsrTable, GpuError> {
+    let offsets: Vec<u32> = gpu.read_buffer(offsets, table_size as usize + 1)?;
+    let filed = offsets[table_size as usize] as usize;
+    let entries = gpu.read_buffer(entries, filed)?;
+    Ok(CsrTable { offsets, entries })
 }
 
 /// Records the counting sort of `count` items by their `keys` (those whose `flags` say dead left

@@ -43,14 +43,14 @@ use glam::Vec3;
 use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
-    BackstopParams, BrushSphere, BuiltEntryBuffers, CsrTable, DeformBuffers, EntryBuffers,
-    FACE_WORDS, FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection,
-    HashedVertices, MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE,
-    PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex,
-    SelectionBuffers, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout,
-    VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params, entry_params,
-    frame_params, frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices,
-    overlay_limit, overlay_table, pass_params, record_apply_moves, record_backstop,
+    BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
+    FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
+    MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
+    ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
+    SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
+    Workgroups, backstop_params, check_invocations, deform_params, entry_params, frame_params,
+    frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
+    overlay_table, pass_params, read_table, record_apply_moves, record_backstop,
     record_brush_frame, record_deform, record_dispatch_args, record_moving_entries,
     record_overlay_members, record_overlay_table, record_proximity, record_select, ring_bytes,
     smoothing_neighbours, table_size_for,
@@ -267,14 +267,10 @@ impl Hashed {
         let marks: Vec<u32> = gpu.read_buffer(&self.marks, n).map_err(fail)?;
         let main = self.table.read(gpu).map_err(fail)?;
         let overlay = match &self.overlay {
-            Some(o) => {
-                let offsets: Vec<u32> = gpu
-                    .read_buffer(o.offsets.buffer(), o.table_size as usize + 1)
-                    .map_err(fail)?;
-                let filed = offsets[o.table_size as usize] as usize;
-                let entries = gpu.read_buffer(o.entries.buffer(), filed).map_err(fail)?;
-                Some(CsrTable { offsets, entries })
-            }
+            Some(o) => Some(
+                read_table(gpu, (o.offsets.buffer(), o.entries.buffer()), o.table_size)
+                    .map_err(fail)?,
+            ),
             None => None,
         };
         let inv = self.table.inv_cell_size;

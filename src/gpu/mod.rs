@@ -46,7 +46,8 @@ pub use deform::{
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use hash_table::{
-    CsrTable, GpuHashTable, run_cell_counts, run_hash_table, run_scatter, table_size_for,
+    CsrTable, GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter,
+    table_size_for,
 };
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{

@@ -16,7 +16,7 @@
 
 use glam::Vec3;
 
-use super::hash_table::record_counting_sort;
+use super::hash_table::{read_table, record_counting_sort};
 use super::reusable::ReusableBuffer;
 use super::{CsrTable, GpuContext, GpuError, MovingVertex, OverlayParams, table_size_for};
 use crate::cpu::OverlaySlots;
@@ -335,12 +335,7 @@ pub fn run_overlay_table(
     let mut encoder = gpu.encoder("overlay table");
     record_overlay_table(gpu, &mut encoder, &buffers, &filed_at, table, inv_cell_size)?;
     gpu.queue.submit([encoder.finish()]);
-    let offsets: Vec<u32> = gpu.read_buffer(&offsets, table_size as usize + 1)?;
-    let filed = offsets[table_size as usize] as usize;
-    Ok(CsrTable {
-        entries: gpu.read_buffer(&entries, filed)?,
-        offsets,
-    })
+    read_table(gpu, (&offsets, &entries), table_size)
 }
 
 #[cfg(test)]
