@@ -11,8 +11,9 @@ use slayer::gpu::shaders::{
 };
 use slayer::gpu::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, OverlayParams,
-    ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
+    DispatchParams, EntryParams, FrameParams, GateParams, GateStage, GateStatus, MovingVertex,
+    NormalParams, OverlayParams, ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex,
+    brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -311,6 +312,25 @@ fn wgsl_constants_match_the_host() {
             "{name}"
         );
     }
+    for (name, stage) in [
+        ("GATE_OPEN", GateStage::Open),
+        ("GATE_DECIDE", GateStage::Decide),
+        ("GATE_VACATE", GateStage::Vacate),
+    ] {
+        assert_eq!(
+            naga_u32_constant("sample_gate", name),
+            stage as u32,
+            "{name}"
+        );
+    }
+    for (name, reason) in [
+        ("STOPPED_EARLIER", GateStatus::EARLIER),
+        ("STOPPED_SELECTION", GateStatus::SELECTION),
+        ("STOPPED_RINGS", GateStatus::RINGS),
+        ("STOPPED_MOVE", GateStatus::MOVE),
+    ] {
+        assert_eq!(naga_u32_constant("sample_gate", name), reason, "{name}");
+    }
     assert_eq!(
         naga_f32_constant("proximity", "CLAMP_SLACK"),
         slayer::pipeline::step::CLAMP_SLACK
@@ -337,6 +357,8 @@ fn wgsl_constants_match_the_host() {
         ("proximity", slayer::gpu::PROXIMITY_WORKGROUP_SIZE),
         ("backstop", slayer::gpu::BACKSTOP_WORKGROUP_SIZE),
         ("moving_entries", slayer::gpu::ENTRIES_WORKGROUP_SIZE),
+        ("longest_move", slayer::gpu::GATE_WORKGROUP_SIZE),
+        ("sample_gate", slayer::gpu::GATE_WORKGROUP_SIZE),
     ] {
         assert_eq!(
             naga_u32_constant(kernel, "WORKGROUP_SIZE"),
@@ -410,6 +432,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
         "backstop",
         "moved_normals",
         "overlay_members",
+        "sample_gate",
     ] {
         assert_layout!(
             kernel,
@@ -474,6 +497,19 @@ fn proximity_and_normal_structs_match_naga_layout() {
             }
         );
     }
+    for kernel in ["longest_move", "sample_gate"] {
+        assert_layout!(
+            kernel,
+            GateParams {
+                capacity,
+                stage,
+                assumed_move,
+                _pad
+            }
+        );
+        assert_layout!(kernel, GateStatus { stopped, longest });
+    }
+    assert_layout!("longest_move", SelectedVertex { vertex, weight });
     for kernel in ["overlay_members", "overlay_keys", "overlay_entries"] {
         assert_layout!(
             kernel,

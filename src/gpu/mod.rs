@@ -8,6 +8,7 @@ mod cell_keys;
 mod context;
 mod deform;
 mod dispatch_args;
+mod gate;
 mod hash_table;
 mod kernels;
 mod layout;
@@ -45,6 +46,10 @@ pub use deform::{
     run_framed_deform, smoothing_neighbours,
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
+pub use gate::{
+    GATE_WORKGROUP_SIZE, GateBuffers, record_gate_check, record_gate_open, run_longest_move,
+    run_sample_gate,
+};
 pub use hash_table::{
     CsrTable, GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter,
     table_size_for,
@@ -52,8 +57,8 @@ pub use hash_table::{
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use layout::{
     ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, MovingVertex, NormalParams, OverlayParams,
-    ProximityParams, PulledVertex, SelectParams, SelectedVertex,
+    DispatchParams, EntryParams, FrameParams, GateParams, GateStage, GateStatus, MovingVertex,
+    NormalParams, OverlayParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
 };
 pub use moving_entries::{
     BuiltEntries, BuiltEntryBuffers, ENTRIES_WORKGROUP_SIZE, EntryBuffers, RING_STRIDE,

@@ -16,6 +16,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("shared/moves", include_str!("../../wgsl/shared/moves.wgsl")),
     ("shared/pages", include_str!("../../wgsl/shared/pages.wgsl")),
     ("shared/fixed", include_str!("../../wgsl/shared/fixed.wgsl")),
+    ("shared/gate", include_str!("../../wgsl/shared/gate.wgsl")),
     (
         "shared/normals",
         include_str!("../../wgsl/shared/normals.wgsl"),
@@ -67,6 +68,8 @@ pub const KERNELS: &[(&str, &str)] = &[
         include_str!("../../wgsl/overlay_members.wgsl"),
     ),
     ("overlay_keys", include_str!("../../wgsl/overlay_keys.wgsl")),
+    ("longest_move", include_str!("../../wgsl/longest_move.wgsl")),
+    ("sample_gate", include_str!("../../wgsl/sample_gate.wgsl")),
     (
         "overlay_entries",
         include_str!("../../wgsl/overlay_entries.wgsl"),

@@ -1,0 +1,176 @@
+//! Host side of `wgsl/longest_move.wgsl` and `wgsl/sample_gate.wgsl`: the gate that stops a run
+//! of samples recorded ahead in one submission at the first sample whose passes were recorded
+//! on assumptions that fail (`wgsl/shared/gate.wgsl`), before that sample moves anything, and
+//! makes every later sample of the run select nothing.
+
+use glam::Vec3;
+
+use super::{
+    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
+};
+
+/// Workgroup size of `longest_move` and `sample_gate`.
+pub const GATE_WORKGROUP_SIZE: u32 = 64;
+
+/// What the gate reads and writes.
+pub struct GateBuffers<'a> {
+    /// Packed x, y, z per vertex: the sample's start positions.
+    pub positions: &'a wgpu::Buffer,
+    pub selected: &'a wgpu::Buffer,
+    pub selection_count: &'a wgpu::Buffer,
+    /// Packed x, y, z per selection entry (`deform`'s).
+    pub targets: &'a wgpu::Buffer,
+    /// One `u32`: the rings `moving_entries` cut short.
+    pub ring_overflows: &'a wgpu::Buffer,
+    pub moving: &'a wgpu::Buffer,
+    /// One [`GateStatus`] for the whole run, zeroed at its start.
+    pub status: &'a wgpu::Buffer,
+}
+
+/// Invocations a `sample_gate` stage runs: one to open or decide, one per slot to vacate.
+fn stage_invocations(params: &GateParams) -> usize {
+    if params.stage == GateStage::Vacate as u32 {
+        params.capacity as usize
+    } else {
+        1
+    }
+}
+
+fn record_stage(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    gate: &GateBuffers<'_>,
+    params: &GateParams,
+) -> Result<(), GpuError> {
+    let pipeline = gpu.compute_pipeline("sample_gate")?;
+    let uniform = gpu.uniform_buffer("sample_gate params", params);
+    gpu.record_dispatch(
+        encoder,
+        &pipeline,
+        "sample_gate",
+        &[
+            &uniform,
+            gate.selection_count,
+            gate.ring_overflows,
+            gate.moving,
+            gate.status,
+        ],
+        stage_invocations(params),
+        GATE_WORKGROUP_SIZE,
+    );
+    Ok(())
+}
+
+/// Records the gate's opening, right after the sample's `select`: the longest move reset, and
+/// the selection emptied when an earlier sample stopped the run.
+pub fn record_gate_open(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    gate: &GateBuffers<'_>,
+) -> Result<(), GpuError> {
+    record_stage(
+        gpu,
+        encoder,
+        gate,
+        &GateParams::new(0, GateStage::Open, 0.0),
+    )
+}
+
+/// Records the sample's check, after its `moving_entries` and before anything is applied:
+/// `longest_move` over the first `capacity` selection entries, the verdict against
+/// `capacity` and `assumed_move`, and the moving list's `capacity` slots vacated if the run
+/// stopped.
+pub fn record_gate_check(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    gate: &GateBuffers<'_>,
+    (capacity, assumed_move): (usize, f32),
+) -> Result<(), GpuError> {
+    let params = GateParams::new(capacity, GateStage::Decide, assumed_move);
+    let pipeline = gpu.compute_pipeline("longest_move")?;
+    let uniform = gpu.uniform_buffer("longest_move params", &params);
+    gpu.record_dispatch(
+        encoder,
+        &pipeline,
+        "longest_move",
+        &[
+            &uniform,
+            gate.positions,
+            gate.selected,
+            gate.selection_count,
+            gate.targets,
+            gate.status,
+        ],
+        capacity,
+        GATE_WORKGROUP_SIZE,
+    );
+    record_stage(gpu, encoder, gate, &params)?;
+    let vacate = GateParams {
+        stage: GateStage::Vacate as u32,
+        ..params
+    };
+    record_stage(gpu, encoder, gate, &vacate)
+}
+
+/// `longest_move` on the GPU over the first `min(selection_count, capacity)` entries, folded
+/// into `status` and read back.
+pub fn run_longest_move(
+    gpu: &GpuContext,
+    (positions, targets): (&[Vec3], &[Vec3]),
+    (selected, selection_count): (&[SelectedVertex], u32),
+    capacity: usize,
+    status: GateStatus,
+) -> Result<GateStatus, GpuError> {
+    gpu.check_binding::<Vec3>("vertex positions", positions.len())?;
+    let params = GateParams::new(capacity, GateStage::Decide, 0.0);
+    let positions = gpu.storage_buffer("positions", positions, false);
+    let targets = gpu.storage_buffer("targets", targets, false);
+    let selected = gpu.storage_buffer("selected", selected, false);
+    let count = gpu.storage_buffer("selection count", &[selection_count], false);
+    let status = gpu.storage_buffer("gate status", &[status], true);
+    let pipeline = gpu.compute_pipeline("longest_move")?;
+    let uniform = gpu.uniform_buffer("longest_move params", &params);
+    let mut encoder = gpu.encoder("longest_move");
+    gpu.record_dispatch(
+        &mut encoder,
+        &pipeline,
+        "longest_move",
+        &[&uniform, &positions, &selected, &count, &targets, &status],
+        capacity,
+        GATE_WORKGROUP_SIZE,
+    );
+    gpu.queue.submit([encoder.finish()]);
+    Ok(gpu.read_buffer::<GateStatus>(&status, 1)?[0])
+}
+
+/// One `sample_gate` stage on the GPU, dispatched as the host records it; returns the
+/// selection count, the moving list and the status after it.
+pub fn run_sample_gate(
+    gpu: &GpuContext,
+    params: &GateParams,
+    ring_overflows: u32,
+    (selection_count, moving, status): (u32, &[MovingVertex], GateStatus),
+) -> Result<(u32, Vec<MovingVertex>, GateStatus), GpuError> {
+    let count = gpu.storage_buffer("selection count", &[selection_count], true);
+    let overflows = gpu.storage_buffer("ring overflows", &[ring_overflows], false);
+    let moving_buffer = gpu.storage_buffer("moving list", moving, true);
+    let status = gpu.storage_buffer("gate status", &[status], true);
+    // Unused by the stages; bound by the check alone.
+    let gate = GateBuffers {
+        positions: &count,
+        selected: &count,
+        selection_count: &count,
+        targets: &count,
+        ring_overflows: &overflows,
+        moving: &moving_buffer,
+        status: &status,
+    };
+    let mut encoder = gpu.encoder("sample_gate");
+    record_stage(gpu, &mut encoder, &gate, params)?;
+    gpu.queue.submit([encoder.finish()]);
+    Ok((
+        gpu.read_buffer::<u32>(&count, 1)?[0],
+        gpu.read_buffer(&moving_buffer, moving.len())?,
+        gpu.read_buffer::<GateStatus>(&status, 1)?[0],
+    ))
+}

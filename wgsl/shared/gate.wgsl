@@ -1,0 +1,41 @@
+// The gate of a run of samples recorded ahead in one submission (src/gpu/gate.rs): each sample
+// checks, on the GPU, the assumptions its passes were recorded on — its selection within the
+// list's room, every exclusion ring within its room, no vertex moving farther than the passes
+// were sized for — and the first sample where one fails stops the run there: its moves are
+// vacated before they are applied, and every later sample of the run selects nothing. The host
+// reads each sample's status back and takes the samples before the stop.
+// Codes as `src/gpu/layout.rs` writes them (tests/wgsl.rs checks the values).
+
+// Host struct: `GateParams`.
+struct GateParams {
+    // Slots of the selection list the sample's passes were sized for (the host's guess).
+    capacity: u32,
+    // `sample_gate`: one of the GATE_* stages.
+    stage: u32,
+    // The longest move the passes were sized for (non-negative).
+    assumed_move: f32,
+    _pad: u32,
+}
+
+// Host struct: `GateStatus`. One per run, read back after every sample's decision.
+struct GateStatus {
+    // Zero while every sample so far held; else the STOPPED_* reasons of the sample that
+    // stopped the run (STOPPED_EARLIER alone for the samples after it).
+    stopped: u32,
+    // The current sample's longest move as the bits of a non-negative f32, which order as the
+    // floats do; a NaN or infinite move has larger bits than any finite one.
+    longest: atomic<u32>,
+}
+
+// At the sample's start, after `select`: the longest move reset, and a stopped run's selection
+// emptied, so that nothing after it in the sample does any work.
+const GATE_OPEN: u32 = 0u;
+// After `deform`, `moving_entries` and `longest_move`: the sample's verdict.
+const GATE_DECIDE: u32 = 1u;
+// Per slot of the moving list: vacated when the run has stopped, so no pass moves anything.
+const GATE_VACATE: u32 = 2u;
+
+const STOPPED_EARLIER: u32 = 1u;
+const STOPPED_SELECTION: u32 = 2u;
+const STOPPED_RINGS: u32 = 4u;
+const STOPPED_MOVE: u32 = 8u;
