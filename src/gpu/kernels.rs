@@ -44,16 +44,16 @@ use super::reusable::{Patches, ReusableBuffer, upload_rows};
 use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
     BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
-    FRAME_WORKGROUP_SIZE, Filed, GpuContext, GpuError, GpuHashTable, GpuSelection, HashedVertices,
-    MovingVertex, OverlayBuffers, PAIRS_GUESS, PROXIMITY_WORKGROUP_SIZE, PackedTopology,
-    ProximityBuffers, ProximityParams, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers, TopologyLayout, VertexBuffers,
-    Workgroups, backstop_params, check_invocations, deform_params, entry_params, frame_params,
-    frame_sums_buffer, indirect_args_buffer, moved_edge_bound, moving_vertices, overlay_limit,
-    overlay_table, pass_params, read_table, record_apply_moves, record_backstop,
-    record_brush_frame, record_deform, record_dispatch_args, record_moving_entries,
-    record_overlay_members, record_overlay_table, record_proximity, record_select, ring_bytes,
-    smoothing_neighbours, table_size_for,
+    FRAME_WORKGROUP_SIZE, Filed, GateBuffers, GateStatus, GpuContext, GpuError, GpuHashTable,
+    GpuSelection, HashedVertices, MovingVertex, OverlayBuffers, PAIRS_GUESS,
+    PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
+    SelectedVertex, SelectionBuffers, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers,
+    TopologyLayout, VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params,
+    entry_params, frame_params, frame_sums_buffer, indirect_args_buffer, moved_edge_bound,
+    moving_vertices, overlay_limit, overlay_table, pass_params, read_table, record_apply_moves,
+    record_backstop, record_brush_frame, record_deform, record_dispatch_args, record_gate_check,
+    record_gate_open, record_moving_entries, record_overlay_members, record_overlay_table,
+    record_proximity, record_select, ring_bytes, smoothing_neighbours, table_size_for,
 };
 use crate::brush::{Dab, DabFrame};
 use crate::grid::{cell_coordinates, hash_cell};
@@ -601,6 +601,9 @@ struct StepBuffers {
     /// The brush frame's sums, and its dispatch sized from the selection count.
     frame_sums: wgpu::Buffer,
     frame_args: wgpu::Buffer,
+    /// A run's [`GateStatus`]: whether a sample has stopped it, and the current sample's
+    /// longest move (`sample_gate`, `longest_move`).
+    gate_status: wgpu::Buffer,
 }
 
 impl StepBuffers {
@@ -623,6 +626,7 @@ impl StepBuffers {
             apply_args: indirect_args_buffer(gpu, "apply pass sizes"),
             frame_sums: frame_sums_buffer(gpu),
             frame_args: indirect_args_buffer(gpu, "brush frame sizes"),
+            gate_status: gpu.output_buffer::<GateStatus>("run gate status", 1),
         }
     }
 }
@@ -1008,6 +1012,7 @@ impl GpuKernels {
         let ahead = assumed_move.map(|assumed_move| AheadBounds {
             assumed_move,
             drift: r.hashed().drift,
+            gated: false,
         });
         let recorded = record_sample(
             gpu,
@@ -1564,6 +1569,9 @@ fn record_clamp(
 struct AheadBounds {
     assumed_move: f32,
     drift: f32,
+    /// A sample of a run: its passes go through the run's gate (`sample_gate`), which stops
+    /// the run at the first sample whose assumptions fail, before it moves anything.
+    gated: bool,
 }
 
 /// What [`record_sample`] leaves to read back after the selection's count and list: `parts`,
@@ -1640,6 +1648,19 @@ fn record_sample<'b>(
     let drift = ahead.map_or(r.hashed().drift, |a| a.drift);
     record_brush_selection(gpu, encoder, r, state.active, dab, drift)?;
     let capacity = r.selection.capacity;
+    let gated = ahead.is_some_and(|a| a.gated);
+    let gate = || GateBuffers {
+        positions: &r.vertices.positions,
+        selected: &r.selection.selected,
+        selection_count: &r.selection.count,
+        targets: step.targets.buffer(),
+        ring_overflows: &step.ring_overflows,
+        moving: step.moving.buffer(),
+        status: &step.gate_status,
+    };
+    if gated {
+        record_gate_open(gpu, encoder, &gate())?;
+    }
     let inputs = SelectionBuffers {
         positions: &r.vertices.positions,
         normals: &r.normals,
@@ -1697,6 +1718,7 @@ fn record_sample<'b>(
     if let Some(AheadBounds {
         assumed_move,
         drift,
+        ..
     }) = ahead
     {
         let Some(topology) = &r.topology else {
@@ -1720,6 +1742,9 @@ fn record_sample<'b>(
                 overflows: &step.ring_overflows,
             },
         )?;
+        if gated {
+            record_gate_check(gpu, encoder, &gate(), (guess, assumed_move))?;
+        }
         // No vertex moves farther than assumed, so no edge grows by more than twice that.
         let bounds = PassBounds {
             count: guess,

@@ -176,6 +176,10 @@ pub struct Uploads {
     /// its room).
     pub clamped_ahead: usize,
     pub dropped_ahead: usize,
+    /// Samples of a run ahead at which the GPU's gate stopped the run (`sample_gate`), before
+    /// they moved anything: their selection outgrew its room, a ring its room, or a vertex
+    /// moved farther than the passes were sized for.
+    pub gated_ahead: usize,
     /// Submissions that ran several samples of a stroke ahead, and the samples taken from them
     /// as predicted ([`StepKernels::upcoming`]).
     pub batches: usize,

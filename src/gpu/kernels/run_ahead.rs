@@ -10,13 +10,17 @@
 //! run queries the table with the first one's drift, however long the run.
 //!
 //! What the GPU ran is what the pipeline would have asked for only while its predictions
-//! hold: each sample one step within the move its passes were sized for and the mesh's edges
-//! within the bound they were sized for (checked against the mesh and the pipeline's edge
-//! bound when the pipeline reaches the sample), its selection within the guessed list and its
-//! rings within their room (checked when read back), and the exact backstop undoing nothing
-//! (checked when the pipeline reports the sample's moves). From the first sample where one
-//! fails, the rest are dropped: the rows they wrote go back to the mesh's (positions, and the
-//! normals around them), and the pipeline goes on one submission per step from there.
+//! hold. Those the GPU can see are checked there, by the run's gate (`longest_move`,
+//! `sample_gate`): each sample's selection within the guessed list, its rings within their
+//! room, and its longest move within the one its passes were sized for. The first sample where
+//! one fails stops the run before it moves anything, and the samples after it select nothing;
+//! the pipeline takes the samples before it and goes on one submission per step from there.
+//! The rest are checked by the host when the pipeline reaches a sample — the mesh's edges within
+//! the bound the passes were sized for (the pipeline's edge bound), the move within the
+//! assumption again in the host's arithmetic — and when it reports the sample's moves (the
+//! exact backstop undoing nothing). From the first sample where one of those fails, the rest
+//! are dropped: the rows they wrote go back to the mesh's (positions, and the normals around
+//! them).
 //!
 //! [`StepKernels::upcoming`]: crate::pipeline::StepKernels::upcoming
 
@@ -29,17 +33,23 @@ use super::{
     TableUse, cell_size, in_vertex_order, permuted, record_sample, selection_guess,
 };
 use crate::gpu::reusable::Patches;
-use crate::gpu::{GpuContext, GpuError, record_moved_normals, ring_bytes};
+use crate::gpu::{GateStatus, GpuContext, GpuError, record_moved_normals, ring_bytes};
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
 use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 
-/// At most this many samples in one submission: the read-back grows with each, and a sample
-/// the pipeline does not take as predicted wastes the work of those after it. A run starts at
-/// two samples and doubles after every run taken whole; a run cut short makes the next one as
-/// long as what was taken of it (at least two).
+/// At most this many samples in one submission: the read-back grows with each, and each later
+/// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
+/// their reach grows with the run. A run starts at two samples and doubles after every run
+/// taken whole; a run cut short makes the next one as long as what was taken of it (at least
+/// two). (Starting every run at the rest of the stroke, with the gate making a stop cheap, took
+/// the run-ahead test from 4 read-backs to 2 but from 16 s to 24 s on lavapipe: the later
+/// samples' inflated reach costs more there than the read-backs it saves.)
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
+
+/// Bytes of the run's gate status read back before each sample's results.
+const GATE_BYTES: usize = std::mem::size_of::<GateStatus>();
 
 /// A run's later samples assume the mesh's longest edge grows by at most this share of the
 /// assumed move per sample before them, and are dropped when the pipeline's edge bound at their
@@ -137,6 +147,7 @@ impl GpuKernels {
         let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
         let mut encoder = gpu.encoder("samples ahead");
         r.hashed().record_gpu_table(gpu, &mut encoder)?;
+        encoder.clear_buffer(&step.gate_status, 0, None);
         // The edges as the samples before sample j may have lengthened them (checked when the
         // pipeline reaches it).
         let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
@@ -159,6 +170,7 @@ impl GpuKernels {
                 Some(AheadBounds {
                     assumed_move,
                     drift,
+                    gated: true,
                 }),
                 filter,
             )?;
@@ -178,7 +190,11 @@ impl GpuKernels {
                     (step.moving.buffer(), guess),
                 )?;
             }
-            let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
+            let mut parts = vec![
+                (&step.gate_status, GATE_BYTES as u64),
+                (&r.selection.count, 4),
+                (&r.selection.selected, list_bytes),
+            ];
             parts.extend_from_slice(&recorded.parts);
             if j == 0 {
                 // Every sample leaves the same parts.
@@ -197,8 +213,18 @@ impl GpuKernels {
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
+            let status: GateStatus = bytemuck::pod_read_unaligned(&bytes[..GATE_BYTES]);
+            let bytes = &bytes[GATE_BYTES..];
             let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
                 .min(capacity);
+            self.last_selection = self.last_selection.max(found);
+            if status.stopped != 0 && dropped_from.is_none() {
+                // The gate stopped the run at this sample, before it moved anything, and the
+                // samples after it selected nothing: there is nothing to put back.
+                self.run_length = j.max(FIRST_SAMPLES_AHEAD);
+                self.uploads.gated_ahead += 1;
+                break;
+            }
             let head = found.min(guess);
             let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
             let (dab, normal) = self.plan[from + j];
@@ -207,10 +233,10 @@ impl GpuKernels {
             if j + 1 < count {
                 filed_on_gpu.extend(list.iter().map(|s| s.vertex));
             }
-            self.last_selection = self.last_selection.max(found);
             if found > guess || parts.ring_overflows != Some(0) || dropped_from.is_some() {
-                // This sample's passes ran on a cut list or cut rings, and the later ones on
-                // what they left: put back everything each moved.
+                // The gate stops a run on a cut list or cut rings; should it not have, this
+                // sample's passes ran on them, and the later ones on what they left: put back
+                // everything each moved.
                 if dropped_from.is_none() {
                     self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 }
