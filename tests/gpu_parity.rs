@@ -2385,7 +2385,7 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
         for capacity in [size, size - size / 3, size + 5] {
             let count = size as u32;
             let params =
-                slayer::gpu::GateParams::new(capacity, slayer::gpu::GateStage::Decide, 0.0);
+                slayer::gpu::GateParams::new(capacity, slayer::gpu::GateStage::Decide, (0.0, 0.0));
             let mut mirror = slayer::gpu::GateStatus::default();
             slayer::cpu::longest_move(
                 &params,
@@ -2429,8 +2429,8 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
         .map(|s| positions[s.vertex as usize] + Vec3::X)
         .collect();
     let held = slayer::gpu::GateStatus {
-        stopped: 0,
         longest: 5.0f32.to_bits(),
+        ..Default::default()
     };
     let kept =
         slayer::gpu::run_longest_move(&gpu, (&positions, &targets), (&selected, 100), 100, held)
@@ -2438,7 +2438,7 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
     assert_eq!(kept.longest_move(), 5.0);
     targets[57] = Vec3::new(f32::NAN, 0.0, 0.0);
     let flat_targets: Vec<f32> = targets.iter().flat_map(|p| p.to_array()).collect();
-    let params = slayer::gpu::GateParams::new(100, slayer::gpu::GateStage::Decide, 0.0);
+    let params = slayer::gpu::GateParams::new(100, slayer::gpu::GateStage::Decide, (0.0, 0.0));
     let mut mirror = slayer::gpu::GateStatus::default();
     slayer::cpu::longest_move(
         &params,
@@ -2491,36 +2491,40 @@ fn sample_gate_stages_match_the_cpu_mirror() {
         let status = GateStatus {
             stopped,
             longest: 7.5f32.to_bits(),
+            edge: 2.0f32.to_bits(),
+            _pad: 0,
         };
-        let open = GateParams::new(0, GateStage::Open, 0.0);
+        let open = GateParams::new(0, GateStage::Open, (0.0, 0.0));
         let (count, _, after) = run(&gpu, &open, 0, (77, &[], status));
         assert_eq!(
             after,
             GateStatus {
-                stopped,
-                longest: 0
+                longest: 0,
+                ..status
             }
         );
         assert_eq!(count, if stopped == 0 { 77 } else { 0 });
     }
-    // The verdict, over every combination of the four reasons, the move on either side of the
-    // assumed one, equal to it, and NaN.
+    // The verdict, over every combination of the five reasons, the move and the edge bound on
+    // either side of the assumed ones, equal to them, and NaN.
     let assumed = 0.25f32;
+    let max_edge = 1.5f32;
+    let around = |x: f32| [0.0f32, x, f32::from_bits(x.to_bits() + 1), f32::NAN];
     let capacity = 64;
     for stopped_before in [0, GateStatus::SELECTION] {
         for count in [capacity as u32, capacity as u32 + 1] {
             for overflows in [0, 3] {
-                for longest in [
-                    0.0f32,
-                    assumed,
-                    f32::from_bits(assumed.to_bits() + 1),
-                    f32::NAN,
-                ] {
+                for (longest, edge) in around(assumed)
+                    .into_iter()
+                    .flat_map(|l| around(max_edge).map(move |e| (l, e)))
+                {
                     let status = GateStatus {
                         stopped: stopped_before,
                         longest: longest.to_bits(),
+                        edge: edge.to_bits(),
+                        _pad: 0,
                     };
-                    let decide = GateParams::new(capacity, GateStage::Decide, assumed);
+                    let decide = GateParams::new(capacity, GateStage::Decide, (assumed, max_edge));
                     let (after_count, _, after) =
                         run(&gpu, &decide, overflows, (count, &[], status));
                     let mut expected = 0;
@@ -2536,8 +2540,17 @@ fn sample_gate_stages_match_the_cpu_mirror() {
                     if longest.is_nan() || longest > assumed {
                         expected |= GateStatus::MOVE;
                     }
-                    assert_eq!(after.stopped, expected, "count {count} longest {longest}");
-                    assert_eq!((after_count, after.longest), (count, longest.to_bits()));
+                    if edge.is_nan() || edge > max_edge {
+                        expected |= GateStatus::EDGES;
+                    }
+                    assert_eq!(
+                        after.stopped, expected,
+                        "count {count} longest {longest} edge {edge}"
+                    );
+                    assert_eq!(
+                        (after_count, after.longest, after.edge),
+                        (count, longest.to_bits(), edge.to_bits())
+                    );
                 }
             }
         }
@@ -2560,10 +2573,10 @@ fn sample_gate_stages_match_the_cpu_mirror() {
             .collect();
         let capacity = size - size / 4;
         for stopped in [0, GateStatus::RINGS] {
-            let vacate = GateParams::new(capacity, GateStage::Vacate, assumed);
+            let vacate = GateParams::new(capacity, GateStage::Vacate, (assumed, max_edge));
             let status = GateStatus {
                 stopped,
-                longest: 0,
+                ..Default::default()
             };
             let (_, after, _) = run(&gpu, &vacate, 0, (size as u32, &moving, status));
             for (i, (a, m)) in after.iter().zip(&moving).enumerate() {
@@ -2575,5 +2588,75 @@ fn sample_gate_stages_match_the_cpu_mirror() {
                 assert_eq!(*a, expected, "size {size} slot {i} stopped {stopped}");
             }
         }
+    }
+}
+
+#[test]
+fn moved_edges_grow_the_edge_bound_as_the_cpu_mirror_and_the_pipeline_do() {
+    // Moving lists over a seeded shuffle of the vertices of two bumpy sheets at awkward sizes
+    // (the largest folded into two dimensions), one slot in seven vacant, about half the
+    // entries moved (some far enough to stretch their faces past the mesh's longest edge).
+    // The bound grows to the longest edge of the faces around the moved vertices, as the
+    // pipeline's `longest_edge` over them; `distance` may round differently on the GPU: a
+    // relative 1e-6.
+    let mut gpu = gpu();
+    let start = bumpy_sheets();
+    let vertex_count = start.vertex_count();
+    let topology = slayer::gpu::PackedTopology::of(&start);
+    let order = shuffled((0..vertex_count as u32).collect(), 931);
+    let mut rng = ChaCha8Rng::seed_from_u64(932);
+    let initial = longest_edge(&start);
+    let sizes = SIZES.map(|size| size.min(vertex_count));
+    for (k, &size) in sizes.iter().enumerate() {
+        if k + 1 == sizes.len() {
+            gpu.limits.max_compute_workgroups_per_dimension = 7;
+        }
+        let mut mesh = start.clone();
+        let mut moving = Vec::with_capacity(size);
+        let mut moved = Vec::new();
+        for (slot, &v) in order[..size].iter().enumerate() {
+            let vertex = if slot % 7 == 6 { INVALID } else { v };
+            moving.push(slayer::gpu::MovingVertex {
+                start: start.positions()[v as usize].to_array(),
+                vertex,
+                ..Default::default()
+            });
+            if rng.random_bool(0.5) {
+                mesh.positions_mut()[v as usize] +=
+                    Vec3::new(0.0, 0.0, rng.random_range(0.001..2.0) * initial);
+                if vertex != INVALID {
+                    moved.push(v);
+                }
+            }
+        }
+        let before = slayer::gpu::GateStatus::starting(0.5 * initial);
+        let params = slayer::gpu::NormalParams {
+            count: size as u32,
+            vertex_rows_base: topology.layout.vertex_rows_base,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+        let mut mirror = before;
+        slayer::cpu::moved_edges(&params, (&flat, &topology.words), &moving, &mut mirror);
+        // What the pipeline's bound grows to: the longest edge of the faces around the moved
+        // vertices.
+        let expected = moved
+            .iter()
+            .flat_map(|&v| mesh.faces_around(v))
+            .map(|f| {
+                let [a, b, c] = mesh.face_positions(f as usize);
+                a.distance(b).max(b.distance(c)).max(c.distance(a))
+            })
+            .fold(before.edge_bound(), f32::max);
+        assert_eq!(mirror.edge_bound(), expected, "mirror at size {size}");
+        let actual = slayer::gpu::run_moved_edges(&gpu, &mesh, &moving, before).expect("GPU run");
+        assert_eq!((actual.stopped, actual.longest), (0, 0));
+        let deviation = (actual.edge_bound() - expected).abs();
+        assert!(
+            deviation <= 1e-6 * expected,
+            "size {size}: GPU {} mirror {expected}",
+            actual.edge_bound()
+        );
     }
 }

@@ -328,6 +328,7 @@ fn wgsl_constants_match_the_host() {
         ("STOPPED_SELECTION", GateStatus::SELECTION),
         ("STOPPED_RINGS", GateStatus::RINGS),
         ("STOPPED_MOVE", GateStatus::MOVE),
+        ("STOPPED_EDGES", GateStatus::EDGES),
     ] {
         assert_eq!(naga_u32_constant("sample_gate", name), reason, "{name}");
     }
@@ -359,6 +360,7 @@ fn wgsl_constants_match_the_host() {
         ("moving_entries", slayer::gpu::ENTRIES_WORKGROUP_SIZE),
         ("longest_move", slayer::gpu::GATE_WORKGROUP_SIZE),
         ("sample_gate", slayer::gpu::GATE_WORKGROUP_SIZE),
+        ("moved_edges", slayer::gpu::GATE_WORKGROUP_SIZE),
     ] {
         assert_eq!(
             naga_u32_constant(kernel, "WORKGROUP_SIZE"),
@@ -433,6 +435,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
         "moved_normals",
         "overlay_members",
         "sample_gate",
+        "moved_edges",
     ] {
         assert_layout!(
             kernel,
@@ -504,11 +507,37 @@ fn proximity_and_normal_structs_match_naga_layout() {
                 capacity,
                 stage,
                 assumed_move,
+                max_edge
+            }
+        );
+        assert_layout!(
+            kernel,
+            GateStatus {
+                stopped,
+                longest,
+                edge,
                 _pad
             }
         );
-        assert_layout!(kernel, GateStatus { stopped, longest });
     }
+    assert_layout!(
+        "moved_edges",
+        GateStatus {
+            stopped,
+            longest,
+            edge,
+            _pad
+        }
+    );
+    assert_layout!(
+        "moved_edges",
+        NormalParams {
+            count,
+            vertex_rows_base,
+            _pad0,
+            _pad1
+        }
+    );
     assert_layout!("longest_move", SelectedVertex { vertex, weight });
     for kernel in ["overlay_members", "overlay_keys", "overlay_entries"] {
         assert_layout!(
@@ -533,6 +562,7 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
         ("backstop", 1),
         ("vertex_normals", 1),
         ("moved_normals", 1),
+        ("moved_edges", 1),
         ("deform", 1),
         ("moving_entries", 1),
     ];

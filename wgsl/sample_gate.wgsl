@@ -1,5 +1,6 @@
 // The gate of a run of samples recorded ahead (shared/gate), in three stages the host records
-// around each sample's passes: GATE_OPEN after `select`, GATE_DECIDE after `longest_move`,
+// around each sample's passes: GATE_OPEN after `select`, GATE_DECIDE after `longest_move`
+// (the edges the samples before left measured by their `moved_edges`),
 // GATE_VACATE before `apply_moves` places anything. The decision is taken by one invocation
 // and read by the next dispatch, so every slot sees the same verdict.
 // CPU mirror: src/cpu/sample_gate.rs.
@@ -47,6 +48,9 @@ fn main(
                 }
                 if atomicLoad(&status.longest) > bitcast<u32>(params.assumed_move) {
                     why |= STOPPED_MOVE;
+                }
+                if atomicLoad(&status.edge) > bitcast<u32>(params.max_edge) {
+                    why |= STOPPED_EDGES;
                 }
                 status.stopped = why;
             }

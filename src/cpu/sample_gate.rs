@@ -44,6 +44,9 @@ pub fn sample_gate(params: &GateParams, ring_overflows: u32, gate: GateState<'_>
             if status.longest > params.assumed_move.to_bits() {
                 why |= GateStatus::MOVE;
             }
+            if status.edge > params.max_edge.to_bits() {
+                why |= GateStatus::EDGES;
+            }
             status.stopped = why;
         }
     } else {

@@ -1,15 +1,17 @@
-//! Host side of `wgsl/longest_move.wgsl` and `wgsl/sample_gate.wgsl`: the gate that stops a run
-//! of samples recorded ahead in one submission at the first sample whose passes were recorded
-//! on assumptions that fail (`wgsl/shared/gate.wgsl`), before that sample moves anything, and
-//! makes every later sample of the run select nothing.
+//! Host side of `wgsl/longest_move.wgsl`, `wgsl/sample_gate.wgsl` and `wgsl/moved_edges.wgsl`:
+//! the gate that stops a run of samples recorded ahead in one submission at the first sample
+//! whose passes were recorded on assumptions that fail (`wgsl/shared/gate.wgsl`), before that
+//! sample moves anything, and makes every later sample of the run select nothing.
 
 use glam::Vec3;
 
 use super::{
-    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
+    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, NormalParams,
+    PackedTopology, SelectedVertex, Workgroups,
 };
+use crate::mesh::Mesh;
 
-/// Workgroup size of `longest_move` and `sample_gate`.
+/// Workgroup size of `longest_move`, `sample_gate` and `moved_edges`.
 pub const GATE_WORKGROUP_SIZE: u32 = 64;
 
 /// What the gate reads and writes.
@@ -72,21 +74,21 @@ pub fn record_gate_open(
         gpu,
         encoder,
         gate,
-        &GateParams::new(0, GateStage::Open, 0.0),
+        &GateParams::new(0, GateStage::Open, (0.0, 0.0)),
     )
 }
 
 /// Records the sample's check, after its `moving_entries` and before anything is applied:
 /// `longest_move` over the first `capacity` selection entries, the verdict against
-/// `capacity` and `assumed_move`, and the moving list's `capacity` slots vacated if the run
-/// stopped.
+/// `capacity` and the move and edge bounds the passes were sized for, and the moving list's
+/// `capacity` slots vacated if the run stopped.
 pub fn record_gate_check(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     gate: &GateBuffers<'_>,
-    (capacity, assumed_move): (usize, f32),
+    (capacity, assumed_move, max_edge): (usize, f32, f32),
 ) -> Result<(), GpuError> {
-    let params = GateParams::new(capacity, GateStage::Decide, assumed_move);
+    let params = GateParams::new(capacity, GateStage::Decide, (assumed_move, max_edge));
     let pipeline = gpu.compute_pipeline("longest_move")?;
     let uniform = gpu.uniform_buffer("longest_move params", &params);
     gpu.record_dispatch(
@@ -122,7 +124,7 @@ pub fn run_longest_move(
     status: GateStatus,
 ) -> Result<GateStatus, GpuError> {
     gpu.check_binding::<Vec3>("vertex positions", positions.len())?;
-    let params = GateParams::new(capacity, GateStage::Decide, 0.0);
+    let params = GateParams::new(capacity, GateStage::Decide, (0.0, 0.0));
     let positions = gpu.storage_buffer("positions", positions, false);
     let targets = gpu.storage_buffer("targets", targets, false);
     let selected = gpu.storage_buffer("selected", selected, false);
@@ -173,4 +175,64 @@ pub fn run_sample_gate(
         gpu.read_buffer(&moving_buffer, moving.len())?,
         gpu.read_buffer::<GateStatus>(&status, 1)?[0],
     ))
+}
+
+/// Records `moved_edges` after a sample's moves: the longest edge of the faces around the
+/// entries of the moving list's first `slots` that moved, folded into the run's edge bound in
+/// `status`.
+pub fn record_moved_edges(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (positions, topology): (&wgpu::Buffer, &wgpu::Buffer),
+    vertex_rows_base: u32,
+    (moving, slots): (&wgpu::Buffer, usize),
+    status: &wgpu::Buffer,
+) -> Result<(), GpuError> {
+    let params = NormalParams {
+        count: slots as u32,
+        vertex_rows_base,
+        _pad0: 0,
+        _pad1: 0,
+    };
+    let pipeline = gpu.compute_pipeline("moved_edges")?;
+    let uniform = gpu.uniform_buffer("moved_edges params", &params);
+    gpu.record_paged_dispatch(
+        encoder,
+        &pipeline,
+        "moved_edges",
+        &[&uniform, positions, moving, status],
+        &[topology],
+        Workgroups::Cover {
+            invocations: slots,
+            workgroup_size: GATE_WORKGROUP_SIZE,
+        },
+    );
+    Ok(())
+}
+
+/// `moved_edges` on the GPU over `moving`, `mesh`'s positions being where the entries are now,
+/// folded into `status` and read back.
+pub fn run_moved_edges(
+    gpu: &GpuContext,
+    mesh: &Mesh,
+    moving: &[MovingVertex],
+    status: GateStatus,
+) -> Result<GateStatus, GpuError> {
+    gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
+    let topology = PackedTopology::of(mesh);
+    let positions = gpu.storage_buffer("positions", mesh.positions(), false);
+    let topology_buffer = topology.upload(gpu)?;
+    let moving_buffer = gpu.storage_buffer("moving list", moving, false);
+    let status = gpu.storage_buffer("gate status", &[status], true);
+    let mut encoder = gpu.encoder("moved_edges");
+    record_moved_edges(
+        gpu,
+        &mut encoder,
+        (&positions, &topology_buffer),
+        topology.layout.vertex_rows_base,
+        (&moving_buffer, moving.len()),
+        &status,
+    )?;
+    gpu.queue.submit([encoder.finish()]);
+    Ok(gpu.read_buffer::<GateStatus>(&status, 1)?[0])
 }

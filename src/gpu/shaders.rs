@@ -70,6 +70,7 @@ pub const KERNELS: &[(&str, &str)] = &[
     ("overlay_keys", include_str!("../../wgsl/overlay_keys.wgsl")),
     ("longest_move", include_str!("../../wgsl/longest_move.wgsl")),
     ("sample_gate", include_str!("../../wgsl/sample_gate.wgsl")),
+    ("moved_edges", include_str!("../../wgsl/moved_edges.wgsl")),
     (
         "overlay_entries",
         include_str!("../../wgsl/overlay_entries.wgsl"),

@@ -1,7 +1,7 @@
 // The gate of a run of samples recorded ahead in one submission (src/gpu/gate.rs): each sample
 // checks, on the GPU, the assumptions its passes were recorded on — its selection within the
 // list's room, every exclusion ring within its room, no vertex moving farther than the passes
-// were sized for — and the first sample where one fails stops the run there: its moves are
+// were sized for, no edge longer than they were sized for — and the first sample where one fails stops the run there: its moves are
 // vacated before they are applied, and every later sample of the run selects nothing. The host
 // reads each sample's status back and takes the samples before the stop.
 // Codes as `src/gpu/layout.rs` writes them (tests/wgsl.rs checks the values).
@@ -14,7 +14,8 @@ struct GateParams {
     stage: u32,
     // The longest move the passes were sized for (non-negative).
     assumed_move: f32,
-    _pad: u32,
+    // The bound on edge lengths at the sample's start the passes were sized for.
+    max_edge: f32,
 }
 
 // Host struct: `GateStatus`. One per run, read back after every sample's decision.
@@ -25,6 +26,10 @@ struct GateStatus {
     // The current sample's longest move as the bits of a non-negative f32, which order as the
     // floats do; a NaN or infinite move has larger bits than any finite one.
     longest: atomic<u32>,
+    // The run's bound on edge lengths, as f32 bits: the host's at the run's start, grown by
+    // `moved_edges` after every sample.
+    edge: atomic<u32>,
+    _pad: u32,
 }
 
 // At the sample's start, after `select`: the longest move reset, and a stopped run's selection
@@ -39,3 +44,4 @@ const STOPPED_EARLIER: u32 = 1u;
 const STOPPED_SELECTION: u32 = 2u;
 const STOPPED_RINGS: u32 = 4u;
 const STOPPED_MOVE: u32 = 8u;
+const STOPPED_EDGES: u32 = 16u;

@@ -11,16 +11,16 @@
 //!
 //! What the GPU ran is what the pipeline would have asked for only while its predictions
 //! hold. Those the GPU can see are checked there, by the run's gate (`longest_move`,
-//! `sample_gate`): each sample's selection within the guessed list, its rings within their
-//! room, and its longest move within the one its passes were sized for. The first sample where
-//! one fails stops the run before it moves anything, and the samples after it select nothing;
-//! the pipeline takes the samples before it and goes on one submission per step from there.
-//! The rest are checked by the host when the pipeline reaches a sample — the mesh's edges within
-//! the bound the passes were sized for (the pipeline's edge bound), the move within the
-//! assumption again in the host's arithmetic — and when it reports the sample's moves (the
-//! exact backstop undoing nothing). From the first sample where one of those fails, the rest
-//! are dropped: the rows they wrote go back to the mesh's (positions, and the normals around
-//! them).
+//! `sample_gate`, with `moved_edges` after each sample): each sample's selection within the
+//! guessed list, its rings within their room, its longest move within the one its passes were
+//! sized for, and the edges the samples before it left within the bound they were sized for.
+//! The first sample where one fails stops the run before it moves anything, and the samples
+//! after it select nothing; the pipeline takes the samples before it and goes on one
+//! submission per step from there. The host checks the move and the edges again in its own
+//! arithmetic when the pipeline reaches a sample, and the exact backstop's verdict when the
+//! pipeline reports the sample's moves (it must undo nothing). From the first sample where one
+//! of those fails, the rest are dropped: the rows they wrote go back to the mesh's (positions,
+//! and the normals around them).
 //!
 //! [`StepKernels::upcoming`]: crate::pipeline::StepKernels::upcoming
 
@@ -33,30 +33,34 @@ use super::{
     TableUse, cell_size, in_vertex_order, permuted, record_sample, selection_guess,
 };
 use crate::gpu::reusable::Patches;
-use crate::gpu::{GateStatus, GpuContext, GpuError, record_moved_normals, ring_bytes};
+use crate::gpu::{
+    GateStatus, GpuContext, GpuError, record_moved_edges, record_moved_normals, ring_bytes,
+};
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
 use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 
 /// At most this many samples in one submission: the read-back grows with each, and each later
 /// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
-/// their reach grows with the run. A run starts at two samples and doubles after every run
-/// taken whole; a run cut short makes the next one as long as what was taken of it (at least
-/// two). (Starting every run at the rest of the stroke, with the gate making a stop cheap, took
-/// the run-ahead test from 4 read-backs to 2 but from 16 s to 24 s on lavapipe: the later
-/// samples' inflated reach costs more there than the read-backs it saves.)
+/// their reach grows with the run. A run takes the rest of the stroke up to this: the gate stops
+/// it on the GPU at the first sample that does not fit, and the pipeline starts the next run
+/// from there. (Before the gate a run started at two samples and doubled after each run taken
+/// whole, because a run cut short cost the host put-backs and full passes for the rest. With the
+/// gate, the run-ahead test reads back twice instead of 4 times, in 19–26 s of lavapipe against
+/// 15–21 s: the samples after a stop still select, and rebuild the overlay, for nothing.)
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
-const FIRST_SAMPLES_AHEAD: usize = 2;
 
 /// Bytes of the run's gate status read back before each sample's results.
 const GATE_BYTES: usize = std::mem::size_of::<GateStatus>();
 
 /// A run's later samples assume the mesh's longest edge grows by at most this share of the
-/// assumed move per sample before them, and are dropped when the pipeline's edge bound at their
-/// start says otherwise. A step lengthens an edge by at most twice its longest move, but the
+/// assumed move per sample before them; the gate stops the run at the first whose edges, as
+/// `moved_edges` measured them, say otherwise (and the host drops it should the pipeline's own
+/// bound disagree). A step lengthens an edge by at most twice its longest move, but the
 /// passes' reach grows with the edge bound (their work with its cube): plaster at 2K faces,
 /// steps of a cell, grew its longest edge by 0 to 0.32 of the step limit a sample; assuming the
-/// worst case (2) made a run of four samples cost three times one assuming this share.
+/// worst case (2) made a run of four samples cost three times one assuming this share. With the
+/// gate, 0.25 stopped the run-ahead test's runs once more for the same lavapipe time.
 const EDGE_GROWTH_AHEAD: f32 = 0.5;
 
 /// A sample recorded ahead, waiting for the pipeline to reach it.
@@ -93,8 +97,8 @@ impl GpuKernels {
             .filter(|&at| at + 1 < self.plan.len())
     }
 
-    /// Records the planned samples from `from` on in one submission (as many as the run's
-    /// length, at most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
+    /// Records the planned samples from `from` on in one submission (the rest of the plan, at
+    /// most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
     /// what each left for the pipeline. The passes are sized as a single step's would be
     /// (`assumed_move`: twice the last move, within `limit`), each later sample's from edges
     /// grown by [`EDGE_GROWTH_AHEAD`] of that move per sample before it.
@@ -123,10 +127,7 @@ impl GpuKernels {
         // Each sample's moved vertices are filed in the overlay on the GPU before the next
         // (`Hashed::record_gpu_filing`): every sample queries with the drift of the first.
         let drift = r.hashed().drift;
-        let count = (self.plan.len() - from).min(
-            self.run_length
-                .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
-        );
+        let count = (self.plan.len() - from).min(MAX_SAMPLES_AHEAD);
         if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
             return Ok(());
         }
@@ -147,7 +148,13 @@ impl GpuKernels {
         let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
         let mut encoder = gpu.encoder("samples ahead");
         r.hashed().record_gpu_table(gpu, &mut encoder)?;
-        encoder.clear_buffer(&step.gate_status, 0, None);
+        // The gate's edge bound starts at the pipeline's; each sample but the last grows it by
+        // the faces it turned (`moved_edges`) for the next one's verdict.
+        gpu.queue.write_buffer(
+            &step.gate_status,
+            0,
+            bytemuck::bytes_of(&GateStatus::starting(state.max_edge)),
+        );
         // The edges as the samples before sample j may have lengthened them (checked when the
         // pipeline reaches it).
         let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
@@ -183,6 +190,14 @@ impl GpuKernels {
                 &r.normals,
             )?;
             if j + 1 < count {
+                record_moved_edges(
+                    gpu,
+                    &mut encoder,
+                    (&r.vertices.positions, &topology.buffer),
+                    topology.layout.vertex_rows_base,
+                    (step.moving.buffer(), guess),
+                    &step.gate_status,
+                )?;
                 r.hashed().record_gpu_filing(
                     gpu,
                     &mut encoder,
@@ -207,9 +222,8 @@ impl GpuKernels {
         let data = readback.submit_and_map(gpu, encoder, sample_bytes * count as u64)?;
         let layout: SampleLayout = layout.expect("at least two samples recorded");
         self.uploads.batches += 1;
-        self.run_taken = 0;
 
-        let mut dropped_from = None;
+        let mut dropped = false;
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
@@ -218,10 +232,9 @@ impl GpuKernels {
             let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
                 .min(capacity);
             self.last_selection = self.last_selection.max(found);
-            if status.stopped != 0 && dropped_from.is_none() {
+            if status.stopped != 0 && !dropped {
                 // The gate stopped the run at this sample, before it moved anything, and the
                 // samples after it selected nothing: there is nothing to put back.
-                self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 self.uploads.gated_ahead += 1;
                 break;
             }
@@ -233,14 +246,11 @@ impl GpuKernels {
             if j + 1 < count {
                 filed_on_gpu.extend(list.iter().map(|s| s.vertex));
             }
-            if found > guess || parts.ring_overflows != Some(0) || dropped_from.is_some() {
+            if found > guess || parts.ring_overflows != Some(0) || dropped {
                 // The gate stops a run on a cut list or cut rings; should it not have, this
                 // sample's passes ran on them, and the later ones on what they left: put back
                 // everything each moved.
-                if dropped_from.is_none() {
-                    self.run_length = j.max(FIRST_SAMPLES_AHEAD);
-                }
-                dropped_from.get_or_insert(j);
+                dropped = true;
                 let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
                 if !vertices.is_empty() {
                     self.uploads.dropped_ahead += 1;
@@ -279,7 +289,7 @@ impl GpuKernels {
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
-            if dropped_from.is_some() {
+            if dropped {
                 // Filed where the dropped samples put them.
                 hashed.gpu_drift = None;
             }
@@ -325,11 +335,6 @@ impl GpuKernels {
             }
         }
         let sample = self.queued.pop_front()?;
-        self.run_taken += 1;
-        if self.queued.is_empty() {
-            // The whole run was taken as predicted.
-            self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
-        }
         self.uploads.samples_ahead += 1;
         self.ahead = sample.ahead;
         self.taken_filed = sample.filed;
@@ -339,9 +344,6 @@ impl GpuKernels {
     /// Drops every queued sample: the rows their passes wrote go back to the mesh's.
     pub(super) fn drop_queued(&mut self, mesh: &Mesh) {
         let queued = std::mem::take(&mut self.queued);
-        if !queued.is_empty() {
-            self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
-        }
         let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
         if vertices.is_empty() {
             return;
