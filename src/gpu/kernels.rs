@@ -664,6 +664,10 @@ pub struct GpuKernels {
     /// the one after the last it took from a submission that ran several ahead.
     plan: Vec<SampleProbe>,
     plan_next: usize,
+    /// How many samples the next run ahead records, and how many of the last run the pipeline
+    /// took (`run_ahead`).
+    run_length: usize,
+    run_taken: usize,
     /// Samples run ahead in such a submission, waiting for the pipeline (`run_ahead`).
     queued: run_ahead::Queue,
     /// The vertices and final positions of the last step taken from passes run ahead, to see
@@ -720,6 +724,8 @@ impl GpuKernels {
             last_move: 0.0,
             plan: Vec::new(),
             plan_next: 0,
+            run_length: 0,
+            run_taken: 0,
             queued: run_ahead::Queue::new(),
             taken: None,
             taken_filed: false,

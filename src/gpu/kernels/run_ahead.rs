@@ -42,13 +42,16 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 
 /// At most this many samples in one submission: the read-back grows with each, and each later
 /// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
-/// their reach grows with the run. A run takes the rest of the stroke up to this: the gate stops
-/// it on the GPU at the first sample that does not fit, and the pipeline starts the next run
-/// from there. (Before the gate a run started at two samples and doubled after each run taken
-/// whole, because a run cut short cost the host put-backs and full passes for the rest. With the
-/// gate, the run-ahead test reads back twice instead of 4 times, in 19–26 s of lavapipe against
-/// 15–21 s: the samples after a stop still select, and rebuild the overlay, for nothing.)
+/// their reach grows with the run. A run starts at two samples and doubles after every run
+/// taken whole; a run cut short makes the next one as long as what was taken of it (at least
+/// two). A run the gate stops still has the GPU go through the recorded passes of every sample
+/// after the stop, emptied but dispatched: starting every run at the rest of the stroke read
+/// the run-ahead test back twice instead of 4 times, but in 19–26 s of lavapipe against 15–21
+/// s, and on a hardware GPU, where each dispatch has a fixed cost, a 32-sample run stopped early
+/// would waste hundreds of them (in the 100K-face plaster bench 1 sample in 7 takes several
+/// steps or has a move undone by the exact backstop, and either ends a run).
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
+const FIRST_SAMPLES_AHEAD: usize = 2;
 
 /// Bytes of the run's gate status read back before each sample's results.
 const GATE_BYTES: usize = std::mem::size_of::<GateStatus>();
@@ -97,8 +100,8 @@ impl GpuKernels {
             .filter(|&at| at + 1 < self.plan.len())
     }
 
-    /// Records the planned samples from `from` on in one submission (the rest of the plan, at
-    /// most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
+    /// Records the planned samples from `from` on in one submission (as many as the run's
+    /// length, at most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
     /// what each left for the pipeline. The passes are sized as a single step's would be
     /// (`assumed_move`: twice the last move, within `limit`), each later sample's from edges
     /// grown by [`EDGE_GROWTH_AHEAD`] of that move per sample before it.
@@ -127,7 +130,10 @@ impl GpuKernels {
         // Each sample's moved vertices are filed in the overlay on the GPU before the next
         // (`Hashed::record_gpu_filing`): every sample queries with the drift of the first.
         let drift = r.hashed().drift;
-        let count = (self.plan.len() - from).min(MAX_SAMPLES_AHEAD);
+        let count = (self.plan.len() - from).min(
+            self.run_length
+                .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
+        );
         if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
             return Ok(());
         }
@@ -222,6 +228,7 @@ impl GpuKernels {
         let data = readback.submit_and_map(gpu, encoder, sample_bytes * count as u64)?;
         let layout: SampleLayout = layout.expect("at least two samples recorded");
         self.uploads.batches += 1;
+        self.run_taken = 0;
 
         let mut dropped = false;
         // What the GPU filed, for the host's next filing to hold too.
@@ -235,6 +242,7 @@ impl GpuKernels {
             if status.stopped != 0 && !dropped {
                 // The gate stopped the run at this sample, before it moved anything, and the
                 // samples after it selected nothing: there is nothing to put back.
+                self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 self.uploads.gated_ahead += 1;
                 break;
             }
@@ -250,6 +258,9 @@ impl GpuKernels {
                 // The gate stops a run on a cut list or cut rings; should it not have, this
                 // sample's passes ran on them, and the later ones on what they left: put back
                 // everything each moved.
+                if !dropped {
+                    self.run_length = j.max(FIRST_SAMPLES_AHEAD);
+                }
                 dropped = true;
                 let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
                 if !vertices.is_empty() {
@@ -335,6 +346,11 @@ impl GpuKernels {
             }
         }
         let sample = self.queued.pop_front()?;
+        self.run_taken += 1;
+        if self.queued.is_empty() {
+            // The whole run was taken as predicted.
+            self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
+        }
         self.uploads.samples_ahead += 1;
         self.ahead = sample.ahead;
         self.taken_filed = sample.filed;
@@ -344,6 +360,9 @@ impl GpuKernels {
     /// Drops every queued sample: the rows their passes wrote go back to the mesh's.
     pub(super) fn drop_queued(&mut self, mesh: &Mesh) {
         let queued = std::mem::take(&mut self.queued);
+        if !queued.is_empty() {
+            self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
+        }
         let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
         if vertices.is_empty() {
             return;
