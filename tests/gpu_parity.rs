@@ -2593,14 +2593,23 @@ fn sample_gate_stages_match_the_cpu_mirror() {
 
 #[test]
 fn moved_edges_grow_the_edge_bound_as_the_cpu_mirror_and_the_pipeline_do() {
+    check_moved_edges(Binding::Whole);
+}
+
+#[test]
+fn moved_edges_read_a_topology_split_over_several_bindings() {
+    check_moved_edges(Binding::Paged);
+}
+
+fn check_moved_edges(binding: Binding) {
     // Moving lists over a seeded shuffle of the vertices of two bumpy sheets at awkward sizes
     // (the largest folded into two dimensions), one slot in seven vacant, about half the
     // entries moved (some far enough to stretch their faces past the mesh's longest edge).
     // The bound grows to the longest edge of the faces around the moved vertices, as the
     // pipeline's `longest_edge` over them; `distance` may round differently on the GPU: a
     // relative 1e-6.
-    let mut gpu = gpu();
     let start = bumpy_sheets();
+    let mut gpu = gpu_for_normals(binding, &start);
     let vertex_count = start.vertex_count();
     let topology = slayer::gpu::PackedTopology::of(&start);
     let order = shuffled((0..vertex_count as u32).collect(), 931);

@@ -5,13 +5,13 @@
 
 use glam::Vec3;
 
+use super::vertex_normals::MovedPass;
 use super::{
-    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, NormalParams,
-    PackedTopology, SelectedVertex, Workgroups,
+    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
 };
 use crate::mesh::Mesh;
 
-/// Workgroup size of `longest_move`, `sample_gate` and `moved_edges`.
+/// Workgroup size of `longest_move` and `sample_gate` (`moved_edges` runs as `moved_normals`).
 pub const GATE_WORKGROUP_SIZE: u32 = 64;
 
 /// What the gate reads and writes.
@@ -188,26 +188,13 @@ pub fn record_moved_edges(
     (moving, slots): (&wgpu::Buffer, usize),
     status: &wgpu::Buffer,
 ) -> Result<(), GpuError> {
-    let params = NormalParams {
-        count: slots as u32,
+    let pass = MovedPass {
+        kernel: "moved_edges",
+        positions,
+        topology,
         vertex_rows_base,
-        _pad0: 0,
-        _pad1: 0,
     };
-    let pipeline = gpu.compute_pipeline("moved_edges")?;
-    let uniform = gpu.uniform_buffer("moved_edges params", &params);
-    gpu.record_paged_dispatch(
-        encoder,
-        &pipeline,
-        "moved_edges",
-        &[&uniform, positions, moving, status],
-        &[topology],
-        Workgroups::Cover {
-            invocations: slots,
-            workgroup_size: GATE_WORKGROUP_SIZE,
-        },
-    );
-    Ok(())
+    pass.record(gpu, encoder, (moving, slots), status)
 }
 
 /// `moved_edges` on the GPU over `moving`, `mesh`'s positions being where the entries are now,
@@ -218,21 +205,5 @@ pub fn run_moved_edges(
     moving: &[MovingVertex],
     status: GateStatus,
 ) -> Result<GateStatus, GpuError> {
-    gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
-    let topology = PackedTopology::of(mesh);
-    let positions = gpu.storage_buffer("positions", mesh.positions(), false);
-    let topology_buffer = topology.upload(gpu)?;
-    let moving_buffer = gpu.storage_buffer("moving list", moving, false);
-    let status = gpu.storage_buffer("gate status", &[status], true);
-    let mut encoder = gpu.encoder("moved_edges");
-    record_moved_edges(
-        gpu,
-        &mut encoder,
-        (&positions, &topology_buffer),
-        topology.layout.vertex_rows_base,
-        (&moving_buffer, moving.len()),
-        &status,
-    )?;
-    gpu.queue.submit([encoder.finish()]);
-    Ok(gpu.read_buffer::<GateStatus>(&status, 1)?[0])
+    Ok(MovedPass::run(gpu, "moved_edges", mesh, moving, &[status])?[0])
 }
