@@ -601,8 +601,8 @@ struct StepBuffers {
     /// The brush frame's sums, and its dispatch sized from the selection count.
     frame_sums: wgpu::Buffer,
     frame_args: wgpu::Buffer,
-    /// A run's [`GateStatus`]: whether a sample has stopped it, and the current sample's
-    /// longest move (`sample_gate`, `longest_move`).
+    /// A run's [`GateStatus`]: whether a sample has stopped it, the current sample's longest
+    /// move (`longest_move`) and the run's edge bound (`moved_edges`).
     gate_status: wgpu::Buffer,
 }
 

@@ -161,8 +161,8 @@ impl GpuKernels {
             0,
             bytemuck::bytes_of(&GateStatus::starting(state.max_edge)),
         );
-        // The edges as the samples before sample j may have lengthened them (checked when the
-        // pipeline reaches it).
+        // The edges as the samples before sample j may have lengthened them (checked by the
+        // gate, and by the host when the pipeline reaches it).
         let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
         let mut layout = None;
         let mut sample_bytes = 0;
