@@ -105,49 +105,110 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
 #[test]
 fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
     let (start, strokes) = plaster_and_strokes(1);
+    let report = check_run_ahead(&start, &strokes);
+    assert_eq!(report.steps, report.samples, "one step a sample");
+    assert!(report.uploads.read_backs < report.samples, "{report:?}");
+}
+
+/// A stroke pressed lightly, then hard: its first samples take one step each and run ahead,
+/// its last move farther than a step. The gate stops the run at the first of those, the
+/// pipeline takes it one submission per sample start and per step (the first step's passes
+/// with its deformation), and does not start a run after a sample of several steps; the
+/// result is still the CPU pipeline's.
+#[test]
+fn samples_of_several_steps_stop_a_run_and_match_the_cpu_pipeline() {
+    let (start, mut strokes) = plaster_and_strokes(1);
+    for stroke in &mut strokes {
+        stroke.brush.strength = 1.0;
+        let n = stroke.samples.len();
+        for (i, sample) in stroke.samples.iter_mut().enumerate() {
+            sample.pressure = if (n / 3..2 * n / 3).contains(&i) {
+                1.0
+            } else {
+                0.3
+            };
+        }
+    }
+    let report = check_run_ahead(&start, &strokes);
+    assert!(report.steps > report.samples, "{report:?}");
+    assert!(report.uploads.gated_ahead > 0, "{report:?}");
+}
+
+struct RunAheadReport {
+    samples: usize,
+    steps: usize,
+    uploads: slayer::pipeline::Uploads,
+    /// Read-backs of the same strokes one submission per step.
+    read_backs_apart: usize,
+}
+
+impl std::fmt::Debug for RunAheadReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} samples in {} steps, {} read-backs one submission per step; {:?}",
+            self.samples, self.steps, self.read_backs_apart, self.uploads
+        )
+    }
+}
+
+/// Runs `strokes` on the CPU and with everything on the GPU, runs ahead on, and checks that
+/// the GPU ran samples ahead, read back fewer times than with one submission per step, and
+/// matched the CPU pipeline's result, its copy the mesh row for row after the strokes.
+fn check_run_ahead(start: &Mesh, strokes: &[slayer::brush::Stroke]) -> RunAheadReport {
     let edge = start.mean_edge_length();
     let settings = PipelineSettings {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
     };
     let (mut on_cpu, mut on_gpu) = (start.clone(), start.clone());
-    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, strokes);
+    let mut kernels_apart = all_on_gpu();
+    kernels_apart.set_run_ahead(false);
+    let mut apart = CpuPipeline::with_kernels(settings, Box::new(kernels_apart));
+    run(&mut apart, &mut start.clone(), strokes);
+    let read_backs_apart = apart.uploads().expect("GPU kernels keep a copy").read_backs;
     let mut kernels = all_on_gpu();
     kernels.set_run_ahead(true);
     // What the GPU files between samples is read back and checked before the host refiles.
     kernels.set_check_filing(true);
     let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
     let mut gpu_collisions = 0;
-    let mut samples = 0;
-    for stroke in &strokes {
+    let (mut samples, mut steps) = (0, 0);
+    for stroke in strokes {
         let report = pipeline.apply_stroke(&mut on_gpu, stroke).unwrap();
         gpu_collisions += report.clamped;
         samples += report.samples;
+        steps += report.steps;
     }
     assert_eq!(pipeline.kernel_failure(), None);
     // Before the check, which reads the whole copy back.
     let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
     pipeline.check_kernel_copy(&on_gpu).unwrap();
     let deviation = largest_deviation(&on_cpu, &on_gpu);
+    let report = RunAheadReport {
+        samples,
+        steps,
+        uploads,
+        read_backs_apart,
+    };
     eprintln!(
-        "{samples} samples: max deviation {deviation:e} ({:.2e} L), collisions cpu \
-         {cpu_collisions} gpu {gpu_collisions}; {uploads:?}",
+        "max deviation {deviation:e} ({:.2e} L), collisions cpu {cpu_collisions} gpu \
+         {gpu_collisions}; {report:?}",
         deviation / edge
     );
     assert!(
         uploads.batches > 0 && uploads.samples_ahead > uploads.batches,
-        "{uploads:?}"
+        "{report:?}"
     );
-    assert!(
-        uploads.read_backs < samples,
-        "{uploads:?}, {samples} samples"
-    );
+    assert!(uploads.read_backs < read_backs_apart, "{report:?}");
     assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
     assert!(cpu_collisions > 0, "the stroke collides");
     let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
     assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
     on_gpu.validate().unwrap();
     assert_eq!(find_intersections(&on_gpu).total(), 0);
+    report
 }
 
 /// With remeshing after every stroke the GPU's copy is patched where remeshing changed the mesh

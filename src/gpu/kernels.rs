@@ -660,6 +660,15 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
+    /// The last sample the pipeline started moved farther than a step: it takes several, and
+    /// its neighbours likely do too, so the next sample does not start a run (each would stop
+    /// at its first sample). Runs start again after a sample of one step.
+    several_steps: bool,
+    /// The step limit of the stroke, and the selection and brush centre of the last sample
+    /// start the pipeline asked for: a sample of several steps deforms that selection again at
+    /// its first step, in one submission with the step's passes (`deform`).
+    step_limit: Option<f32>,
+    opened: Option<(Vec3, Vec<(u32, f32)>)>,
     /// The samples the pipeline said it will start this stroke (`upcoming`), and the index of
     /// the one after the last it took from a submission that ran several ahead.
     plan: Vec<SampleProbe>,
@@ -722,6 +731,9 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
+            several_steps: false,
+            step_limit: None,
+            opened: None,
             plan: Vec::new(),
             plan_next: 0,
             run_length: 0,
@@ -1141,6 +1153,40 @@ impl GpuKernels {
         let (finals, backstop) = step.parse_clamp(&data, count, read);
         tally(&mut self.filter, &backstop, filter);
         Ok((finals, backstop))
+    }
+
+    /// [`StepKernels::select_deform_and_clamp`] on the GPU, falling back to the CPU: at a
+    /// sample's start the sample run ahead, or a run of the samples planned from it (unless the
+    /// sample before took several steps), else one submission for this step.
+    fn select_deform_and_clamp_on_gpu(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        dab: &Dab,
+        source: FrameSource,
+        step_limit: f32,
+    ) -> Deformed {
+        let how = (source, true);
+        self.taken_filed = false;
+        if let FrameSource::Selection { normal } = source {
+            let probe = (*dab, normal);
+            if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
+                return deformed;
+            }
+            let runs_ahead = self.proximity_on_gpu
+                && self.clamp_ahead
+                && self.run_ahead
+                && !self.several_steps
+                && self.failed.is_none();
+            if let Some(from) = self.planned(&probe).filter(|_| runs_ahead) {
+                self.on_gpu(|k| k.gpu_run_ahead(state, mesh, from, step_limit));
+                if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
+                    return deformed;
+                }
+            }
+        }
+        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(step_limit)))
+            .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
     }
 
     /// The longest move passes recorded before the moves are known are sized for: twice the
@@ -1884,33 +1930,26 @@ impl StepKernels for GpuKernels {
         source: FrameSource,
         step_limit: f32,
     ) -> Deformed {
-        let how = (source, true);
-        self.taken_filed = false;
-        // At a sample's start: the sample run ahead, or a run of the samples planned from it.
-        if let FrameSource::Selection { normal } = source {
-            let probe = (*dab, normal);
-            if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
-                return deformed;
-            }
-            let runs_ahead = self.proximity_on_gpu
-                && self.clamp_ahead
-                && self.run_ahead
-                && self.failed.is_none();
-            if let Some(from) = self.planned(&probe).filter(|_| runs_ahead) {
-                self.on_gpu(|k| k.gpu_run_ahead(state, mesh, from, step_limit));
-                if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
-                    return deformed;
-                }
-            }
+        let deformed = self.select_deform_and_clamp_on_gpu(state, mesh, dab, source, step_limit);
+        self.step_limit = Some(step_limit);
+        if matches!(source, FrameSource::Selection { .. }) {
+            // Several steps when the whole sample moves farther than one (a NaN move is not
+            // within it either).
+            self.several_steps = deformed
+                .targets
+                .as_ref()
+                .is_some_and(|t| !(longest_move(mesh, &deformed.selection, t) <= step_limit));
+            self.opened = Some((dab.frame.center, deformed.selection.clone()));
         }
-        self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(step_limit)))
-            .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
+        deformed
     }
 
     fn upcoming(&mut self, mesh: &Mesh, probes: &[SampleProbe]) {
         self.drop_queued(mesh);
         self.plan = probes.to_vec();
         self.plan_next = 0;
+        self.several_steps = false;
+        self.opened = None;
     }
 
     fn deform(
@@ -1920,6 +1959,28 @@ impl StepKernels for GpuKernels {
         dab: &Dab,
         selection: &[(u32, f32)],
     ) -> Vec<Vec3> {
+        // The first step of a sample of several: the selection its start found, under the same
+        // brush (a share of the move). Selected again with the deformation and the step's
+        // passes in one submission, as a later step is, when the selection comes out the same.
+        let reopened = self
+            .opened
+            .take()
+            .is_some_and(|(center, opened)| center == dab.frame.center && opened == selection);
+        if let Some(limit) = self
+            .step_limit
+            .filter(|_| reopened && self.failed.is_none())
+        {
+            let how = (FrameSource::Dab, true);
+            if let Some(Deformed {
+                selection: found,
+                targets: Some(targets),
+                ..
+            }) = self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(limit)))
+                && found == selection
+            {
+                return targets;
+            }
+        }
         self.on_gpu(|k| k.gpu_deform(state, mesh, dab, selection))
             .unwrap_or_else(|| CpuKernels.deform(state, mesh, dab, selection))
     }

@@ -244,6 +244,7 @@ impl GpuKernels {
                 // samples after it selected nothing: there is nothing to put back.
                 self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 self.uploads.gated_ahead += 1;
+                self.after_stop(from + j, status, limit);
                 break;
             }
             let head = found.min(guess);
@@ -308,6 +309,26 @@ impl GpuKernels {
         Ok(())
     }
 
+    /// After the gate stopped a run at planned sample `index`: whether the pipeline's call for
+    /// it starts the next run. One whose selection outgrew the guessed list, whose edges the
+    /// samples before grew past the prediction, or whose move outgrew the assumed one within a
+    /// step does, sized from what this run read (the list's count, the pipeline's edges, the
+    /// move: `last_move`). One that moves farther than a step (several steps), or whose rings
+    /// outgrow their fixed room, would stop it again: the pipeline takes it one submission per
+    /// step, and the sample after it starts the next run.
+    fn after_stop(&mut self, index: usize, status: GateStatus, limit: f32) {
+        let longest = status.longest_move();
+        let moved_too_far = status.stopped & GateStatus::MOVE != 0;
+        if moved_too_far && longest.is_finite() {
+            self.last_move = longest;
+        }
+        // A NaN move is not within the limit either.
+        let one_step = longest <= limit;
+        if status.stopped & GateStatus::RINGS != 0 || (moved_too_far && !one_step) {
+            self.plan_next = index + 1;
+        }
+    }
+
     /// The queued sample the pipeline starts with `probe`, when it is the next one queued and
     /// its moves are one step within what its passes assumed, from where the mesh is now, and
     /// the pipeline's bound on the edges (`max_edge`) within theirs. Any other probe, or moves
@@ -335,7 +356,7 @@ impl GpuKernels {
             .ahead
             .as_ref()
             .map(|ahead| longest_move(mesh, &head.deformed.selection, &ahead.targets));
-        self.plan_next = head.index + 1;
+        self.plan_next = self.plan_next.max(head.index + 1);
         if let Some(longest) = longest {
             self.last_move = longest;
             // A NaN move does not fit either.
