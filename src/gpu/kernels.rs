@@ -1935,10 +1935,10 @@ impl StepKernels for GpuKernels {
         if matches!(source, FrameSource::Selection { .. }) {
             // Several steps when the whole sample moves farther than one (a NaN move is not
             // within it either).
-            self.several_steps = deformed
-                .targets
-                .as_ref()
-                .is_some_and(|t| !(longest_move(mesh, &deformed.selection, t) <= step_limit));
+            self.several_steps = deformed.targets.as_ref().is_some_and(|t| {
+                let longest = longest_move(mesh, &deformed.selection, t);
+                longest.is_nan() || longest > step_limit
+            });
             self.opened = Some((dab.frame.center, deformed.selection.clone()));
         }
         deformed
