@@ -1021,11 +1021,19 @@ impl GpuKernels {
         )?;
         let r = &*r;
         let mut encoder = gpu.encoder("select and deform");
+        // Through the gate: passes whose assumptions fail move nothing (nothing to put back).
         let ahead = assumed_move.map(|assumed_move| AheadBounds {
             assumed_move,
             drift: r.hashed().drift,
-            gated: false,
+            gated: true,
         });
+        if ahead.is_some() {
+            gpu.queue.write_buffer(
+                &step.gate_status,
+                0,
+                bytemuck::bytes_of(&GateStatus::starting(state.max_edge)),
+            );
+        }
         let recorded = record_sample(
             gpu,
             &mut encoder,
@@ -1063,9 +1071,10 @@ impl GpuKernels {
         if let (Some(assumed), Some(clamp_read)) = (assumed_move, layout.clamp) {
             let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
             // Within the assumed move, which is within the step limit: one step, which moves
-            // the selection to exactly these targets.
+            // the selection to exactly these targets. The gate checked the same on the GPU.
+            let stopped = parts.gate.is_some_and(|g| g.stopped != 0);
             let kept = targets.as_ref().filter(|_| {
-                parts.ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed)
+                !stopped && parts.ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed)
             });
             match kept {
                 Some(targets) => {
@@ -1079,6 +1088,8 @@ impl GpuKernels {
                 }
                 // Nothing selected: nothing moved, nothing to drop.
                 None if vertices.is_empty() => {}
+                // Stopped by the gate before they moved anything.
+                None if stopped => self.uploads.gated_ahead += 1,
                 // The passes moved what they were wrong about.
                 None => put_back(gpu, Some(r), &mut self.uploads, mesh, &vertices),
             }
@@ -1634,6 +1645,8 @@ struct SampleLayout {
     frame_from_selection: Option<Option<Vec3>>,
     target_bytes: u64,
     clamp: Option<ClampRead>,
+    /// The passes went through the gate, whose status follows the ring overflows.
+    gated: bool,
 }
 
 /// A recorded sample's bytes after the selection list, split.
@@ -1643,6 +1656,9 @@ struct SampleBytes<'d> {
     targets: &'d [u8],
     /// Rings `moving_entries` cut short, where the passes ran.
     ring_overflows: Option<u32>,
+    /// The gate's verdict, where the passes went through it: when it stopped them they moved
+    /// nothing.
+    gate: Option<GateStatus>,
     /// The rest: what `StepBuffers::parse_clamp` reads.
     clamp: &'d [u8],
 }
@@ -1665,10 +1681,14 @@ impl SampleLayout {
         let ring_overflows = self
             .clamp
             .map(|_| u32::from_le_bytes(take(4).try_into().expect("four bytes")));
+        let gate = self
+            .gated
+            .then(|| bytemuck::pod_read_unaligned(take(std::mem::size_of::<GateStatus>() as u64)));
         SampleBytes {
             frame,
             targets,
             ring_overflows,
+            gate,
             clamp: rest,
         }
     }
@@ -1801,6 +1821,9 @@ fn record_sample<'b>(
         };
         let read = record_clamp(gpu, encoder, (r, step), state, &bounds, filter)?;
         parts.push((&step.ring_overflows, 4));
+        if gated {
+            parts.push((&step.gate_status, std::mem::size_of::<GateStatus>() as u64));
+        }
         parts.push((step.finals.buffer(), read.finals_bytes));
         if let Some(pair_bytes) = read.pair_bytes {
             parts.push((&step.pair_count, 4));
@@ -1814,6 +1837,7 @@ fn record_sample<'b>(
             frame_from_selection,
             target_bytes,
             clamp,
+            gated,
         },
     })
 }

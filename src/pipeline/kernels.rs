@@ -171,14 +171,14 @@ pub struct Uploads {
     /// round trips a hardware GPU pays beside its kernels).
     pub read_backs: usize,
     /// Steps whose proximity passes ran in the submission that selected and deformed
-    /// ([`StepKernels::select_deform_and_clamp`]), and those whose passes so run were dropped
-    /// (the step was longer than assumed, the selection outgrew its guessed length, or a ring
-    /// its room).
+    /// ([`StepKernels::select_deform_and_clamp`]), and those whose passes so run moved vertices
+    /// the pipeline did not take and were put back (the exact backstop undid a move, or the
+    /// host's check of the move or the edges disagreed with the gate's).
     pub clamped_ahead: usize,
     pub dropped_ahead: usize,
-    /// Samples of a run ahead at which the GPU's gate stopped the run (`sample_gate`), before
-    /// they moved anything: their selection outgrew its room, a ring its room, or a vertex
-    /// moved farther than the passes were sized for.
+    /// Steps whose passes ran ahead and the GPU's gate stopped before they moved anything
+    /// (`sample_gate`; a run stops there): their selection outgrew its room, a ring its room, a
+    /// vertex moved farther or an edge grew longer than the passes were sized for.
     pub gated_ahead: usize,
     /// Submissions that ran several samples of a stroke ahead, and the samples taken from them
     /// as predicted ([`StepKernels::upcoming`]).

@@ -53,9 +53,6 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
 
-/// Bytes of the run's gate status read back before each sample's results.
-const GATE_BYTES: usize = std::mem::size_of::<GateStatus>();
-
 /// A run's later samples assume the mesh's longest edge grows by at most this share of the
 /// assumed move per sample before them; the gate stops the run at the first whose edges, as
 /// `moved_edges` measured them, say otherwise (and the host drops it should the pipeline's own
@@ -211,11 +208,7 @@ impl GpuKernels {
                     (step.moving.buffer(), guess),
                 )?;
             }
-            let mut parts = vec![
-                (&step.gate_status, GATE_BYTES as u64),
-                (&r.selection.count, 4),
-                (&r.selection.selected, list_bytes),
-            ];
+            let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
             parts.extend_from_slice(&recorded.parts);
             if j == 0 {
                 // Every sample leaves the same parts.
@@ -234,11 +227,14 @@ impl GpuKernels {
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
-            let status: GateStatus = bytemuck::pod_read_unaligned(&bytes[..GATE_BYTES]);
-            let bytes = &bytes[GATE_BYTES..];
             let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
                 .min(capacity);
             self.last_selection = self.last_selection.max(found);
+            let head = found.min(guess);
+            let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
+            let (dab, normal) = self.plan[from + j];
+            let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
+            let status = parts.gate.expect("runs go through the gate");
             if status.stopped != 0 && !dropped {
                 // The gate stopped the run at this sample, before it moved anything, and the
                 // samples after it selected nothing: there is nothing to put back.
@@ -247,10 +243,6 @@ impl GpuKernels {
                 self.after_stop(from + j, status, limit);
                 break;
             }
-            let head = found.min(guess);
-            let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
-            let (dab, normal) = self.plan[from + j];
-            let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
             let (order, selection) = in_vertex_order(&list);
             if j + 1 < count {
                 filed_on_gpu.extend(list.iter().map(|s| s.vertex));
