@@ -1195,6 +1195,34 @@ struct ProximityScene {
     edge: f32,
 }
 
+/// A moving list over `listed`, each entry starting where `start` has its vertex, one slot in
+/// seven vacant; about half the slots' vertices (vacant ones too) moved in `positions` by what
+/// `step` draws. Returns the list and the vertices of its (not vacant) entries that moved.
+fn half_moved_list(
+    start: &[Vec3],
+    positions: &mut [Vec3],
+    listed: &[u32],
+    (rng, step): (&mut ChaCha8Rng, impl Fn(&mut ChaCha8Rng) -> Vec3),
+) -> (Vec<slayer::gpu::MovingVertex>, Vec<u32>) {
+    let mut moving = Vec::with_capacity(listed.len());
+    let mut moved = Vec::new();
+    for (slot, &v) in listed.iter().enumerate() {
+        let vertex = if slot % 7 == 6 { INVALID } else { v };
+        moving.push(slayer::gpu::MovingVertex {
+            start: start[v as usize].to_array(),
+            vertex,
+            ..Default::default()
+        });
+        if rng.random_bool(0.5) {
+            positions[v as usize] += step(rng);
+            if vertex != INVALID {
+                moved.push(v);
+            }
+        }
+    }
+    (moving, moved)
+}
+
 fn shuffled(mut vertices: Vec<u32>, seed: u64) -> Vec<u32> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     for i in (1..vertices.len()).rev() {
@@ -1623,23 +1651,15 @@ fn check_moved_normals(binding: Binding) {
             gpu.limits.max_compute_workgroups_per_dimension = 7;
         }
         let mut mesh = start.clone();
-        let mut moving = Vec::with_capacity(size);
-        let mut moved = Vec::new();
-        for (slot, &v) in order[..size].iter().enumerate() {
-            let vertex = if slot % 7 == 6 { INVALID } else { v };
-            moving.push(slayer::gpu::MovingVertex {
-                start: start.positions()[v as usize].to_array(),
-                vertex,
-                ..Default::default()
-            });
-            // Vacant slots move too: their vertex's normals must stay all the same.
-            if rng.random_bool(0.5) {
-                mesh.positions_mut()[v as usize].z += rng.random_range(-0.01..0.01);
-                if vertex != INVALID {
-                    moved.push(v);
-                }
-            }
-        }
+        // Vacant slots move too: their vertex's normals must stay all the same.
+        let (moving, moved) = half_moved_list(
+            start.positions(),
+            mesh.positions_mut(),
+            &order[..size],
+            (&mut rng, |rng| {
+                Vec3::new(0.0, 0.0, rng.random_range(-0.01..0.01))
+            }),
+        );
         let mut corners: Vec<u32> = moved
             .iter()
             .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
@@ -2226,22 +2246,14 @@ fn overlay_members_file_the_moved_entries_as_the_cpu_mirror_does() {
             gpu.limits.max_compute_workgroups_per_dimension = 7;
         }
         let mut positions = start.clone();
-        let mut moving = Vec::with_capacity(size);
-        let mut moved = Vec::new();
-        for (slot, &v) in order[..size].iter().enumerate() {
-            let vertex = if slot % 7 == 6 { INVALID } else { v };
-            moving.push(slayer::gpu::MovingVertex {
-                start: start[v as usize].to_array(),
-                vertex,
-                ..Default::default()
-            });
-            if rng.random_bool(0.5) {
-                positions[v as usize] += Vec3::new(0.0, 0.0, rng.random_range(0.001..0.3));
-                if vertex != INVALID {
-                    moved.push(v);
-                }
-            }
-        }
+        let (moving, moved) = half_moved_list(
+            &start,
+            &mut positions,
+            &order[..size],
+            (&mut rng, |rng| {
+                Vec3::new(0.0, 0.0, rng.random_range(0.001..0.3))
+            }),
+        );
         let room = held.len() + size;
         let before = overlay_slots(&start, &held, room);
         let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
@@ -2621,23 +2633,14 @@ fn check_moved_edges(binding: Binding) {
             gpu.limits.max_compute_workgroups_per_dimension = 7;
         }
         let mut mesh = start.clone();
-        let mut moving = Vec::with_capacity(size);
-        let mut moved = Vec::new();
-        for (slot, &v) in order[..size].iter().enumerate() {
-            let vertex = if slot % 7 == 6 { INVALID } else { v };
-            moving.push(slayer::gpu::MovingVertex {
-                start: start.positions()[v as usize].to_array(),
-                vertex,
-                ..Default::default()
-            });
-            if rng.random_bool(0.5) {
-                mesh.positions_mut()[v as usize] +=
-                    Vec3::new(0.0, 0.0, rng.random_range(0.001..2.0) * initial);
-                if vertex != INVALID {
-                    moved.push(v);
-                }
-            }
-        }
+        let (moving, moved) = half_moved_list(
+            start.positions(),
+            mesh.positions_mut(),
+            &order[..size],
+            (&mut rng, |rng| {
+                Vec3::new(0.0, 0.0, rng.random_range(0.001..2.0) * initial)
+            }),
+        );
         let before = slayer::gpu::GateStatus::starting(0.5 * initial);
         let params = slayer::gpu::NormalParams {
             count: size as u32,
