@@ -660,15 +660,16 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
-    /// The last sample the pipeline started moved farther than a step: it takes several, and
-    /// its neighbours likely do too, so the next sample does not start a run (each would stop
-    /// at its first sample). Runs start again after a sample of one step.
+    /// The last sample the pipeline started takes several steps (it asked to deform its
+    /// selection again, `deform`), and its neighbours likely do too: the next sample does not
+    /// start a run (each would stop at its first sample). Runs start again after a sample of
+    /// one step.
     several_steps: bool,
-    /// The step limit of the stroke, and the selection and brush centre of the last sample
-    /// start the pipeline asked for: a sample of several steps deforms that selection again at
-    /// its first step, in one submission with the step's passes (`deform`).
+    /// The step limit of the stroke, and the brush centre and selection size of the last
+    /// sample start: the pipeline deforms that selection again at the first step of a sample
+    /// of several, which then runs in one submission with the step's passes (`deform`).
     step_limit: Option<f32>,
-    opened: Option<(Vec3, Vec<(u32, f32)>)>,
+    opened: Option<(Vec3, usize)>,
     /// The samples the pipeline said it will start this stroke (`upcoming`), and the index of
     /// the one after the last it took from a submission that ran several ahead.
     plan: Vec<SampleProbe>,
@@ -1021,18 +1022,12 @@ impl GpuKernels {
         )?;
         let r = &*r;
         let mut encoder = gpu.encoder("select and deform");
-        // Through the gate: passes whose assumptions fail move nothing (nothing to put back).
         let ahead = assumed_move.map(|assumed_move| AheadBounds {
             assumed_move,
             drift: r.hashed().drift,
-            gated: true,
         });
         if ahead.is_some() {
-            gpu.queue.write_buffer(
-                &step.gate_status,
-                0,
-                bytemuck::bytes_of(&GateStatus::starting(state.max_edge)),
-            );
+            step.start_gate(gpu, state.max_edge);
         }
         let recorded = record_sample(
             gpu,
@@ -1327,6 +1322,16 @@ struct ClampRead {
 }
 
 impl StepBuffers {
+    /// Starts the gate for a single step's passes or a run's: no stop yet, and the edge bound
+    /// at `max_edge` (the pipeline's). Written before the submission's commands run.
+    fn start_gate(&self, gpu: &GpuContext, max_edge: f32) {
+        gpu.queue.write_buffer(
+            &self.gate_status,
+            0,
+            bytemuck::bytes_of(&GateStatus::starting(max_edge)),
+        );
+    }
+
     /// Room for [`record_sample`] over `guess` slots (with `ahead`, its passes too: the
     /// topology made resident).
     fn reserve_sample(
@@ -1621,14 +1626,12 @@ fn record_clamp(
 
 /// How a sample's passes, recorded before its moves are known, are sized: for moves up to
 /// `assumed_move`, over a table whose vertices may have drifted `drift` from where they were
-/// filed.
+/// filed. Such passes go through the gate (`sample_gate`, started by
+/// [`StepBuffers::start_gate`]): where those assumptions fail they move nothing.
 #[derive(Debug, Clone, Copy)]
 struct AheadBounds {
     assumed_move: f32,
     drift: f32,
-    /// A sample of a run: its passes go through the run's gate (`sample_gate`), which stops
-    /// the run at the first sample whose assumptions fail, before it moves anything.
-    gated: bool,
 }
 
 /// What [`record_sample`] leaves to read back after the selection's count and list: `parts`,
@@ -1644,9 +1647,8 @@ struct SampleLayout {
     /// The sample's own normal when the frame is summed from the selection.
     frame_from_selection: Option<Option<Vec3>>,
     target_bytes: u64,
+    /// Where the passes ran (through the gate, whose status follows the ring overflows).
     clamp: Option<ClampRead>,
-    /// The passes went through the gate, whose status follows the ring overflows.
-    gated: bool,
 }
 
 /// A recorded sample's bytes after the selection list, split.
@@ -1682,8 +1684,8 @@ impl SampleLayout {
             .clamp
             .map(|_| u32::from_le_bytes(take(4).try_into().expect("four bytes")));
         let gate = self
-            .gated
-            .then(|| bytemuck::pod_read_unaligned(take(std::mem::size_of::<GateStatus>() as u64)));
+            .clamp
+            .map(|_| bytemuck::pod_read_unaligned(take(std::mem::size_of::<GateStatus>() as u64)));
         SampleBytes {
             frame,
             targets,
@@ -1714,7 +1716,6 @@ fn record_sample<'b>(
     let drift = ahead.map_or(r.hashed().drift, |a| a.drift);
     record_brush_selection(gpu, encoder, r, state.active, dab, drift)?;
     let capacity = r.selection.capacity;
-    let gated = ahead.is_some_and(|a| a.gated);
     let gate = || GateBuffers {
         positions: &r.vertices.positions,
         selected: &r.selection.selected,
@@ -1724,7 +1725,7 @@ fn record_sample<'b>(
         moving: step.moving.buffer(),
         status: &step.gate_status,
     };
-    if gated {
+    if ahead.is_some() {
         record_gate_open(gpu, encoder, &gate())?;
     }
     let inputs = SelectionBuffers {
@@ -1808,9 +1809,7 @@ fn record_sample<'b>(
                 overflows: &step.ring_overflows,
             },
         )?;
-        if gated {
-            record_gate_check(gpu, encoder, &gate(), (guess, assumed_move, state.max_edge))?;
-        }
+        record_gate_check(gpu, encoder, &gate(), (guess, assumed_move, state.max_edge))?;
         // No vertex moves farther than assumed, so no edge grows by more than twice that.
         let bounds = PassBounds {
             count: guess,
@@ -1821,9 +1820,7 @@ fn record_sample<'b>(
         };
         let read = record_clamp(gpu, encoder, (r, step), state, &bounds, filter)?;
         parts.push((&step.ring_overflows, 4));
-        if gated {
-            parts.push((&step.gate_status, std::mem::size_of::<GateStatus>() as u64));
-        }
+        parts.push((&step.gate_status, std::mem::size_of::<GateStatus>() as u64));
         parts.push((step.finals.buffer(), read.finals_bytes));
         if let Some(pair_bytes) = read.pair_bytes {
             parts.push((&step.pair_count, 4));
@@ -1837,7 +1834,6 @@ fn record_sample<'b>(
             frame_from_selection,
             target_bytes,
             clamp,
-            gated,
         },
     })
 }
@@ -1957,13 +1953,9 @@ impl StepKernels for GpuKernels {
         let deformed = self.select_deform_and_clamp_on_gpu(state, mesh, dab, source, step_limit);
         self.step_limit = Some(step_limit);
         if matches!(source, FrameSource::Selection { .. }) {
-            // Several steps when the whole sample moves farther than one (a NaN move is not
-            // within it either).
-            self.several_steps = deformed.targets.as_ref().is_some_and(|t| {
-                let longest = longest_move(mesh, &deformed.selection, t);
-                longest.is_nan() || longest > step_limit
-            });
-            self.opened = Some((dab.frame.center, deformed.selection.clone()));
+            // Until the pipeline asks to deform this sample's selection again (`deform`).
+            self.several_steps = false;
+            self.opened = Some((dab.frame.center, deformed.selection.len()));
         }
         deformed
     }
@@ -1989,7 +1981,8 @@ impl StepKernels for GpuKernels {
         let reopened = self
             .opened
             .take()
-            .is_some_and(|(center, opened)| center == dab.frame.center && opened == selection);
+            .is_some_and(|opened| opened == (dab.frame.center, selection.len()));
+        self.several_steps |= reopened;
         if let Some(limit) = self
             .step_limit
             .filter(|_| reopened && self.failed.is_none())

@@ -153,11 +153,7 @@ impl GpuKernels {
         r.hashed().record_gpu_table(gpu, &mut encoder)?;
         // The gate's edge bound starts at the pipeline's; each sample but the last grows it by
         // the faces it turned (`moved_edges`) for the next one's verdict.
-        gpu.queue.write_buffer(
-            &step.gate_status,
-            0,
-            bytemuck::bytes_of(&GateStatus::starting(state.max_edge)),
-        );
+        step.start_gate(gpu, state.max_edge);
         // The edges as the samples before sample j may have lengthened them (checked by the
         // gate, and by the host when the pipeline reaches it).
         let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
@@ -180,7 +176,6 @@ impl GpuKernels {
                 Some(AheadBounds {
                     assumed_move,
                     drift,
-                    gated: true,
                 }),
                 filter,
             )?;
@@ -223,7 +218,6 @@ impl GpuKernels {
         self.uploads.batches += 1;
         self.run_taken = 0;
 
-        let mut dropped = false;
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
@@ -235,7 +229,7 @@ impl GpuKernels {
             let (dab, normal) = self.plan[from + j];
             let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
             let status = parts.gate.expect("runs go through the gate");
-            if status.stopped != 0 && !dropped {
+            if status.stopped != 0 {
                 // The gate stopped the run at this sample, before it moved anything, and the
                 // samples after it selected nothing: there is nothing to put back.
                 self.run_length = j.max(FIRST_SAMPLES_AHEAD);
@@ -247,21 +241,8 @@ impl GpuKernels {
             if j + 1 < count {
                 filed_on_gpu.extend(list.iter().map(|s| s.vertex));
             }
-            if found > guess || parts.ring_overflows != Some(0) || dropped {
-                // The gate stops a run on a cut list or cut rings; should it not have, this
-                // sample's passes ran on them, and the later ones on what they left: put back
-                // everything each moved.
-                if !dropped {
-                    self.run_length = j.max(FIRST_SAMPLES_AHEAD);
-                }
-                dropped = true;
-                let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
-                if !vertices.is_empty() {
-                    self.uploads.dropped_ahead += 1;
-                    put_back_rows(gpu, Some(r), mesh, &vertices);
-                }
-                continue;
-            }
+            // The gate stops a run on a cut list or cut rings (the same count and buffer).
+            debug_assert!(found <= guess && parts.ring_overflows == Some(0));
             let ahead = (!selection.is_empty()).then(|| {
                 let targets: Vec<Vec3> = permuted(
                     &order,
@@ -293,10 +274,6 @@ impl GpuKernels {
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
-            if dropped {
-                // Filed where the dropped samples put them.
-                hashed.gpu_drift = None;
-            }
         }
         Ok(())
     }
