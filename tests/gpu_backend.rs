@@ -110,15 +110,17 @@ fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
     assert!(report.uploads.read_backs < report.samples, "{report:?}");
 }
 
-/// A stroke pressed lightly, then hard: its first samples take one step each and run ahead,
-/// its last move farther than a step. The gate stops the run at the first of those, the
-/// pipeline takes it one submission per sample start and per step (the first step's passes
-/// with its deformation), and does not start a run after a sample of several steps; the
-/// result is still the CPU pipeline's.
+/// An inflating stroke pressed lightly, then hard, then lightly: its middle samples move
+/// farther than a step. The gate stops a run at the start of such a sample, which the pipeline
+/// takes from what the run read; its steps and the samples after it then run ahead in one
+/// submission, each step deforming on the normals from before the sample (inflate moves along
+/// them), the normals recomputed after its last. The result is the CPU pipeline's, in fewer
+/// read-backs than samples.
 #[test]
-fn samples_of_several_steps_stop_a_run_and_match_the_cpu_pipeline() {
+fn samples_of_several_steps_run_their_steps_ahead_and_match_the_cpu_pipeline() {
     let (start, mut strokes) = plaster_and_strokes(1);
     for stroke in &mut strokes {
+        stroke.brush.kind = slayer::brush::BrushKind::Inflate;
         stroke.brush.strength = 1.0;
         let n = stroke.samples.len();
         for (i, sample) in stroke.samples.iter_mut().enumerate() {
@@ -132,6 +134,8 @@ fn samples_of_several_steps_stop_a_run_and_match_the_cpu_pipeline() {
     let report = check_run_ahead(&start, &strokes);
     assert!(report.steps > report.samples, "{report:?}");
     assert!(report.uploads.gated_ahead > 0, "{report:?}");
+    assert!(report.uploads.steps_ahead > 0, "{report:?}");
+    assert!(report.uploads.read_backs < report.samples, "{report:?}");
 }
 
 struct RunAheadReport {

@@ -107,11 +107,20 @@ pub fn record_gate_check(
         GATE_WORKGROUP_SIZE,
     );
     record_stage(gpu, encoder, gate, &params)?;
-    let vacate = GateParams {
-        stage: GateStage::Vacate as u32,
-        ..params
-    };
-    record_stage(gpu, encoder, gate, &vacate)
+    record_gate_vacate(gpu, encoder, gate, capacity)
+}
+
+/// Records the vacating of the first `capacity` slots of `gate.moving` when the run has
+/// stopped (a step's moving list before anything is applied, or the lists a sample's steps
+/// kept for its normals).
+pub fn record_gate_vacate(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    gate: &GateBuffers<'_>,
+    capacity: usize,
+) -> Result<(), GpuError> {
+    let params = GateParams::new(capacity, GateStage::Vacate, (0.0, 0.0));
+    record_stage(gpu, encoder, gate, &params)
 }
 
 /// `longest_move` on the GPU over the first `min(selection_count, capacity)` entries, folded

@@ -68,6 +68,7 @@ use crate::pipeline::step::{
 use crate::pipeline::{
     BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
 };
+use run_ahead::steps_of_share;
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -604,9 +605,25 @@ struct StepBuffers {
     /// A run's [`GateStatus`]: whether a sample has stopped it, the current sample's longest
     /// move (`longest_move`) and the run's edge bound (`moved_edges`).
     gate_status: wgpu::Buffer,
+    /// The moving lists of a run's steps of one sample, one after another, for the normals
+    /// after its last step.
+    held_moving: ReusableBuffer,
 }
 
 impl StepBuffers {
+    /// What the run's gate reads and writes for a step recorded into these buffers.
+    fn gate<'b>(&'b self, r: &'b Resident) -> GateBuffers<'b> {
+        GateBuffers {
+            positions: &r.vertices.positions,
+            selected: &r.selection.selected,
+            selection_count: &r.selection.count,
+            targets: self.targets.buffer(),
+            ring_overflows: &self.ring_overflows,
+            moving: self.moving.buffer(),
+            status: &self.gate_status,
+        }
+    }
+
     fn new(gpu: &GpuContext) -> StepBuffers {
         StepBuffers {
             selected: ReusableBuffer::storage("selected"),
@@ -627,6 +644,7 @@ impl StepBuffers {
             frame_sums: frame_sums_buffer(gpu),
             frame_args: indirect_args_buffer(gpu, "brush frame sizes"),
             gate_status: gpu.output_buffer::<GateStatus>("run gate status", 1),
+            held_moving: ReusableBuffer::storage("moving lists of a sample's steps"),
         }
     }
 }
@@ -660,16 +678,17 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
-    /// The last sample the pipeline started takes several steps (it asked to deform its
-    /// selection again, `deform`), and its neighbours likely do too: the next sample does not
-    /// start a run (each would stop at its first sample). Runs start again after a sample of
-    /// one step.
-    several_steps: bool,
-    /// The step limit of the stroke, and the brush centre and selection size of the last
-    /// sample start: the pipeline deforms that selection again at the first step of a sample
-    /// of several, which then runs in one submission with the step's passes (`deform`).
+    /// The step limit of the stroke, and the last sample start: the pipeline deforms its
+    /// selection again at the first step of a sample of several, which then records the
+    /// sample's steps and the samples after it in one run (`deform`).
     step_limit: Option<f32>,
-    opened: Option<(Vec3, usize)>,
+    opened: Option<OpenedSample>,
+    /// The planned sample that stopped the last run where a run starting at it would stop
+    /// again: the pipeline's call for it runs alone.
+    no_run_at: Option<usize>,
+    /// The vertices the steps of the current sample taken from a run moved: the run
+    /// recomputed their normals after the sample's last step, which go back with it.
+    steps_taken: Vec<u32>,
     /// The samples the pipeline said it will start this stroke (`upcoming`), and the index of
     /// the one after the last it took from a submission that ran several ahead.
     plan: Vec<SampleProbe>,
@@ -691,6 +710,17 @@ pub struct GpuKernels {
     filing_error: Option<String>,
     /// Read-backs the checks made, left out of [`Uploads::read_backs`].
     check_read_backs: usize,
+}
+
+/// A sample start the pipeline may go on to deform in several steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OpenedSample {
+    /// Its brush centre and the size of its selection, to recognise the call for its first
+    /// step (the GPU's reselection is compared with the pipeline's before it is used).
+    center: Vec3,
+    selected: usize,
+    /// Where it is in the plan: the samples after it follow its steps in their run.
+    planned: Option<usize>,
 }
 
 /// A merged submission's passes assume moves up to this many times the last step's longest.
@@ -732,9 +762,10 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
-            several_steps: false,
             step_limit: None,
             opened: None,
+            no_run_at: None,
+            steps_taken: Vec::new(),
             plan: Vec::new(),
             plan_next: 0,
             run_length: 0,
@@ -1174,22 +1205,21 @@ impl GpuKernels {
     ) -> Deformed {
         let how = (source, true);
         self.taken_filed = false;
-        if let FrameSource::Selection { normal } = source {
-            let probe = (*dab, normal);
-            if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
-                return deformed;
+        let taken = match source {
+            FrameSource::Selection { normal } => {
+                let probe = (*dab, normal);
+                self.take_queued_start(mesh, &probe, state.max_edge)
+                    .or_else(|| {
+                        let from = self.planned(&probe).filter(|_| self.runs_ahead())?;
+                        let run = (None, Some(from));
+                        self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, step_limit))?;
+                        self.take_queued_start(mesh, &probe, state.max_edge)
+                    })
             }
-            let runs_ahead = self.proximity_on_gpu
-                && self.clamp_ahead
-                && self.run_ahead
-                && !self.several_steps
-                && self.failed.is_none();
-            if let Some(from) = self.planned(&probe).filter(|_| runs_ahead) {
-                self.on_gpu(|k| k.gpu_run_ahead(state, mesh, from, step_limit));
-                if let Some(deformed) = self.take_queued(mesh, &probe, state.max_edge) {
-                    return deformed;
-                }
-            }
+            FrameSource::Dab => self.take_queued_step(mesh, (dab, None), state.max_edge),
+        };
+        if let Some(deformed) = taken {
+            return deformed;
         }
         self.on_gpu(|k| k.gpu_select_and_deform(state, mesh, dab, how, Some(step_limit)))
             .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
@@ -1716,15 +1746,7 @@ fn record_sample<'b>(
     let drift = ahead.map_or(r.hashed().drift, |a| a.drift);
     record_brush_selection(gpu, encoder, r, state.active, dab, drift)?;
     let capacity = r.selection.capacity;
-    let gate = || GateBuffers {
-        positions: &r.vertices.positions,
-        selected: &r.selection.selected,
-        selection_count: &r.selection.count,
-        targets: step.targets.buffer(),
-        ring_overflows: &step.ring_overflows,
-        moving: step.moving.buffer(),
-        status: &step.gate_status,
-    };
+    let gate = || step.gate(r);
     if ahead.is_some() {
         record_gate_open(gpu, encoder, &gate())?;
     }
@@ -1950,12 +1972,19 @@ impl StepKernels for GpuKernels {
         source: FrameSource,
         step_limit: f32,
     ) -> Deformed {
+        let planned = match source {
+            FrameSource::Selection { normal } => self.plan_position(&(*dab, normal)),
+            FrameSource::Dab => None,
+        };
         let deformed = self.select_deform_and_clamp_on_gpu(state, mesh, dab, source, step_limit);
         self.step_limit = Some(step_limit);
         if matches!(source, FrameSource::Selection { .. }) {
-            // Until the pipeline asks to deform this sample's selection again (`deform`).
-            self.several_steps = false;
-            self.opened = Some((dab.frame.center, deformed.selection.len()));
+            self.steps_taken.clear();
+            self.opened = Some(OpenedSample {
+                center: dab.frame.center,
+                selected: deformed.selection.len(),
+                planned,
+            });
         }
         deformed
     }
@@ -1964,8 +1993,9 @@ impl StepKernels for GpuKernels {
         self.drop_queued(mesh);
         self.plan = probes.to_vec();
         self.plan_next = 0;
-        self.several_steps = false;
         self.opened = None;
+        self.no_run_at = None;
+        self.steps_taken.clear();
     }
 
     fn deform(
@@ -1976,17 +2006,35 @@ impl StepKernels for GpuKernels {
         selection: &[(u32, f32)],
     ) -> Vec<Vec3> {
         // The first step of a sample of several: the selection its start found, under the same
-        // brush (a share of the move). Selected again with the deformation and the step's
-        // passes in one submission, as a later step is, when the selection comes out the same.
-        let reopened = self
+        // brush (a share of the move). Its steps and the samples after it run ahead in one
+        // submission; or, when they do not, the step is selected again with the deformation
+        // and its passes in one submission, as a later step is, when the selection comes out
+        // the same.
+        let opened = self
             .opened
             .take()
-            .is_some_and(|opened| opened == (dab.frame.center, selection.len()));
-        self.several_steps |= reopened;
-        if let Some(limit) = self
-            .step_limit
-            .filter(|_| reopened && self.failed.is_none())
+            .filter(|o| (o.center, o.selected) == (dab.frame.center, selection.len()));
+        if let (Some(opened), Some(limit)) = (opened, self.step_limit)
+            && self.failed.is_none()
         {
+            if let Some(steps) = steps_of_share(dab.share).filter(|_| self.runs_ahead()) {
+                let from = opened
+                    .planned
+                    .map(|at| at + 1)
+                    .filter(|&at| at < self.plan.len());
+                let run = (Some((*dab, steps)), from);
+                let step = (dab, Some(selection));
+                if self
+                    .on_gpu(|k| k.gpu_run_ahead(state, mesh, run, limit))
+                    .is_some()
+                    && let Some(Deformed {
+                        targets: Some(targets),
+                        ..
+                    }) = self.take_queued_step(mesh, step, state.max_edge)
+                {
+                    return targets;
+                }
+            }
             let how = (FrameSource::Dab, true);
             if let Some(Deformed {
                 selection: found,

@@ -47,8 +47,8 @@ pub use deform::{
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use gate::{
-    GATE_WORKGROUP_SIZE, GateBuffers, record_gate_check, record_gate_open, record_moved_edges,
-    run_longest_move, run_moved_edges, run_sample_gate,
+    GATE_WORKGROUP_SIZE, GateBuffers, record_gate_check, record_gate_open, record_gate_vacate,
+    record_moved_edges, run_longest_move, run_moved_edges, run_sample_gate,
 };
 pub use hash_table::{
     CsrTable, GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter,

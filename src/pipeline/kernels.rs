@@ -184,6 +184,8 @@ pub struct Uploads {
     /// as predicted ([`StepKernels::upcoming`]).
     pub batches: usize,
     pub samples_ahead: usize,
+    /// Steps of samples of several steps taken from such submissions.
+    pub steps_ahead: usize,
 }
 
 /// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.

@@ -29,12 +29,15 @@ use std::collections::VecDeque;
 use glam::Vec3;
 
 use super::{
-    AheadBounds, ClampedAhead, GpuKernels, Resident, SampleLayout, SelectedVertex, StrokeState,
-    TableUse, cell_size, in_vertex_order, permuted, record_sample, selection_guess,
+    AheadBounds, ClampedAhead, GpuKernels, Resident, SelectedVertex, StrokeState, TableUse,
+    cell_size, in_vertex_order, permuted, record_sample, selection_guess,
 };
+use crate::brush::Dab;
+use crate::cpu::FRAME_SUM_WORDS;
 use crate::gpu::reusable::Patches;
 use crate::gpu::{
-    GateStatus, GpuContext, GpuError, record_moved_edges, record_moved_normals, ring_bytes,
+    GateBuffers, GateStatus, GpuContext, GpuError, MovingVertex, record_gate_vacate,
+    record_moved_edges, record_moved_normals, ring_bytes,
 };
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
@@ -53,6 +56,10 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
 
+/// A sample of at most this many steps has them recorded in a run (each step's moving list
+/// is kept until the sample's last, for the normals): the bench strokes took at most 3.
+pub(super) const MAX_STEPS_AHEAD: usize = 8;
+
 /// A run's later samples assume the mesh's longest edge grows by at most this share of the
 /// assumed move per sample before them; the gate stops the run at the first whose edges, as
 /// `moved_edges` measured them, say otherwise (and the host drops it should the pipeline's own
@@ -63,55 +70,102 @@ const FIRST_SAMPLES_AHEAD: usize = 2;
 /// gate, 0.25 stopped the run-ahead test's runs once more for the same lavapipe time.
 const EDGE_GROWTH_AHEAD: f32 = 0.5;
 
-/// A sample recorded ahead, waiting for the pipeline to reach it.
-pub(super) struct QueuedSample {
-    /// Where it is in the plan, and the probe the pipeline will ask with.
-    index: usize,
-    probe: SampleProbe,
+/// What a run records at one place, and what the pipeline's call for it must be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum RunCall {
+    /// Planned sample `index` from its start: its selection, brush frame and whole
+    /// deformation (`select_deform_and_clamp` with the sample's probe), and the passes of its
+    /// one step.
+    Start(usize),
+    /// Step `k` of the `steps` of a sample of several, each under `dab` (the sample's frame, a
+    /// share of its move): selected again and deformed, with the step's passes. The pipeline
+    /// asks for step 0 with `deform` on the sample's selection, and for the later ones with
+    /// `select_deform_and_clamp` under the dab.
+    Step { dab: Dab, k: usize, steps: usize },
+}
+
+/// A sample start or step recorded ahead, waiting for the pipeline to reach it.
+pub(super) struct QueuedCall {
+    call: RunCall,
     deformed: Deformed,
-    /// The step's passes; `None` when nothing was selected.
+    /// The step's passes; `None` when nothing was selected, or at the start of a sample of
+    /// several steps the gate stopped (its passes moved nothing; its steps are recorded when
+    /// the pipeline asks for the first).
     ahead: Option<ClampedAhead>,
     /// The longest move the passes were sized for.
     assumed_move: f32,
-    /// The bound on the mesh's edges at the sample's start the passes were sized for.
+    /// The bound on the mesh's edges at the step's start the passes were sized for.
     max_edge: f32,
-    /// Its moved vertices were filed in the overlay on the GPU (every sample of a run but the
+    /// Its moved vertices were filed in the overlay on the GPU (every call of a run but the
     /// last).
     filed: bool,
 }
 
-/// The vertices a queued sample's passes may have moved.
-fn moved_by(sample: &QueuedSample) -> &[u32] {
-    sample.ahead.as_ref().map_or(&[], |a| a.vertices.as_slice())
+/// The vertices a queued call's passes may have moved.
+fn moved_by(queued: &QueuedCall) -> &[u32] {
+    queued.ahead.as_ref().map_or(&[], |a| a.vertices.as_slice())
+}
+
+/// The steps a sample takes when the pipeline deforms a step at `share` of its move (it
+/// gives each step `1 / steps`), when there are at most [`MAX_STEPS_AHEAD`] and more than one.
+pub(super) fn steps_of_share(share: f32) -> Option<usize> {
+    (2..=MAX_STEPS_AHEAD).find(|&steps| 1.0 / steps as f32 == share)
 }
 
 impl GpuKernels {
     /// Where the sample the pipeline starts with `probe` is in the plan, looking from the
-    /// sample after the last one taken ahead; `None` when it is not planned or is the last.
-    pub(super) fn planned(&self, probe: &SampleProbe) -> Option<usize> {
+    /// sample after the last one taken ahead.
+    pub(super) fn plan_position(&self, probe: &SampleProbe) -> Option<usize> {
         let from = self.plan_next.min(self.plan.len());
         self.plan[from..]
             .iter()
             .position(|p| p == probe)
             .map(|at| from + at)
-            .filter(|&at| at + 1 < self.plan.len())
     }
 
-    /// Records the planned samples from `from` on in one submission (as many as the run's
-    /// length, at most [`MAX_SAMPLES_AHEAD`]; nothing when that is fewer than two) and queues
-    /// what each left for the pipeline. The passes are sized as a single step's would be
-    /// (`assumed_move`: twice the last move, within `limit`), each later sample's from edges
-    /// grown by [`EDGE_GROWTH_AHEAD`] of that move per sample before it.
+    /// [`GpuKernels::plan_position`] of a sample a run may start at: not the last of the plan
+    /// (a run of one sample is a single step), nor one that stopped a run where the next would
+    /// stop too ([`GpuKernels::after_stop`]).
+    pub(super) fn planned(&self, probe: &SampleProbe) -> Option<usize> {
+        self.plan_position(probe)
+            .filter(|&at| at + 1 < self.plan.len() && Some(at) != self.no_run_at)
+    }
+
+    /// Whether runs ahead are recorded at all: the passes on the GPU, run ahead of the
+    /// pipeline's clamp, and the GPU not given up.
+    pub(super) fn runs_ahead(&self) -> bool {
+        self.proximity_on_gpu && self.clamp_ahead && self.run_ahead && self.failed.is_none()
+    }
+
+    /// Records in one submission the `steps` of a sample of several (all under its dab) when
+    /// given, then the planned samples from `from` (as many as the run's length, at most
+    /// [`MAX_SAMPLES_AHEAD`]), and queues what each left for the pipeline; nothing when that
+    /// is fewer than two. The passes are sized as a single step's would be (`assumed_move`:
+    /// twice the last move, within `limit`), each later call's from edges grown by
+    /// [`EDGE_GROWTH_AHEAD`] of that move per call before it.
     pub(super) fn gpu_run_ahead(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
-        from: usize,
+        (steps, from): (Option<(Dab, usize)>, Option<usize>),
         limit: f32,
     ) -> Result<(), GpuError> {
         self.check_injected_failure()?;
         self.check_gpu_filing(mesh);
         self.drop_all_ahead(mesh);
+        let mut calls: Vec<RunCall> = steps
+            .into_iter()
+            .flat_map(|(dab, steps)| (0..steps).map(move |k| RunCall::Step { dab, k, steps }))
+            .collect();
+        let step_count = calls.len();
+        if let Some(from) = from {
+            let samples = (self.plan.len() - from).min(
+                self.run_length
+                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
+            );
+            calls.extend((from..from + samples).map(RunCall::Start));
+        }
+        let count = calls.len();
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
@@ -124,18 +178,17 @@ impl GpuKernels {
         )?;
         let capacity = r.selection.capacity;
         let guess = selection_guess(self.last_selection, capacity);
-        // Each sample's moved vertices are filed in the overlay on the GPU before the next
-        // (`Hashed::record_gpu_filing`): every sample queries with the drift of the first.
+        // Each call's moved vertices are filed in the overlay on the GPU before the next
+        // (`Hashed::record_gpu_filing`): every call queries with the drift of the first.
         let drift = r.hashed().drift;
-        let count = (self.plan.len() - from).min(
-            self.run_length
-                .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
-        );
         if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
             return Ok(());
         }
         step.reserve_sample(gpu, (r, mesh), guess, true, true, filter)?;
-        // Room for the overlay's members and for every slot of the moving lists of the samples
+        let moving_bytes = (guess * std::mem::size_of::<MovingVertex>()) as u64;
+        step.held_moving
+            .reserve(gpu, step_count as u64 * moving_bytes)?;
+        // Room for the overlay's members and for every slot of the moving lists of the calls
         // that file theirs (all but the last); no more than the vertices there are.
         let room = (r.hashed().overlay.as_ref().map_or(0, |o| o.members.len())
             + (count - 1) * guess)
@@ -151,16 +204,22 @@ impl GpuKernels {
         let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
         let mut encoder = gpu.encoder("samples ahead");
         r.hashed().record_gpu_table(gpu, &mut encoder)?;
-        // The gate's edge bound starts at the pipeline's; each sample but the last grows it by
+        // The gate's edge bound starts at the pipeline's; each call but the last grows it by
         // the faces it turned (`moved_edges`) for the next one's verdict.
         step.start_gate(gpu, state.max_edge);
-        // The edges as the samples before sample j may have lengthened them (checked by the
-        // gate, and by the host when the pipeline reaches it).
+        // The edges as the calls before call j may have lengthened them (checked by the gate,
+        // and by the host when the pipeline reaches it).
         let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
-        let mut layout = None;
-        let mut sample_bytes = 0;
-        for j in 0..count {
-            let (dab, normal) = self.plan[from + j];
+        let mut layouts = Vec::with_capacity(count);
+        let mut stride = 0;
+        for (j, &call) in calls.iter().enumerate() {
+            let (dab, source) = match call {
+                RunCall::Start(index) => {
+                    let (dab, normal) = self.plan[index];
+                    (dab, FrameSource::Selection { normal })
+                }
+                RunCall::Step { dab, .. } => (dab, FrameSource::Dab),
+            };
             let state = StrokeState {
                 max_edge: edge_bound(j),
                 ..*state
@@ -171,7 +230,7 @@ impl GpuKernels {
                 (r, step),
                 &state,
                 &dab,
-                (FrameSource::Selection { normal }, true),
+                (source, true),
                 guess,
                 Some(AheadBounds {
                     assumed_move,
@@ -179,14 +238,46 @@ impl GpuKernels {
                 }),
                 filter,
             )?;
-            record_moved_normals(
-                gpu,
-                &mut encoder,
-                (&r.vertices.positions, &topology.buffer),
-                topology.layout.vertex_rows_base,
-                (step.moving.buffer(), guess),
-                &r.normals,
-            )?;
+            let normals_of = match call {
+                RunCall::Start(_) => Some((step.moving.buffer(), guess)),
+                // The pipeline recomputes normals after a sample's last step: every step
+                // deforms on the normals from before the sample. Each step's moving list is
+                // kept until then, and vacated if the run stopped at one of them: the steps
+                // taken before the stop leave their normals to the pipeline.
+                RunCall::Step { k, steps, .. } => {
+                    let held = step.held_moving.buffer();
+                    encoder.copy_buffer_to_buffer(
+                        step.moving.buffer(),
+                        0,
+                        held,
+                        k as u64 * moving_bytes,
+                        moving_bytes,
+                    );
+                    let last = k + 1 == steps;
+                    if last {
+                        record_gate_vacate(
+                            gpu,
+                            &mut encoder,
+                            &GateBuffers {
+                                moving: held,
+                                ..step.gate(r)
+                            },
+                            steps * guess,
+                        )?;
+                    }
+                    last.then_some((held, steps * guess))
+                }
+            };
+            if let Some(moving) = normals_of {
+                record_moved_normals(
+                    gpu,
+                    &mut encoder,
+                    (&r.vertices.positions, &topology.buffer),
+                    topology.layout.vertex_rows_base,
+                    moving,
+                    &r.normals,
+                )?;
+            }
             if j + 1 < count {
                 record_moved_edges(
                     gpu,
@@ -206,71 +297,93 @@ impl GpuKernels {
             let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
             parts.extend_from_slice(&recorded.parts);
             if j == 0 {
-                // Every sample leaves the same parts.
-                sample_bytes = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>();
-                readback.reserve(gpu, sample_bytes * count as u64)?;
-                layout = Some(recorded.layout);
+                // Every call leaves the same parts, but for the brush frame's sums a step
+                // (whose frame is its dab's) leaves out: room for the largest.
+                let frame_bytes = match recorded.layout.frame_from_selection {
+                    Some(_) => 0,
+                    None => (FRAME_SUM_WORDS * 4) as u64,
+                };
+                stride = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>() + frame_bytes;
+                readback.reserve(gpu, stride * count as u64)?;
             }
-            readback.record_copies(&mut encoder, &parts, j as u64 * sample_bytes);
+            layouts.push(recorded.layout);
+            readback.record_copies(&mut encoder, &parts, j as u64 * stride);
         }
-        let data = readback.submit_and_map(gpu, encoder, sample_bytes * count as u64)?;
-        let layout: SampleLayout = layout.expect("at least two samples recorded");
+        let data = readback.submit_and_map(gpu, encoder, stride * count as u64)?;
         self.uploads.batches += 1;
         self.run_taken = 0;
 
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
-        for (j, bytes) in data.chunks_exact(sample_bytes as usize).enumerate() {
+        for (j, bytes) in data.chunks_exact(stride as usize).enumerate() {
             let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
                 .min(capacity);
             self.last_selection = self.last_selection.max(found);
             let head = found.min(guess);
             let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
-            let (dab, normal) = self.plan[from + j];
+            let call = calls[j];
+            let dab = match call {
+                RunCall::Start(index) => self.plan[index].0,
+                RunCall::Step { dab, .. } => dab,
+            };
+            let layout = layouts[j];
             let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
             let status = parts.gate.expect("runs go through the gate");
+            let (order, selection) = in_vertex_order(&list);
+            let targets = |found: usize| -> Vec<Vec3> {
+                permuted(
+                    &order,
+                    &bytemuck::pod_collect_to_vec(&parts.targets[..found * 12]),
+                )
+            };
+            let mut queued = QueuedCall {
+                call,
+                deformed: Deformed {
+                    targets: None,
+                    selection,
+                    frame: parts.frame,
+                    deform_millis: 0.0,
+                },
+                ahead: None,
+                assumed_move,
+                max_edge: edge_bound(j),
+                filed: j + 1 < count,
+            };
             if status.stopped != 0 {
-                // The gate stopped the run at this sample, before it moved anything, and the
-                // samples after it selected nothing: there is nothing to put back.
+                // The gate stopped the run here, before this call moved anything, and the
+                // calls after it selected nothing: there is nothing to put back.
                 self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 self.uploads.gated_ahead += 1;
-                self.after_stop(from + j, status, limit);
+                if let RunCall::Start(index) = call
+                    && self.after_stop(index, status, limit)
+                {
+                    // Its selection and whole move hold (nothing moved since): the pipeline's
+                    // call for it is answered from here, and its steps recorded when it asks
+                    // for the first.
+                    queued.deformed.targets = Some(targets(found));
+                    queued.filed = false;
+                    self.queued.push_back(queued);
+                }
                 break;
             }
-            let (order, selection) = in_vertex_order(&list);
             if j + 1 < count {
                 filed_on_gpu.extend(list.iter().map(|s| s.vertex));
             }
             // The gate stops a run on a cut list or cut rings (the same count and buffer).
             debug_assert!(found <= guess && parts.ring_overflows == Some(0));
-            let ahead = (!selection.is_empty()).then(|| {
-                let targets: Vec<Vec3> = permuted(
-                    &order,
-                    &bytemuck::pod_collect_to_vec(&parts.targets[..found * 12]),
-                );
+            if !queued.deformed.selection.is_empty() {
+                let targets = targets(found);
                 let clamp = layout.clamp.expect("passes recorded");
                 let (finals, backstop) = step.parse_clamp(parts.clamp, guess, clamp);
-                ClampedAhead {
-                    vertices: selection.iter().map(|&(v, _)| v).collect(),
+                queued.deformed.targets = Some(targets.clone());
+                queued.ahead = Some(ClampedAhead {
+                    vertices: queued.deformed.selection.iter().map(|&(v, _)| v).collect(),
                     targets,
                     finals: permuted(&order, &finals),
                     backstop,
-                }
-            });
-            self.queued.push_back(QueuedSample {
-                index: from + j,
-                probe: (dab, normal),
-                deformed: Deformed {
-                    targets: ahead.as_ref().map(|a| a.targets.clone()),
-                    selection,
-                    frame: parts.frame,
-                    deform_millis: 0.0,
-                },
-                ahead,
-                assumed_move,
-                max_edge: edge_bound(j),
-                filed: j + 1 < count,
-            });
+                });
+            }
+            self.queued.push_back(queued);
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
@@ -278,14 +391,16 @@ impl GpuKernels {
         Ok(())
     }
 
-    /// After the gate stopped a run at planned sample `index`: whether the pipeline's call for
-    /// it starts the next run. One whose selection outgrew the guessed list, whose edges the
-    /// samples before grew past the prediction, or whose move outgrew the assumed one within a
-    /// step does, sized from what this run read (the list's count, the pipeline's edges, the
-    /// move: `last_move`). One that moves farther than a step (several steps), or whose rings
-    /// outgrow their fixed room, would stop it again: the pipeline takes it one submission per
-    /// step, and the sample after it starts the next run.
-    fn after_stop(&mut self, index: usize, status: GateStatus, limit: f32) {
+    /// After the gate stopped a run at the start of planned sample `index`: whether the
+    /// pipeline's call for it is answered from what the run read (returns `true`), and whether
+    /// that call starts the next run. One whose selection outgrew the guessed list, whose edges
+    /// the samples before grew past the prediction, or whose move outgrew the assumed one
+    /// within a step starts the next run, sized from what this run read (the list's count, the
+    /// pipeline's edges, the move: `last_move`). One whose rings outgrow their fixed room would
+    /// stop it again: the pipeline takes it one submission per step. One that only moves
+    /// farther than a step takes several: its start is answered from here, and its first step
+    /// records its steps and the samples after it in the next run.
+    fn after_stop(&mut self, index: usize, status: GateStatus, limit: f32) -> bool {
         let longest = status.longest_move();
         let moved_too_far = status.stopped & GateStatus::MOVE != 0;
         if moved_too_far && longest.is_finite() {
@@ -293,23 +408,57 @@ impl GpuKernels {
         }
         // A NaN move is not within the limit either.
         let one_step = longest <= limit;
-        if status.stopped & GateStatus::RINGS != 0 || (moved_too_far && !one_step) {
-            self.plan_next = index + 1;
+        let several_steps = moved_too_far && !one_step;
+        if status.stopped & GateStatus::RINGS != 0 || several_steps {
+            self.no_run_at = Some(index);
         }
+        status.stopped == GateStatus::MOVE && several_steps && longest.is_finite()
     }
 
-    /// The queued sample the pipeline starts with `probe`, when it is the next one queued and
-    /// its moves are one step within what its passes assumed, from where the mesh is now, and
-    /// the pipeline's bound on the edges (`max_edge`) within theirs. Any other probe, or moves
-    /// or edges past the assumption, drop the queue.
-    /// A sample dropped for moving too far is not run ahead again: the pipeline takes it one
-    /// submission per step, and the next sample starts a new run sized from its move.
-    pub(super) fn take_queued(
+    /// The queued start of the sample the pipeline starts with `probe` (see
+    /// [`GpuKernels::take_queued`]).
+    pub(super) fn take_queued_start(
         &mut self,
         mesh: &Mesh,
         probe: &SampleProbe,
         max_edge: f32,
     ) -> Option<Deformed> {
+        let plan = &self.plan;
+        let is_probe =
+            |call: &RunCall| matches!(*call, RunCall::Start(index) if plan[index] == *probe);
+        let is_probe = self.queued.front().is_some_and(|head| is_probe(&head.call));
+        self.take_queued(mesh, is_probe, max_edge)
+    }
+
+    /// The queued step the pipeline asks for under `dab`: the first of a sample of several,
+    /// deformed on the sample's `selection` (found again under the dab on the GPU), or a later
+    /// one (see [`GpuKernels::take_queued`]).
+    pub(super) fn take_queued_step(
+        &mut self,
+        mesh: &Mesh,
+        (dab, selection): (&Dab, Option<&[(u32, f32)]>),
+        max_edge: f32,
+    ) -> Option<Deformed> {
+        let is_step = self.queued.front().is_some_and(|head| match head.call {
+            RunCall::Step { dab: d, k, .. } => {
+                d == *dab
+                    && match selection {
+                        Some(selection) => k == 0 && head.deformed.selection == selection,
+                        None => k > 0,
+                    }
+            }
+            RunCall::Start(_) => false,
+        });
+        let deformed = self.take_queued(mesh, is_step, max_edge)?;
+        self.uploads.steps_ahead += 1;
+        Some(deformed)
+    }
+
+    /// The queued call at the head, when the pipeline's call is it (`is_call`), its moves are
+    /// one step within what its passes assumed from where the mesh is now, and the pipeline's
+    /// bound on the edges (`max_edge`) within theirs. Any other call, or moves or edges past
+    /// the assumption, drop the queue.
+    fn take_queued(&mut self, mesh: &Mesh, is_call: bool, max_edge: f32) -> Option<Deformed> {
         if self.failed.is_some() {
             self.queued.clear();
             return None;
@@ -317,7 +466,7 @@ impl GpuKernels {
         let head = self.queued.front()?;
         // A NaN bound does not fit either.
         let edges_fit = max_edge <= head.max_edge;
-        if head.probe != *probe || !edges_fit {
+        if !is_call || !edges_fit {
             self.drop_queued(mesh);
             return None;
         }
@@ -325,7 +474,9 @@ impl GpuKernels {
             .ahead
             .as_ref()
             .map(|ahead| longest_move(mesh, &head.deformed.selection, &ahead.targets));
-        self.plan_next = self.plan_next.max(head.index + 1);
+        if let RunCall::Start(index) = head.call {
+            self.plan_next = self.plan_next.max(index + 1);
+        }
         if let Some(longest) = longest {
             self.last_move = longest;
             // A NaN move does not fit either.
@@ -335,25 +486,39 @@ impl GpuKernels {
                 return None;
             }
         }
-        let sample = self.queued.pop_front()?;
+        let queued = self.queued.pop_front()?;
         self.run_taken += 1;
         if self.queued.is_empty() {
             // The whole run was taken as predicted.
             self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
         }
-        self.uploads.samples_ahead += 1;
-        self.ahead = sample.ahead;
-        self.taken_filed = sample.filed;
-        Some(sample.deformed)
+        match queued.call {
+            RunCall::Start(_) => {
+                self.uploads.samples_ahead += 1;
+                self.steps_taken.clear();
+            }
+            RunCall::Step { .. } => self.steps_taken.extend_from_slice(moved_by(&queued)),
+        }
+        self.ahead = queued.ahead;
+        self.taken_filed = queued.filed;
+        Some(queued.deformed)
     }
 
-    /// Drops every queued sample: the rows their passes wrote go back to the mesh's.
+    /// Drops every queued call: the rows their passes wrote go back to the mesh's. When a
+    /// step goes, so do the normals the run recomputed after the sample's last step around
+    /// the steps of it taken before.
     pub(super) fn drop_queued(&mut self, mesh: &Mesh) {
         let queued = std::mem::take(&mut self.queued);
         if !queued.is_empty() {
             self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
         }
         let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
+        if queued
+            .iter()
+            .any(|q| matches!(q.call, RunCall::Step { .. }))
+        {
+            vertices.extend_from_slice(&self.steps_taken);
+        }
         if vertices.is_empty() {
             return;
         }
@@ -361,14 +526,14 @@ impl GpuKernels {
         vertices.dedup();
         self.uploads.dropped_ahead += queued.iter().filter(|s| s.ahead.is_some()).count();
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
-            // Filed where the dropped samples put them.
+            // Filed where the dropped calls put them.
             hashed.gpu_drift = None;
         }
         put_back_rows(&self.gpu, self.resident.as_ref(), mesh, &vertices);
     }
 
     /// After the pipeline reported a step's moves: when they are not what the passes ran ahead
-    /// left (the exact backstop undid some), the samples queued after were recorded on the
+    /// left (the exact backstop undid some), the calls queued after were recorded on the
     /// wrong positions and are dropped.
     pub(super) fn check_taken(&mut self, mesh: &Mesh) {
         let Some((vertices, finals)) = self.taken.take() else {
@@ -409,4 +574,4 @@ pub(super) fn put_back_rows(
 }
 
 /// The queue of samples recorded ahead, oldest first.
-pub(super) type Queue = VecDeque<QueuedSample>;
+pub(super) type Queue = VecDeque<QueuedCall>;
