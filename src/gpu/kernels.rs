@@ -68,7 +68,6 @@ use crate::pipeline::step::{
 use crate::pipeline::{
     BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
 };
-use run_ahead::steps_of_share;
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
 /// from where they were filed. Queries grow by the drift, and the passes' work grows with the
@@ -2017,23 +2016,10 @@ impl StepKernels for GpuKernels {
         if let (Some(opened), Some(limit)) = (opened, self.step_limit)
             && self.failed.is_none()
         {
-            if let Some(steps) = steps_of_share(dab.share).filter(|_| self.runs_ahead()) {
-                let from = opened
-                    .planned
-                    .map(|at| at + 1)
-                    .filter(|&at| at < self.plan.len());
-                let run = (Some((*dab, steps)), from);
-                let step = (dab, Some(selection));
-                if self
-                    .on_gpu(|k| k.gpu_run_ahead(state, mesh, run, limit))
-                    .is_some()
-                    && let Some(Deformed {
-                        targets: Some(targets),
-                        ..
-                    }) = self.take_queued_step(mesh, step, state.max_edge)
-                {
-                    return targets;
-                }
+            if let Some(targets) =
+                self.run_steps_ahead(state, mesh, (dab, selection), opened.planned, limit)
+            {
+                return targets;
             }
             let how = (FrameSource::Dab, true);
             if let Some(Deformed {

@@ -22,6 +22,14 @@
 //! of those fails, the rest are dropped: the rows they wrote go back to the mesh's (positions,
 //! and the normals around them).
 //!
+//! A sample that moves farther than a step takes several, each a share of its move, and the
+//! step count is known only from its whole move. The gate stops a run at the start of such a
+//! sample; what that start read (its selection, frame and whole move: nothing moved since)
+//! answers the pipeline's call for it, and the pipeline's call for its first step records its
+//! steps and the samples after it in the next run ([`RunCall::Step`]). Each step deforms on the
+//! normals from before the sample, as the pipeline's do; the normals its moves turned are
+//! recomputed after its last step.
+//!
 //! [`StepKernels::upcoming`]: crate::pipeline::StepKernels::upcoming
 
 use std::collections::VecDeque;
@@ -52,7 +60,7 @@ use crate::pipeline::{Deformed, FrameSource, SampleProbe};
 /// the run-ahead test back twice instead of 4 times, but in 19–26 s of lavapipe against 15–21
 /// s, and on a hardware GPU, where each dispatch has a fixed cost, a 32-sample run stopped early
 /// would waste hundreds of them (in the 100K-face plaster bench 1 sample in 7 takes several
-/// steps or has a move undone by the exact backstop, and either ends a run).
+/// steps or has a move undone by the exact backstop, and either stops a run).
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 const FIRST_SAMPLES_AHEAD: usize = 2;
 
@@ -108,7 +116,7 @@ fn moved_by(queued: &QueuedCall) -> &[u32] {
 
 /// The steps a sample takes when the pipeline deforms a step at `share` of its move (it
 /// gives each step `1 / steps`), when there are at most [`MAX_STEPS_AHEAD`] and more than one.
-pub(super) fn steps_of_share(share: f32) -> Option<usize> {
+fn steps_of_share(share: f32) -> Option<usize> {
     (2..=MAX_STEPS_AHEAD).find(|&steps| 1.0 / steps as f32 == share)
 }
 
@@ -389,6 +397,28 @@ impl GpuKernels {
             hashed.moved.extend_from_slice(&filed_on_gpu);
         }
         Ok(())
+    }
+
+    /// The first step of a sample of several (planned at `planned`) under `dab`, on the
+    /// sample's `selection`: records the sample's steps and the samples after it in one run
+    /// and takes the first step's targets from it. `None` when the stroke is not planned (a
+    /// grab deforms what its first sample caught at every step; remeshing between samples),
+    /// when the steps are too many, or when the run does not give the step.
+    pub(super) fn run_steps_ahead(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        (dab, selection): (&Dab, &[(u32, f32)]),
+        planned: Option<usize>,
+        limit: f32,
+    ) -> Option<Vec<Vec3>> {
+        let at = planned.filter(|_| self.runs_ahead())?;
+        let steps = steps_of_share(dab.share)?;
+        let from = Some(at + 1).filter(|&next| next < self.plan.len());
+        let run = (Some((*dab, steps)), from);
+        self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, limit))?;
+        self.take_queued_step(mesh, (dab, Some(selection)), state.max_edge)?
+            .targets
     }
 
     /// After the gate stopped a run at the start of planned sample `index`: whether the
