@@ -115,10 +115,12 @@ fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
 /// takes from what the run read; its steps and the samples after it then run ahead in one
 /// submission, each step deforming on the normals from before the sample (inflate moves along
 /// them), the normals recomputed after its last. The result is the CPU pipeline's, in fewer
-/// read-backs than samples.
+/// read-backs than samples. (Over the second stroke the exact backstop undoes a move a run
+/// made where the run's normals around it are read again before the pipeline refreshes them:
+/// they must go back with the move.)
 #[test]
 fn samples_of_several_steps_run_their_steps_ahead_and_match_the_cpu_pipeline() {
-    let (start, mut strokes) = plaster_and_strokes(1);
+    let (start, mut strokes) = plaster_and_strokes(2);
     for stroke in &mut strokes {
         stroke.brush.kind = slayer::brush::BrushKind::Inflate;
         stroke.brush.strength = 1.0;

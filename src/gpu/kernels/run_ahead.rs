@@ -189,11 +189,14 @@ impl GpuKernels {
         // Each call's moved vertices are filed in the overlay on the GPU before the next
         // (`Hashed::record_gpu_filing`): every call queries with the drift of the first.
         let drift = r.hashed().drift;
-        if count < 2 || ring_bytes(guess) > gpu.limits.max_storage_buffer_binding_size {
+        let moving_bytes = (guess * std::mem::size_of::<MovingVertex>()) as u64;
+        // The rings of the guessed slots, and the moving lists the steps keep, must each fit
+        // one binding.
+        let binding = gpu.limits.max_storage_buffer_binding_size;
+        if count < 2 || ring_bytes(guess) > binding || step_count as u64 * moving_bytes > binding {
             return Ok(());
         }
         step.reserve_sample(gpu, (r, mesh), guess, true, true, filter)?;
-        let moving_bytes = (guess * std::mem::size_of::<MovingVertex>()) as u64;
         step.held_moving
             .reserve(gpu, step_count as u64 * moving_bytes)?;
         // Room for the overlay's members and for every slot of the moving lists of the calls
@@ -564,7 +567,9 @@ impl GpuKernels {
 
     /// After the pipeline reported a step's moves: when they are not what the passes ran ahead
     /// left (the exact backstop undid some), the calls queued after were recorded on the
-    /// wrong positions and are dropped.
+    /// wrong positions and are dropped, and the step's own rows go back to the mesh's: a run
+    /// recomputed the normals around its moves (`moved_normals`) and filed them where the GPU
+    /// put them, and the pipeline refreshes only the normals around the vertices it moved.
     pub(super) fn check_taken(&mut self, mesh: &Mesh) {
         let Some((vertices, finals)) = self.taken.take() else {
             return;
@@ -576,6 +581,10 @@ impl GpuKernels {
             .all(|(&v, &p)| positions[v as usize] == p);
         if !as_predicted {
             self.drop_queued(mesh);
+            if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
+                hashed.gpu_drift = None;
+            }
+            put_back_rows(&self.gpu, self.resident.as_ref(), mesh, &vertices);
         }
     }
 }
