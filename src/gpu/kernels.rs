@@ -712,7 +712,7 @@ pub struct GpuKernels {
 }
 
 /// A sample start the pipeline may go on to deform in several steps.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 struct OpenedSample {
     /// Its brush centre and the size of its selection, to recognise the call for its first
     /// step (the GPU's reselection is compared with the pipeline's before it is used).

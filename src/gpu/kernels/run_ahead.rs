@@ -456,11 +456,10 @@ impl GpuKernels {
         probe: &SampleProbe,
         max_edge: f32,
     ) -> Option<Deformed> {
-        let plan = &self.plan;
-        let is_probe =
-            |call: &RunCall| matches!(*call, RunCall::Start(index) if plan[index] == *probe);
-        let is_probe = self.queued.front().is_some_and(|head| is_probe(&head.call));
-        self.take_queued(mesh, is_probe, max_edge)
+        let is_start = self.queued.front().is_some_and(
+            |head| matches!(head.call, RunCall::Start(index) if self.plan[index] == *probe),
+        );
+        self.take_queued(mesh, is_start, max_edge)
     }
 
     /// The queued step the pipeline asks for under `dab`: the first of a sample of several,
@@ -526,10 +525,7 @@ impl GpuKernels {
             self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
         }
         match queued.call {
-            RunCall::Start(_) => {
-                self.uploads.samples_ahead += 1;
-                self.steps_taken.clear();
-            }
+            RunCall::Start(_) => self.uploads.samples_ahead += 1,
             RunCall::Step { .. } => self.steps_taken.extend_from_slice(moved_by(&queued)),
         }
         self.ahead = queued.ahead;
