@@ -1191,15 +1191,15 @@ impl GpuKernels {
         Ok((finals, backstop))
     }
 
-    /// [`StepKernels::select_deform_and_clamp`] on the GPU, falling back to the CPU: at a
-    /// sample's start the sample run ahead, or a run of the samples planned from it (unless the
-    /// sample before took several steps), else one submission for this step.
+    /// [`StepKernels::select_deform_and_clamp`] on the GPU, falling back to the CPU: the call a
+    /// run queued, else at the start of a sample (planned at `planned`) a run of the samples
+    /// planned from it, else one submission for this step.
     fn select_deform_and_clamp_on_gpu(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
-        source: FrameSource,
+        (source, planned): (FrameSource, Option<usize>),
         step_limit: f32,
     ) -> Deformed {
         let how = (source, true);
@@ -1209,7 +1209,8 @@ impl GpuKernels {
                 let probe = (*dab, normal);
                 self.take_queued_start(mesh, &probe, state.max_edge)
                     .or_else(|| {
-                        let from = self.planned(&probe).filter(|_| self.runs_ahead())?;
+                        let from =
+                            planned.filter(|&at| self.may_start_run(at) && self.runs_ahead())?;
                         let run = (None, Some(from));
                         self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, step_limit))?;
                         self.take_queued_start(mesh, &probe, state.max_edge)
@@ -1975,7 +1976,8 @@ impl StepKernels for GpuKernels {
             FrameSource::Selection { normal } => self.plan_position(&(*dab, normal)),
             FrameSource::Dab => None,
         };
-        let deformed = self.select_deform_and_clamp_on_gpu(state, mesh, dab, source, step_limit);
+        let deformed =
+            self.select_deform_and_clamp_on_gpu(state, mesh, dab, (source, planned), step_limit);
         self.step_limit = Some(step_limit);
         if matches!(source, FrameSource::Selection { .. }) {
             self.steps_taken.clear();

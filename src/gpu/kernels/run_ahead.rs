@@ -92,6 +92,20 @@ pub(super) enum RunCall {
     Step { dab: Dab, k: usize, steps: usize },
 }
 
+impl RunCall {
+    /// The dab the call is recorded under, and where its frame comes from (`plan`: the
+    /// stroke's planned samples).
+    fn dab_and_source(self, plan: &[SampleProbe]) -> (Dab, FrameSource) {
+        match self {
+            RunCall::Start(index) => {
+                let (dab, normal) = plan[index];
+                (dab, FrameSource::Selection { normal })
+            }
+            RunCall::Step { dab, .. } => (dab, FrameSource::Dab),
+        }
+    }
+}
+
 /// A sample start or step recorded ahead, waiting for the pipeline to reach it.
 pub(super) struct QueuedCall {
     call: RunCall,
@@ -131,12 +145,12 @@ impl GpuKernels {
             .map(|at| from + at)
     }
 
-    /// [`GpuKernels::plan_position`] of a sample a run may start at: not the last of the plan
-    /// (a run of one sample is a single step), nor one that stopped a run where the next would
-    /// stop too ([`GpuKernels::after_stop`]).
-    pub(super) fn planned(&self, probe: &SampleProbe) -> Option<usize> {
-        self.plan_position(probe)
-            .filter(|&at| at + 1 < self.plan.len() && Some(at) != self.no_run_at)
+    /// Whether a run may start at planned sample `at`: not the last of the plan (a run of one
+    /// sample is a single step), not one a run reached already (its queued start was dropped
+    /// for moving farther than assumed), nor one that stopped a run where the next would stop
+    /// too ([`GpuKernels::after_stop`]).
+    pub(super) fn may_start_run(&self, at: usize) -> bool {
+        at + 1 < self.plan.len() && at >= self.plan_next && Some(at) != self.no_run_at
     }
 
     /// Whether runs ahead are recorded at all: the passes on the GPU, run ahead of the
@@ -224,13 +238,7 @@ impl GpuKernels {
         let mut layouts = Vec::with_capacity(count);
         let mut stride = 0;
         for (j, &call) in calls.iter().enumerate() {
-            let (dab, source) = match call {
-                RunCall::Start(index) => {
-                    let (dab, normal) = self.plan[index];
-                    (dab, FrameSource::Selection { normal })
-                }
-                RunCall::Step { dab, .. } => (dab, FrameSource::Dab),
-            };
+            let (dab, source) = call.dab_and_source(&self.plan);
             let state = StrokeState {
                 max_edge: edge_bound(j),
                 ..*state
@@ -333,10 +341,7 @@ impl GpuKernels {
             let head = found.min(guess);
             let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
             let call = calls[j];
-            let dab = match call {
-                RunCall::Start(index) => self.plan[index].0,
-                RunCall::Step { dab, .. } => dab,
-            };
+            let (dab, _) = call.dab_and_source(&self.plan);
             let layout = layouts[j];
             let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
             let status = parts.gate.expect("runs go through the gate");
@@ -537,11 +542,17 @@ impl GpuKernels {
     /// step goes, so do the normals the run recomputed after the sample's last step around
     /// the steps of it taken before.
     pub(super) fn drop_queued(&mut self, mesh: &Mesh) {
+        self.drop_queued_and(mesh, &[]);
+    }
+
+    /// [`GpuKernels::drop_queued`], putting back the rows of `also` too.
+    fn drop_queued_and(&mut self, mesh: &Mesh, also: &[u32]) {
         let queued = std::mem::take(&mut self.queued);
         if !queued.is_empty() {
             self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
         }
         let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
+        vertices.extend_from_slice(also);
         if queued
             .iter()
             .any(|q| matches!(q.call, RunCall::Step { .. }))
@@ -576,11 +587,7 @@ impl GpuKernels {
             .zip(&finals)
             .all(|(&v, &p)| positions[v as usize] == p);
         if !as_predicted {
-            self.drop_queued(mesh);
-            if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
-                hashed.gpu_drift = None;
-            }
-            put_back_rows(&self.gpu, self.resident.as_ref(), mesh, &vertices);
+            self.drop_queued_and(mesh, &vertices);
         }
     }
 }
