@@ -100,6 +100,162 @@ fn every_shared_file_is_registered() {
     }
 }
 
+/// Each kernel's parity tests in `tests/gpu_parity.rs`: the tests that dispatch it on the GPU
+/// and compare it with its CPU mirror. Adding a kernel to `wgsl/` without naming its parity
+/// tests here fails `every_kernel_has_a_cpu_mirror_and_a_parity_test`.
+const PARITY_TESTS: &[(&str, &[&str])] = &[
+    (
+        "cell_keys",
+        &[
+            "cell_keys_matches_cpu_mirror_at_awkward_sizes",
+            "cell_keys_agree_on_cell_boundaries_and_negative_cells",
+            "wide_dispatches_fold_into_two_dimensions",
+        ],
+    ),
+    (
+        "cell_counts",
+        &["cell_counts_match_cpu_mirror_and_ranks_number_each_bucket"],
+    ),
+    ("scan", &["scan_matches_cpu_mirror_and_a_running_sum"]),
+    // The multi-level scan adds each block's offset with `scan_add` past 256 entries.
+    ("scan_add", &["scan_matches_cpu_mirror_and_a_running_sum"]),
+    (
+        "scatter",
+        &[
+            "scatter_matches_cpu_mirror_given_the_same_ranks",
+            "hash_table_matches_cpu_chain_and_the_grid",
+            "hash_build_folds_wide_dispatches",
+        ],
+    ),
+    (
+        "select",
+        &[
+            "select_matches_cpu_mirror_at_awkward_sizes",
+            "select_scans_vertices_for_huge_brushes_and_folds_wide_dispatches",
+            "select_through_an_overlay_matches_a_fresh_table",
+            "select_finds_vertices_that_moved_since_the_table_was_built",
+        ],
+    ),
+    (
+        "deform",
+        &[
+            "deform_matches_cpu_mirror_and_the_brush_fields",
+            "deform_reads_neighbours_split_over_several_bindings",
+            "deform_takes_the_frame_from_the_sums_as_the_mirror_does",
+        ],
+    ),
+    (
+        "brush_frame",
+        &["brush_frame_sums_match_the_cpu_mirror_bit_for_bit_in_any_order"],
+    ),
+    (
+        "dispatch_args",
+        &["dispatch_args_match_the_host_fold_and_the_cpu_mirror"],
+    ),
+    (
+        "proximity",
+        &[
+            "proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_pressed_sheets",
+            "proximity_matches_cpu_mirror_and_the_cpu_pipeline_on_a_folded_sheet",
+            "proximity_reads_a_topology_split_over_several_bindings",
+        ],
+    ),
+    (
+        "apply_moves",
+        &[
+            "apply_moves_matches_cpu_mirror_in_every_mode",
+            "clamp_loop_matches_the_cpu_pipeline_on_pressed_sheets",
+            "clamp_loop_matches_the_cpu_pipeline_on_a_folded_sheet",
+        ],
+    ),
+    (
+        "moving_entries",
+        &[
+            "moving_entries_match_the_cpu_mirror_and_the_hosts_rings",
+            "moving_entries_read_a_topology_split_over_several_bindings",
+        ],
+    ),
+    (
+        "backstop",
+        &["backstop_filter_matches_cpu_mirror_and_keeps_every_crossing"],
+    ),
+    (
+        "vertex_normals",
+        &[
+            "vertex_normals_match_cpu_mirror_and_the_mesh",
+            "vertex_normals_read_a_topology_split_over_several_bindings",
+        ],
+    ),
+    (
+        "moved_normals",
+        &[
+            "moved_normals_match_cpu_mirror_and_the_mesh",
+            "moved_normals_read_a_topology_split_over_several_bindings",
+        ],
+    ),
+    (
+        "overlay_members",
+        &["overlay_members_file_the_moved_entries_as_the_cpu_mirror_does"],
+    ),
+    (
+        "overlay_keys",
+        &["overlay_tables_rebuilt_from_slots_match_the_cpu_chain_and_the_host_filing"],
+    ),
+    (
+        "overlay_entries",
+        &["overlay_tables_rebuilt_from_slots_match_the_cpu_chain_and_the_host_filing"],
+    ),
+    (
+        "longest_move",
+        &["longest_move_matches_the_cpu_mirror_at_awkward_sizes"],
+    ),
+    ("sample_gate", &["sample_gate_stages_match_the_cpu_mirror"]),
+    (
+        "moved_edges",
+        &[
+            "moved_edges_grow_the_edge_bound_as_the_cpu_mirror_and_the_pipeline_do",
+            "moved_edges_read_a_topology_split_over_several_bindings",
+        ],
+    ),
+];
+
+#[test]
+fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
+    // DESIGN §6: every kernel in `wgsl/` has a mirror of the same name in `src/cpu/` (a module
+    // of `slayer::cpu`) and at least one parity test, and every test named here is a test.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cpu_mod = std::fs::read_to_string(root.join("src/cpu/mod.rs")).unwrap();
+    let parity = std::fs::read_to_string(root.join("tests/gpu_parity.rs")).unwrap();
+    for name in wgsl_files(&root.join("wgsl")) {
+        assert!(
+            root.join(format!("src/cpu/{name}.rs")).is_file(),
+            "wgsl/{name}.wgsl has no CPU mirror src/cpu/{name}.rs"
+        );
+        assert!(
+            cpu_mod.lines().any(|l| l.trim() == format!("mod {name};")),
+            "src/cpu/mod.rs does not declare the mirror `{name}`"
+        );
+        let tests = PARITY_TESTS
+            .iter()
+            .find(|(kernel, _)| *kernel == name)
+            .map(|(_, tests)| *tests)
+            .unwrap_or_else(|| panic!("wgsl/{name}.wgsl has no parity test in PARITY_TESTS"));
+        assert!(!tests.is_empty(), "{name}: no parity test named");
+        for test in tests {
+            assert!(
+                parity.contains(&format!("#[test]\nfn {test}()")),
+                "{name}: tests/gpu_parity.rs has no test `{test}`"
+            );
+        }
+    }
+    for (kernel, _) in PARITY_TESTS {
+        assert!(
+            KERNELS.iter().any(|(k, _)| k == kernel),
+            "PARITY_TESTS names `{kernel}`, which is not a kernel"
+        );
+    }
+}
+
 #[test]
 fn unknown_imports_are_reported() {
     let error = expand_imports("x", "#import shared/nope\n").unwrap_err();

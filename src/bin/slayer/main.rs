@@ -29,7 +29,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Generate the default material, write it and check it (the sculpting demo grows from here).
+    /// Generate the default material, sculpt and paint it with a seeded stroke script, then write,
+    /// check and render it before and after
     Demo {
         /// Folder for the demo's files.
         #[arg(long, default_value = "slayer-demo")]
