@@ -608,6 +608,19 @@ fn bench_on_both_backends_writes_parity() {
         assert!(parity.get(field).is_some(), "missing parity.{field}");
     }
     assert_eq!(report["gpu_scenes"][0]["intersections"], 0);
+    // GPU memory: the allocator's figures (wgpu's Vulkan backend keeps them) hold at least the
+    // positions (12 bytes a vertex) and no more than it reserved; the CPU run holds none.
+    let memory = &report["gpu_scenes"][0]["gpu_memory"];
+    let vertices = report["gpu_scenes"][0]["vertices"].as_u64().unwrap();
+    if report["adapter"].as_str().unwrap().contains("Vulkan") {
+        let allocated = memory["allocated_bytes"].as_u64().expect("an allocator report");
+        let reserved = memory["reserved_bytes"].as_u64().expect("an allocator report");
+        assert!(allocated >= 12 * vertices && allocated <= reserved, "{memory}");
+    }
+    assert!(memory["budget_bytes"].as_u64().unwrap() >= 12 * vertices, "{memory}");
+    assert!(report["scenes"][0]["gpu_memory"].is_null());
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("gpu memory plaster (gpu): at most"), "{stdout}");
     let out = slayer(&["bench", "--scene", "plaster", "--backend", "quantum"]);
     assert!(!out.status.success());
     let first = text(&out.stderr)

@@ -4,7 +4,7 @@
 mod report;
 mod script;
 
-pub use report::{paper_table, scaling_svg, scaling_table};
+pub use report::{gpu_memory_lines, paper_table, scaling_svg, scaling_table};
 pub use script::{BrushMix, ScriptSpec, generate_script};
 
 use serde::Serialize;
@@ -12,7 +12,9 @@ use serde::Serialize;
 use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
-use crate::pipeline::{BackstopFilter, PhaseTimes, PipelineError, SculptPipeline, Uploads};
+use crate::pipeline::{
+    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, SculptPipeline, Uploads,
+};
 use crate::remesh::RemeshReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
@@ -105,6 +107,8 @@ pub struct SceneResult {
     /// GPU backends: how many steps' backstop pairs the GPU filtered, how many pairs it left
     /// the CPU, and how many steps overflowed its room.
     pub gpu_backstop: Option<BackstopFilter>,
+    /// GPU backends: the most GPU memory they held after any stroke.
+    pub gpu_memory: Option<GpuMemory>,
 }
 
 /// One row of the scaling run.
@@ -117,6 +121,8 @@ pub struct ScalingRow {
     pub samples: usize,
     pub steps: usize,
     pub moves: usize,
+    /// GPU backends: the most GPU memory they held after any stroke.
+    pub gpu_memory: Option<GpuMemory>,
 }
 
 /// Runs `strokes` on `mesh` and measures. `progress` is told after each stroke.
@@ -139,8 +145,13 @@ pub fn run_strokes(
     let mut phases = PhaseTimes::default();
     let mut remesh = RemeshReport::default();
     let (mut samples, mut steps, mut collisions, mut reverted, mut moves) = (0, 0, 0, 0, 0);
+    let mut gpu_memory = pipeline.gpu_memory(mesh);
     for (i, stroke) in strokes.iter().enumerate() {
         let report = pipeline.apply_stroke(mesh, stroke)?;
+        gpu_memory = match (gpu_memory, pipeline.gpu_memory(mesh)) {
+            (Some(peak), Some(now)) => Some(peak.max(now)),
+            (peak, now) => peak.or(now),
+        };
         phases.add(&report.phases);
         samples += report.samples;
         steps += report.steps;
@@ -201,6 +212,7 @@ pub fn run_strokes(
         moves,
         gpu_uploads: pipeline.uploads(),
         gpu_backstop: pipeline.backstop_filter(),
+        gpu_memory,
     })
 }
 

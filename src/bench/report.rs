@@ -4,6 +4,33 @@ use std::fmt::Write;
 
 use super::{ScalingRow, SceneResult};
 
+/// One line per scene run on the GPU: the most GPU memory it held after any stroke, as the
+/// allocator reports it and as the budget counts the mesh's copy.
+pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
+    let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
+    let mut out = String::new();
+    for r in results {
+        let Some(m) = &r.gpu_memory else { continue };
+        let held = match (m.allocated_bytes, m.reserved_bytes) {
+            (Some(allocated), Some(reserved)) => format!(
+                "{:.1} MiB in buffers ({:.1} MiB reserved by the allocator)",
+                mib(allocated),
+                mib(reserved)
+            ),
+            _ => "no allocator report from this backend".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "gpu memory {}: at most {held}; the budget counts {:.1} MiB of its {:.0} MiB \
+             (SLAYER_GPU_BUDGET_MIB)",
+            r.name,
+            mib(m.budget_bytes),
+            mib(m.budget_limit_bytes)
+        );
+    }
+    out
+}
+
 /// The paper's Table 1 layout, plus our per-sample figures; the paper's rows follow for
 /// comparison.
 pub fn paper_table(results: &[SceneResult]) -> String {
@@ -103,13 +130,16 @@ pub fn paper_table(results: &[SceneResult]) -> String {
 pub fn scaling_table(rows: &[ScalingRow]) -> String {
     let mut out = String::new();
     let base = rows.first().map_or(1.0, |r| r.ms_per_sample.max(1e-9));
-    let _ = writeln!(
+    // GPU runs add the most memory the allocator reported in buffers.
+    let on_gpu = rows.iter().any(|r| r.gpu_memory.is_some());
+    let _ = write!(
         out,
         "{:>10} {:>10} {:>10} {:>12} {:>8} {:>8} {:>9}",
         "faces", "ms/sample", "ms/remesh", "vs smallest", "samples", "steps", "moves"
     );
+    let _ = writeln!(out, "{}", if on_gpu { "   gpu MiB" } else { "" });
     for r in rows {
-        let _ = writeln!(
+        let _ = write!(
             out,
             "{:>10} {:>10.3} {:>10.1} {:>11.2}x {:>8} {:>8} {:>9}",
             r.faces,
@@ -119,6 +149,21 @@ pub fn scaling_table(rows: &[ScalingRow]) -> String {
             r.samples,
             r.steps,
             r.moves
+        );
+        let held = r
+            .gpu_memory
+            .and_then(|m| m.allocated_bytes)
+            .map_or("-".to_string(), |b| {
+                format!("{:.1}", b as f64 / (1u64 << 20) as f64)
+            });
+        let _ = writeln!(
+            out,
+            "{}",
+            if on_gpu {
+                format!(" {held:>9}")
+            } else {
+                String::new()
+            }
         );
     }
     out

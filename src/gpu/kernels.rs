@@ -66,7 +66,7 @@ use crate::pipeline::step::{
     frame_of_sums, longest_move,
 };
 use crate::pipeline::{
-    BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
+    BackstopFilter, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels, Uploads,
 };
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
@@ -2114,6 +2114,17 @@ impl StepKernels for GpuKernels {
 
     fn backstop_filter(&self) -> Option<BackstopFilter> {
         (self.proximity_on_gpu && self.backstop_on_gpu).then_some(self.filter)
+    }
+
+    fn gpu_memory(&self, mesh: &Mesh) -> Option<GpuMemory> {
+        self.resident.as_ref()?;
+        let report = self.gpu.device.generate_allocator_report();
+        Some(GpuMemory {
+            allocated_bytes: report.as_ref().map(|r| r.total_allocated_bytes),
+            reserved_bytes: report.as_ref().map(|r| r.total_reserved_bytes),
+            budget_bytes: resident_bytes(mesh),
+            budget_limit_bytes: self.gpu.budget_bytes,
+        })
     }
 
     fn check_copy(&self, mesh: &Mesh) -> Result<(), String> {

@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use super::kernels::{CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{Region, StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
 use super::{
-    BackstopFilter, PhaseTimes, PipelineError, PipelineSettings, Remeshing, SculptPipeline,
-    StrokeHook, StrokeReport, Uploads,
+    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, Remeshing,
+    SculptPipeline, StrokeHook, StrokeReport, Uploads,
 };
 use crate::brush::{BrushKind, Dab, DabFrame, Sample, Stroke, resample};
 use crate::collide::neighbourhood::exclusion_ring;
@@ -247,6 +247,10 @@ impl SculptPipeline for CpuPipeline {
 
     fn backstop_filter(&self) -> Option<BackstopFilter> {
         self.kernels.backstop_filter()
+    }
+
+    fn gpu_memory(&self, mesh: &Mesh) -> Option<GpuMemory> {
+        self.kernels.gpu_memory(mesh)
     }
 
     fn name(&self) -> String {

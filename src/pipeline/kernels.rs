@@ -121,6 +121,11 @@ pub trait StepKernels: Send {
     fn backstop_filter(&self) -> Option<BackstopFilter> {
         None
     }
+    /// What the kernels hold in GPU memory now, with `mesh` their copy; `None` for kernels
+    /// that hold none.
+    fn gpu_memory(&self, _mesh: &Mesh) -> Option<GpuMemory> {
+        None
+    }
     /// Compares the kernels' copy of the mesh, if they keep one, with `mesh`: `Err` names the
     /// first difference. Reads everything back: for tests.
     fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
@@ -186,6 +191,30 @@ pub struct Uploads {
     pub samples_ahead: usize,
     /// Steps of samples of several steps taken from such submissions.
     pub steps_ahead: usize,
+}
+
+/// GPU memory held by kernels that keep the mesh there: as the wgpu backend's allocator reports
+/// it (every live buffer, and the memory blocks they are carved from; `None` where the backend
+/// keeps no report), and as our budget check (`SLAYER_GPU_BUDGET_MIB`) counts the mesh's copy.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct GpuMemory {
+    pub allocated_bytes: Option<u64>,
+    pub reserved_bytes: Option<u64>,
+    /// `gpu::resident_bytes` of the mesh: what the budget check counts, and the budget.
+    pub budget_bytes: u64,
+    pub budget_limit_bytes: u64,
+}
+
+impl GpuMemory {
+    /// Each figure the larger of the two: the peak over samples taken at different times.
+    pub fn max(self, other: GpuMemory) -> GpuMemory {
+        GpuMemory {
+            allocated_bytes: self.allocated_bytes.max(other.allocated_bytes),
+            reserved_bytes: self.reserved_bytes.max(other.reserved_bytes),
+            budget_bytes: self.budget_bytes.max(other.budget_bytes),
+            budget_limit_bytes: self.budget_limit_bytes.max(other.budget_limit_bytes),
+        }
+    }
 }
 
 /// What kernels that filter the backstop's first round (the GPU's) left the CPU to decide.

@@ -14,7 +14,7 @@ pub mod step;
 
 pub use cpu::{CpuPipeline, Search};
 pub use kernels::{
-    BackstopFilter, CpuKernels, Deformed, FrameSource, SampleProbe, StepKernels, Uploads,
+    BackstopFilter, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels, Uploads,
 };
 
 use serde::Serialize;
@@ -181,6 +181,10 @@ pub trait SculptPipeline {
     }
     /// Backends that filter the backstop's pairs elsewhere (the GPU): what they left the CPU.
     fn backstop_filter(&self) -> Option<BackstopFilter> {
+        None
+    }
+    /// Backends that keep `mesh` in GPU memory: how much they hold now.
+    fn gpu_memory(&self, _mesh: &Mesh) -> Option<GpuMemory> {
         None
     }
 }

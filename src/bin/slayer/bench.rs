@@ -3,8 +3,8 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use slayer::bench::{
-    ScalingRow, SceneResult, ScriptSpec, generate_script, paper_table, run_strokes, scaling_svg,
-    scaling_table,
+    ScalingRow, SceneResult, ScriptSpec, generate_script, gpu_memory_lines, paper_table,
+    run_strokes, scaling_svg, scaling_table,
 };
 use slayer::mesh::Mesh;
 use slayer::pipeline::{PipelineSettings, Remeshing, SculptPipeline};
@@ -191,10 +191,12 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         .collect();
     if !scenes.is_empty() {
         println!("{}", paper_table(&scenes));
+        print!("{}", gpu_memory_lines(&scenes));
     }
     if !gpu_scenes.is_empty() {
         println!("the same strokes on the GPU path ({adapter}):");
         println!("{}", paper_table(&gpu_scenes));
+        print!("{}", gpu_memory_lines(&gpu_scenes));
         for (name, p) in &parities {
             println!(
                 "parity {name}: max position deviation {}, collisions cpu {} gpu {}; gpu/cpu time: {}",
@@ -235,6 +237,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 samples: r.samples,
                 steps: r.steps,
                 moves: r.moves,
+                gpu_memory: r.gpu_memory,
             });
         }
         println!("scaling: the same strokes (radius 12 L) on plaster of growing size");

@@ -3,7 +3,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use slayer::bench::{ScriptSpec, generate_script, paper_table};
+use slayer::bench::{ScriptSpec, generate_script, gpu_memory_lines, paper_table};
 use slayer::brush::{BrushKind, PaintSpec, StencilSpec, StrokeFile};
 use slayer::gpu::GpuContext;
 use slayer::mesh::Mesh;
@@ -139,6 +139,7 @@ pub fn run(
         eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
     }
     println!("{}", paper_table(std::slice::from_ref(&result)));
+    print!("{}", gpu_memory_lines(std::slice::from_ref(&result)));
 
     let after = out.join("plaster-sculpted.ply");
     let after_obj = out.join("plaster-sculpted.obj");
