@@ -613,14 +613,27 @@ fn bench_on_both_backends_writes_parity() {
     let memory = &report["gpu_scenes"][0]["gpu_memory"];
     let vertices = report["gpu_scenes"][0]["vertices"].as_u64().unwrap();
     if report["adapter"].as_str().unwrap().contains("Vulkan") {
-        let allocated = memory["allocated_bytes"].as_u64().expect("an allocator report");
-        let reserved = memory["reserved_bytes"].as_u64().expect("an allocator report");
-        assert!(allocated >= 12 * vertices && allocated <= reserved, "{memory}");
+        let allocated = memory["allocated_bytes"]
+            .as_u64()
+            .expect("an allocator report");
+        let reserved = memory["reserved_bytes"]
+            .as_u64()
+            .expect("an allocator report");
+        assert!(
+            allocated >= 12 * vertices && allocated <= reserved,
+            "{memory}"
+        );
     }
-    assert!(memory["budget_bytes"].as_u64().unwrap() >= 12 * vertices, "{memory}");
+    assert!(
+        memory["budget_bytes"].as_u64().unwrap() >= 12 * vertices,
+        "{memory}"
+    );
     assert!(report["scenes"][0]["gpu_memory"].is_null());
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("gpu memory plaster (gpu): at most"), "{stdout}");
+    assert!(
+        stdout.contains("gpu memory plaster (gpu): at most"),
+        "{stdout}"
+    );
     let out = slayer(&["bench", "--scene", "plaster", "--backend", "quantum"]);
     assert!(!out.status.success());
     let first = text(&out.stderr)

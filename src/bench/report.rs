@@ -150,21 +150,14 @@ pub fn scaling_table(rows: &[ScalingRow]) -> String {
             r.steps,
             r.moves
         );
-        let held = r
-            .gpu_memory
-            .and_then(|m| m.allocated_bytes)
-            .map_or("-".to_string(), |b| {
-                format!("{:.1}", b as f64 / (1u64 << 20) as f64)
-            });
-        let _ = writeln!(
-            out,
-            "{}",
-            if on_gpu {
-                format!(" {held:>9}")
-            } else {
-                String::new()
-            }
-        );
+        if on_gpu {
+            let held = r.gpu_memory.and_then(|m| m.allocated_bytes);
+            let _ = match held {
+                Some(bytes) => write!(out, " {:>9.1}", bytes as f64 / (1u64 << 20) as f64),
+                None => write!(out, " {:>9}", "-"),
+            };
+        }
+        out.push('\n');
     }
     out
 }
