@@ -29,8 +29,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Generate the default material, sculpt and paint it with a seeded stroke script, then write,
-    /// check and render it before and after
+    /// Sculpt and paint the generated default material with a seeded script; write, check, render
     Demo {
         /// Folder for the demo's files.
         #[arg(long, default_value = "slayer-demo")]
