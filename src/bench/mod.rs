@@ -148,10 +148,10 @@ pub fn run_strokes(
     let mut gpu_memory = pipeline.gpu_memory(mesh);
     for (i, stroke) in strokes.iter().enumerate() {
         let report = pipeline.apply_stroke(mesh, stroke)?;
-        gpu_memory = match (gpu_memory, pipeline.gpu_memory(mesh)) {
-            (Some(peak), Some(now)) => Some(peak.max(now)),
-            (peak, now) => peak.or(now),
-        };
+        gpu_memory = gpu_memory
+            .into_iter()
+            .chain(pipeline.gpu_memory(mesh))
+            .reduce(GpuMemory::max);
         phases.add(&report.phases);
         samples += report.samples;
         steps += report.steps;

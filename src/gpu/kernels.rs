@@ -1192,8 +1192,8 @@ impl GpuKernels {
     }
 
     /// [`StepKernels::select_deform_and_clamp`] on the GPU, falling back to the CPU: the call a
-    /// run queued, else at the start of a sample (planned at `planned`) a run of the samples
-    /// planned from it, else one submission for this step.
+    /// run queued, else at the start of a sample (planned at `planned`, known only while runs
+    /// ahead are on) a run of the samples planned from it, else one submission for this step.
     fn select_deform_and_clamp_on_gpu(
         &mut self,
         state: &StrokeState<'_>,
@@ -1209,8 +1209,7 @@ impl GpuKernels {
                 let probe = (*dab, normal);
                 self.take_queued_start(mesh, &probe, state.max_edge)
                     .or_else(|| {
-                        let from =
-                            planned.filter(|&at| self.may_start_run(at) && self.runs_ahead())?;
+                        let from = planned.filter(|&at| self.may_start_run(at))?;
                         let run = (None, Some(from));
                         self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, step_limit))?;
                         self.take_queued_start(mesh, &probe, state.max_edge)
@@ -1972,9 +1971,12 @@ impl StepKernels for GpuKernels {
         source: FrameSource,
         step_limit: f32,
     ) -> Deformed {
+        // Only runs ahead read the plan position: no search for it otherwise.
         let planned = match source {
-            FrameSource::Selection { normal } => self.plan_position(&(*dab, normal)),
-            FrameSource::Dab => None,
+            FrameSource::Selection { normal } if self.runs_ahead() => {
+                self.plan_position(&(*dab, normal))
+            }
+            _ => None,
         };
         let deformed =
             self.select_deform_and_clamp_on_gpu(state, mesh, dab, (source, planned), step_limit);

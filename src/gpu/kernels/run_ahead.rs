@@ -409,9 +409,10 @@ impl GpuKernels {
 
     /// The first step of a sample of several (planned at `planned`) under `dab`, on the
     /// sample's `selection`: records the sample's steps and the samples after it in one run
-    /// and takes the first step's targets from it. `None` when the stroke is not planned (a
-    /// grab deforms what its first sample caught at every step; remeshing between samples),
-    /// when the steps are too many, or when the run does not give the step.
+    /// and takes the first step's targets from it. `None` when the sample has no plan position
+    /// (runs ahead off at its start; a stroke not planned: a grab deforms what its first sample
+    /// caught at every step, remeshing between samples), when the steps are too many, or when
+    /// the run does not give the step.
     pub(super) fn run_steps_ahead(
         &mut self,
         state: &StrokeState<'_>,
@@ -420,7 +421,7 @@ impl GpuKernels {
         planned: Option<usize>,
         limit: f32,
     ) -> Option<Vec<Vec3>> {
-        let at = planned.filter(|_| self.runs_ahead())?;
+        let at = planned?;
         let steps = steps_of_share(dab.share)?;
         let from = Some(at + 1).filter(|&next| next < self.plan.len());
         let run = (Some((*dab, steps)), from);
@@ -486,9 +487,7 @@ impl GpuKernels {
             }
             RunCall::Start(_) => false,
         });
-        let deformed = self.take_queued(mesh, is_step, max_edge)?;
-        self.uploads.steps_ahead += 1;
-        Some(deformed)
+        self.take_queued(mesh, is_step, max_edge)
     }
 
     /// The queued call at the head, when the pipeline's call is it (`is_call`), its moves are
@@ -531,7 +530,10 @@ impl GpuKernels {
         }
         match queued.call {
             RunCall::Start(_) => self.uploads.samples_ahead += 1,
-            RunCall::Step { .. } => self.steps_taken.extend_from_slice(moved_by(&queued)),
+            RunCall::Step { .. } => {
+                self.uploads.steps_ahead += 1;
+                self.steps_taken.extend_from_slice(moved_by(&queued));
+            }
         }
         self.ahead = queued.ahead;
         self.taken_filed = queued.filed;
