@@ -4,7 +4,7 @@
 use glam::Vec3;
 use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke, StrokeFile, resample};
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
 use slayer::scene::shapes;
 
 #[test]
@@ -98,7 +98,7 @@ fn stroke(kind: BrushKind, invert: bool, points: &[Vec3]) -> Stroke {
 
 /// Applies a stroke without remeshing: these tests follow vertices by index.
 fn apply(mesh: &mut Mesh, stroke: &Stroke) {
-    CpuPipeline::new(PipelineSettings {
+    Pipeline::new(PipelineSettings {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
     })

@@ -12,7 +12,7 @@ use slayer::collide::neighbourhood::{exclusion_ring, ring_vertices};
 use slayer::geom::point_triangle_distance_squared;
 use slayer::grid::SpatialHash;
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
 use slayer::scene::{SceneKind, SceneSpec, generate, shapes};
 
 /// The brush pipeline without remeshing: these tests are about collisions (and compare vertex
@@ -109,7 +109,7 @@ fn three_hundred_random_strokes_leave_no_intersection() {
         for _ in 0..12 {
             strokes.push(push_down(&mesh, &mut rng, edge));
         }
-        let mut pipeline = CpuPipeline::new(sculpt_only());
+        let mut pipeline = Pipeline::new(sculpt_only());
         let mut collisions = 0;
         for (i, stroke) in strokes.iter().enumerate() {
             let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
@@ -135,7 +135,7 @@ fn three_hundred_random_strokes_leave_no_intersection() {
 fn a_layer_pushed_down_stops_one_collision_distance_above_the_next() {
     let mut mesh = shapes::stacked_sheets(2, 30, 30, 1.0, 2.5);
     let settings = sculpt_only();
-    let mut pipeline = CpuPipeline::new(settings);
+    let mut pipeline = Pipeline::new(settings);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let edge = mesh.mean_edge_length();
     for _ in 0..4 {
@@ -185,8 +185,8 @@ fn grid_backend_agrees_with_the_brute_force_reference_bit_for_bit() {
     );
     let strokes = script.resolve(&base, "script").unwrap();
     let (mut fast, mut reference) = (base.clone(), base.clone());
-    let mut fast_pipeline = CpuPipeline::new(sculpt_only());
-    let mut reference_pipeline = CpuPipeline::reference(sculpt_only());
+    let mut fast_pipeline = Pipeline::new(sculpt_only());
+    let mut reference_pipeline = Pipeline::reference(sculpt_only());
     assert_eq!(reference_pipeline.name(), "cpu-reference");
     for (i, stroke) in strokes.iter().enumerate() {
         let a = fast_pipeline.apply_stroke(&mut fast, stroke).unwrap();
@@ -233,7 +233,7 @@ fn masked_vertices_and_inactive_layers_stay_still() {
             normal: Some(Vec3::Z),
         }],
     };
-    let report = CpuPipeline::new(sculpt_only())
+    let report = Pipeline::new(sculpt_only())
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
     assert!(report.moves > 0);
@@ -361,7 +361,7 @@ fn a_fold_within_one_layer_still_collides() {
             })
             .collect(),
     };
-    let report = CpuPipeline::new(sculpt_only())
+    let report = Pipeline::new(sculpt_only())
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
     assert!(report.clamped > 0, "the fold collided with itself");

@@ -6,7 +6,7 @@ use slayer::bench::{ScriptSpec, generate_script};
 use slayer::collide::find_intersections;
 use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels, PackedTopology};
 use slayer::mesh::Mesh;
-use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 fn gpu() -> GpuContext {
@@ -49,7 +49,7 @@ fn plaster_and_strokes(strokes: usize) -> (Mesh, Vec<slayer::brush::Stroke>) {
 }
 
 /// Runs `strokes` and returns the collision count.
-fn run(pipeline: &mut CpuPipeline, mesh: &mut Mesh, strokes: &[slayer::brush::Stroke]) -> usize {
+fn run(pipeline: &mut Pipeline, mesh: &mut Mesh, strokes: &[slayer::brush::Stroke]) -> usize {
     strokes
         .iter()
         .map(|s| pipeline.apply_stroke(mesh, s).unwrap().clamped)
@@ -75,8 +75,8 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
         ..PipelineSettings::default()
     };
     let (mut on_cpu, mut on_gpu) = (start.clone(), start.clone());
-    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
-    let mut gpu_pipeline = CpuPipeline::with_kernels(settings, Box::new(all_on_gpu()));
+    let cpu_collisions = run(&mut Pipeline::new(settings), &mut on_cpu, &strokes);
+    let mut gpu_pipeline = Pipeline::with_kernels(settings, Box::new(all_on_gpu()));
     let gpu_collisions = run(&mut gpu_pipeline, &mut on_gpu, &strokes);
     assert_eq!(gpu_pipeline.kernel_failure(), None);
     let deviation = largest_deviation(&on_cpu, &on_gpu);
@@ -168,17 +168,17 @@ fn check_run_ahead(start: &Mesh, strokes: &[slayer::brush::Stroke]) -> RunAheadR
         ..PipelineSettings::default()
     };
     let (mut on_cpu, mut on_gpu) = (start.clone(), start.clone());
-    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, strokes);
+    let cpu_collisions = run(&mut Pipeline::new(settings), &mut on_cpu, strokes);
     let mut kernels_apart = all_on_gpu();
     kernels_apart.set_run_ahead(false);
-    let mut apart = CpuPipeline::with_kernels(settings, Box::new(kernels_apart));
+    let mut apart = Pipeline::with_kernels(settings, Box::new(kernels_apart));
     run(&mut apart, &mut start.clone(), strokes);
     let read_backs_apart = apart.uploads().expect("GPU kernels keep a copy").read_backs;
     let mut kernels = all_on_gpu();
     kernels.set_run_ahead(true);
     // What the GPU files between samples is read back and checked before the host refiles.
     kernels.set_check_filing(true);
-    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut pipeline = Pipeline::with_kernels(settings, Box::new(kernels));
     let mut gpu_collisions = 0;
     let (mut samples, mut steps) = (0, 0);
     for stroke in strokes {
@@ -228,7 +228,7 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
     let (start, strokes) = plaster_and_strokes(3);
     let settings = PipelineSettings::default();
     let mut on_cpu = start.clone();
-    let mut cpu_pipeline = CpuPipeline::new(settings);
+    let mut cpu_pipeline = Pipeline::new(settings);
     let (mut cpu_collisions, mut cpu_reverted) = (0, 0);
     for stroke in &strokes {
         let report = cpu_pipeline.apply_stroke(&mut on_cpu, stroke).unwrap();
@@ -239,7 +239,7 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
         let mut kernels = all_on_gpu();
         kernels.set_proximity_on_gpu(proximity_on_gpu);
         let mut mesh = start.clone();
-        let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+        let mut pipeline = Pipeline::with_kernels(settings, Box::new(kernels));
         let (mut gpu_collisions, mut gpu_reverted) = (0, 0);
         for stroke in &strokes {
             let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
@@ -291,10 +291,10 @@ fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
         ..PipelineSettings::default()
     };
     let mut on_cpu = start.clone();
-    run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    run(&mut Pipeline::new(settings), &mut on_cpu, &strokes);
     let mut kernels = all_on_gpu();
     kernels.fail_after(7);
-    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut pipeline = Pipeline::with_kernels(settings, Box::new(kernels));
     let mut mesh = start.clone();
     run(&mut pipeline, &mut mesh, &strokes);
     let failure = pipeline
@@ -317,14 +317,14 @@ fn a_mesh_over_the_gpu_budget_runs_on_the_cpu() {
         ..PipelineSettings::default()
     };
     let mut on_cpu = start.clone();
-    run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    run(&mut Pipeline::new(settings), &mut on_cpu, &strokes);
     let mut gpu = gpu();
     let needed = slayer::gpu::resident_bytes(&start);
     assert!(needed > 100_000, "{needed} bytes");
     gpu.budget_bytes = needed / 2;
     let mut kernels = GpuKernels::new(gpu);
     kernels.set_proximity_on_gpu(true);
-    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut pipeline = Pipeline::with_kernels(settings, Box::new(kernels));
     let mut mesh = start.clone();
     run(&mut pipeline, &mut mesh, &strokes);
     let failure = pipeline.kernel_failure().expect("the budget is reported");
@@ -378,10 +378,10 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
     );
 
     let mut on_cpu = start.clone();
-    let cpu_collisions = run(&mut CpuPipeline::new(settings), &mut on_cpu, &strokes);
+    let cpu_collisions = run(&mut Pipeline::new(settings), &mut on_cpu, &strokes);
     let mut kernels = GpuKernels::new(gpu);
     kernels.set_proximity_on_gpu(true);
-    let mut pipeline = CpuPipeline::with_kernels(settings, Box::new(kernels));
+    let mut pipeline = Pipeline::with_kernels(settings, Box::new(kernels));
     let mut mesh = start.clone();
     let gpu_collisions = run(&mut pipeline, &mut mesh, &strokes);
     assert_eq!(pipeline.kernel_failure(), None);

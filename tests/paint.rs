@@ -11,7 +11,7 @@ use slayer::brush::{
 };
 use slayer::material;
 use slayer::mesh::{Brdf, Mesh, VertexFlags};
-use slayer::pipeline::{CpuPipeline, PipelineSettings, SculptPipeline};
+use slayer::pipeline::{Pipeline, PipelineSettings};
 use slayer::render::brdf::blinn_exponent;
 use slayer::scene::shapes;
 
@@ -105,11 +105,11 @@ fn stroke(kind: BrushKind, paint: Option<Paint>, layers: Vec<u32>, at: Vec3) -> 
 
 fn apply(mesh: &mut Mesh, stroke: &Stroke) {
     let mut reference = mesh.clone();
-    CpuPipeline::new(PipelineSettings::default())
+    Pipeline::new(PipelineSettings::default())
         .apply_stroke(mesh, stroke)
         .unwrap();
     mesh.validate().unwrap();
-    CpuPipeline::reference(PipelineSettings::default())
+    Pipeline::reference(PipelineSettings::default())
         .apply_stroke(&mut reference, stroke)
         .unwrap();
     // Both backends paint and move the same bits.

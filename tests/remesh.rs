@@ -173,7 +173,7 @@ fn remeshing_an_irregular_sheet_makes_edges_uniform() {
 #[test]
 fn remeshing_after_strokes_keeps_layers_apart() {
     use slayer::bench::{BrushMix, ScriptSpec, edge_band_fraction_where, generate_script};
-    use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+    use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
     for (kind, seed) in [
         (SceneKind::Plaster, 21),
         (SceneKind::Bark, 22),
@@ -198,7 +198,7 @@ fn remeshing_after_strokes_keeps_layers_apart() {
             },
         );
         let strokes = script.resolve(&mesh, "script").unwrap();
-        let mut pipeline = CpuPipeline::new(PipelineSettings {
+        let mut pipeline = Pipeline::new(PipelineSettings {
             remeshing: Remeshing::AfterStroke,
             ..PipelineSettings::default()
         });
@@ -236,7 +236,7 @@ fn remeshing_after_strokes_keeps_layers_apart() {
 #[test]
 fn remeshing_per_sample_keeps_the_mesh_sound() {
     use slayer::bench::{ScriptSpec, generate_script};
-    use slayer::pipeline::{CpuPipeline, PipelineSettings, Remeshing, SculptPipeline};
+    use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
     let mut mesh = generate(&SceneSpec {
         kind: SceneKind::Plaster,
         triangles: 6_000,
@@ -252,7 +252,7 @@ fn remeshing_per_sample_keeps_the_mesh_sound() {
         },
     );
     let strokes = script.resolve(&mesh, "script").unwrap();
-    let mut pipeline = CpuPipeline::new(PipelineSettings {
+    let mut pipeline = Pipeline::new(PipelineSettings {
         remeshing: Remeshing::AfterSample,
         ..PipelineSettings::default()
     });

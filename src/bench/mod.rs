@@ -12,9 +12,7 @@ use serde::Serialize;
 use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
-use crate::pipeline::{
-    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, SculptPipeline, Uploads,
-};
+use crate::pipeline::{BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, Uploads};
 use crate::remesh::RemeshReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
@@ -130,7 +128,7 @@ pub fn run_strokes(
     name: &str,
     mesh: &mut Mesh,
     strokes: &[Stroke],
-    pipeline: &mut dyn SculptPipeline,
+    pipeline: &mut Pipeline,
     mut progress: impl FnMut(usize),
     check_intersections: bool,
 ) -> Result<SceneResult, PipelineError> {

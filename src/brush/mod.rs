@@ -12,8 +12,8 @@ pub use field::{Dab, DabFrame, displacement};
 pub use paint::{Paint, paint_share};
 pub use stencil::{Pattern, Stencil};
 pub use stroke::{
-    LayerRef, MAX_RADIUS_OVER_EXTENT, PaintSpec, Sample, SampleSpec, StencilSpec, Stroke,
-    StrokeError, StrokeFile, StrokeSpec, resample,
+    LayerRef, MAX_RADIUS_OVER_EXTENT, PaintSpec, Resampler, Sample, SampleSpec, StencilSpec,
+    Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec, resample,
 };
 
 use serde::{Deserialize, Serialize};

@@ -198,6 +198,37 @@ pub struct Stroke {
     pub samples: Vec<Sample>,
 }
 
+/// What a stroke is but its samples, which stream in while it is drawn
+/// (`Pipeline::begin_stroke`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrokeSettings {
+    pub brush: Brush,
+    pub paint: Option<Paint>,
+    /// Active layers, sorted.
+    pub layers: Vec<LayerId>,
+    /// Resampling step as a share of the radius.
+    pub spacing: f32,
+}
+
+impl StrokeSettings {
+    /// The arc length between resampled samples.
+    pub fn resampling_step(&self) -> f32 {
+        self.spacing * self.brush.radius
+    }
+}
+
+impl Stroke {
+    /// The stroke without its samples.
+    pub fn settings(&self) -> StrokeSettings {
+        StrokeSettings {
+            brush: self.brush,
+            paint: self.paint.clone(),
+            layers: self.layers.clone(),
+            spacing: self.spacing,
+        }
+    }
+}
+
 impl StrokeFile {
     /// Parses JSON; `source_name` names the file in messages.
     pub fn parse(text: &str, source_name: &str) -> Result<StrokeFile, StrokeError> {
@@ -501,40 +532,85 @@ fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, S
 }
 
 /// Resamples a polyline of samples every `step` of arc length, interpolating pressure and
-/// normal; the first and last samples are kept.
+/// normal; the first and last samples are kept. The whole of [`Resampler`] in one call.
 pub fn resample(samples: &[Sample], step: f32) -> Vec<Sample> {
-    let Some(first) = samples.first() else {
-        return Vec::new();
-    };
-    if samples.len() == 1 || step.is_nan() || step <= 0.0 {
-        return samples.to_vec();
+    let mut resampler = Resampler::new(step);
+    let mut out = Vec::new();
+    for &sample in samples {
+        resampler.push(sample, &mut out);
     }
-    let mut out = vec![*first];
-    let mut carried = 0.0f32; // arc length since the last emitted sample
-    for pair in samples.windows(2) {
-        let (a, b) = (pair[0], pair[1]);
+    resampler.finish(&mut out);
+    out
+}
+
+/// Resamples a stroke while it is drawn: samples are pushed as they arrive, and each push
+/// emits the samples every `step` of arc length that the new segment completes. The last
+/// input sample is emitted by [`Resampler::finish`] (only then is it known to be the last),
+/// unless an emission already lies on it. Pushing samples one at a time or all at once
+/// emits the same samples, bit for bit: the arithmetic is per segment.
+#[derive(Debug, Clone)]
+pub struct Resampler {
+    step: f32,
+    /// The last sample pushed, and where the last emitted one lies.
+    last_input: Option<Sample>,
+    last_emitted: Option<Vec3>,
+    /// Arc length since the last emission.
+    carried: f32,
+}
+
+impl Resampler {
+    /// A step that is not a positive number passes every sample through as it is.
+    pub fn new(step: f32) -> Resampler {
+        Resampler {
+            step,
+            last_input: None,
+            last_emitted: None,
+            carried: 0.0,
+        }
+    }
+
+    fn passes_through(&self) -> bool {
+        self.step.is_nan() || self.step <= 0.0
+    }
+
+    /// Emits into `out` the samples the segment up to `sample` completes.
+    pub fn push(&mut self, sample: Sample, out: &mut Vec<Sample>) {
+        let previous = self.last_input.replace(sample);
+        let Some(a) = previous.filter(|_| !self.passes_through()) else {
+            out.push(sample);
+            self.last_emitted = Some(sample.position);
+            return;
+        };
+        let b = sample;
+        let step = self.step;
         let length = a.position.distance(b.position);
-        let mut at = step - carried; // distance along this segment of the next emission
+        let mut at = step - self.carried; // distance along this segment of the next emission
         while at <= length && length > 0.0 {
             let t = at / length;
-            out.push(Sample {
+            let emitted = Sample {
                 position: a.position.lerp(b.position, t),
                 pressure: a.pressure + (b.pressure - a.pressure) * t,
                 normal: match (a.normal, b.normal) {
                     (Some(na), Some(nb)) => na.lerp(nb, t).try_normalize().or(Some(na)),
                     (n, None) | (None, n) => n,
                 },
-            });
+            };
+            self.last_emitted = Some(emitted.position);
+            out.push(emitted);
             at += step;
         }
-        carried = length - (at - step);
+        self.carried = length - (at - step);
     }
-    let last = *samples.last().unwrap_or(first);
-    if out
-        .last()
-        .is_some_and(|s| s.position.distance(last.position) > 1e-3 * step)
-    {
-        out.push(last);
+
+    /// Emits the last sample pushed, unless the last emission lies on it. Pushing after this
+    /// starts a new segment from that sample.
+    pub fn finish(&mut self, out: &mut Vec<Sample>) {
+        let (Some(last), Some(emitted)) = (self.last_input, self.last_emitted) else {
+            return;
+        };
+        if !self.passes_through() && emitted.distance(last.position) > 1e-3 * self.step {
+            out.push(last);
+            self.last_emitted = Some(last.position);
+        }
     }
-    out
 }

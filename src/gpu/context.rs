@@ -10,6 +10,8 @@ use bytemuck::Pod;
 use thiserror::Error;
 use wgpu::util::DeviceExt;
 
+use super::options::GpuOptions;
+
 #[derive(Debug, Error)]
 pub enum GpuError {
     #[error("no GPU adapter found{0}")]
@@ -149,11 +151,6 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
         .collect()
 }
 
-/// The resident-memory budget when `SLAYER_GPU_BUDGET_MIB` is not set: room for a 16M-face mesh
-/// (about 1.8 GB resident with its room to grow, `resident_bytes`) with margin, well within an
-/// H100; a desktop GPU with less memory should set its own.
-pub const DEFAULT_GPU_BUDGET_MIB: u64 = 8192;
-
 /// A device and queue on the chosen adapter.
 pub struct GpuContext {
     pub device: wgpu::Device,
@@ -162,8 +159,8 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     /// How much GPU memory a backend may keep resident, in bytes: our own budget, because
     /// lavapipe never reports running out (it takes host memory until the process dies) and
-    /// wgpu does not say how much a device has. `SLAYER_GPU_BUDGET_MIB` sets it; the default is
-    /// [`DEFAULT_GPU_BUDGET_MIB`].
+    /// wgpu does not say how much a device has. [`GpuOptions::budget_mib`] sets it; the default is
+    /// [`super::DEFAULT_GPU_BUDGET_MIB`].
     pub budget_bytes: u64,
     /// Compiled kernels by name: validating and compiling a kernel takes milliseconds, and a
     /// backend records the same few kernels for every step of every stroke.
@@ -174,10 +171,15 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// Opens the best adapter allowed by `choice` (and by `WGPU_ADAPTER_NAME`, if set), with
-    /// every limit the adapter offers.
+    /// Opens the best adapter allowed by `choice`, with every limit the adapter offers.
     pub fn new(choice: AdapterChoice) -> Result<GpuContext, GpuError> {
         GpuContext::with_limits(choice, |_| {})
+    }
+
+    /// Opens the best adapter `options` allow (software ones, one by name), with every limit
+    /// the adapter offers and the options' memory budget.
+    pub fn open(options: &GpuOptions) -> Result<GpuContext, GpuError> {
+        GpuContext::open_with_limits(options, |_| {})
     }
 
     /// As [`GpuContext::new`], with the device's limits lowered by `lower` first: the device
@@ -188,11 +190,20 @@ impl GpuContext {
         choice: AdapterChoice,
         lower: impl FnOnce(&mut wgpu::Limits),
     ) -> Result<GpuContext, GpuError> {
+        let options = GpuOptions {
+            allow_software: choice.allow_software,
+            ..GpuOptions::default()
+        };
+        GpuContext::open_with_limits(&options, lower)
+    }
+
+    fn open_with_limits(
+        options: &GpuOptions,
+        lower: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<GpuContext, GpuError> {
         let instance = instance();
         let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
-        let pinned = std::env::var("WGPU_ADAPTER_NAME")
-            .ok()
-            .filter(|s| !s.is_empty());
+        let pinned = options.adapter_name.clone().filter(|s| !s.is_empty());
         if let Some(name) = &pinned {
             let wanted = name.to_lowercase();
             adapters.retain(|a| a.get_info().name.to_lowercase().contains(&wanted));
@@ -208,7 +219,7 @@ impl GpuContext {
         };
         let info = adapter.get_info();
         let summary = AdapterSummary::of(&info);
-        if summary.software && !choice.allow_software {
+        if summary.software && !options.allow_software {
             return Err(GpuError::OnlySoftware(summary.to_string()));
         }
         let mut limits = adapter.limits();
@@ -220,10 +231,7 @@ impl GpuContext {
                 required_limits: limits.clone(),
                 ..Default::default()
             }))?;
-        let budget_mib = std::env::var("SLAYER_GPU_BUDGET_MIB")
-            .ok()
-            .and_then(|v| v.trim().parse::<u64>().ok())
-            .unwrap_or(DEFAULT_GPU_BUDGET_MIB);
+        let budget_mib = options.budget_mib;
         Ok(GpuContext {
             device,
             queue,

@@ -45,7 +45,7 @@ use super::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
     BackstopParams, BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FACE_WORDS,
     FRAME_WORKGROUP_SIZE, Filed, GateBuffers, GateStatus, GpuContext, GpuError, GpuHashTable,
-    GpuSelection, HashedVertices, MovingVertex, OverlayBuffers, PAIRS_GUESS,
+    GpuOptions, GpuSelection, HashedVertices, MovingVertex, OverlayBuffers, PAIRS_GUESS,
     PROXIMITY_WORKGROUP_SIZE, PackedTopology, ProximityBuffers, ProximityParams, SELECTION_GUESS,
     SelectedVertex, SelectionBuffers, SlotBuffers, SlottedRows, SmoothingNeighbours, TableBuffers,
     TopologyLayout, VertexBuffers, Workgroups, backstop_params, check_invocations, deform_params,
@@ -66,7 +66,8 @@ use crate::pipeline::step::{
     frame_of_sums, longest_move,
 };
 use crate::pipeline::{
-    BackstopFilter, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels, Uploads,
+    BackstopFilter, CallAt, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels,
+    Uploads,
 };
 
 /// The proximity passes rebuild the hash table once vertices may have drifted this many cells
@@ -658,7 +659,7 @@ pub struct GpuKernels {
     /// (else the CPU gathers the step's region and searches it).
     backstop_on_gpu: bool,
     /// Whether a step's proximity passes may run in the submission that selected and
-    /// deformed (`select_deform_and_clamp`; `SLAYER_GPU_AHEAD=0` turns it off).
+    /// deformed (`select_deform_and_clamp`; [`GpuOptions::clamp_in_one_submission`]).
     clamp_ahead: bool,
     /// Whether, with those, several samples of a stroke run ahead in one submission
     /// (`run_ahead`; see [`GpuKernels::set_run_ahead`]).
@@ -688,9 +689,11 @@ pub struct GpuKernels {
     /// The vertices the steps of the current sample taken from a run moved: the run
     /// recomputed their normals after the sample's last step, which go back with it.
     steps_taken: Vec<u32>,
-    /// The samples the pipeline said it will start this stroke (`upcoming`), and the index of
-    /// the one after the last it took from a submission that ran several ahead.
+    /// The samples the pipeline gave (`given`: those of its current call), the stroke's number
+    /// of the first, and the index of the one after the last it took from a submission that
+    /// ran several ahead.
     plan: Vec<SampleProbe>,
+    plan_first: usize,
     plan_next: usize,
     /// How many samples the next run ahead records, and how many of the last run the pipeline
     /// took (`run_ahead`).
@@ -714,10 +717,8 @@ pub struct GpuKernels {
 /// A sample start the pipeline may go on to deform in several steps.
 #[derive(Debug, Clone, Copy)]
 struct OpenedSample {
-    /// Its brush centre and the size of its selection, to recognise the call for its first
-    /// step (the GPU's reselection is compared with the pipeline's before it is used).
-    center: Vec3,
-    selected: usize,
+    /// Its number in the stroke, to know the call for its first step.
+    sample: usize,
     /// Where it is in the plan: the samples after it follow its steps in their run.
     planned: Option<usize>,
 }
@@ -737,20 +738,24 @@ struct ClampedAhead {
 }
 
 impl GpuKernels {
+    /// Kernels on `gpu` with the default [`GpuOptions`].
+    pub fn new(gpu: GpuContext) -> GpuKernels {
+        GpuKernels::with_options(gpu, &GpuOptions::default())
+    }
+
     /// Kernels on `gpu`. The proximity passes run there on a hardware GPU; on a software
-    /// adapter (lavapipe) they stay on the CPU unless `SLAYER_GPU_PROXIMITY=1`: the kernel's
+    /// adapter (lavapipe) they stay on the CPU unless `options` say otherwise: the kernel's
     /// broad phase walks every cell within reach of each moving vertex (reach set by the
     /// longest edge), which lavapipe runs hundreds of times slower than the CPU's per-step face
-    /// grid. [`GpuKernels::set_proximity_on_gpu`] chooses explicitly.
-    pub fn new(gpu: GpuContext) -> GpuKernels {
-        let forced = std::env::var("SLAYER_GPU_PROXIMITY").is_ok_and(|v| v == "1");
+    /// grid. Runs ahead likewise.
+    pub fn with_options(gpu: GpuContext, options: &GpuOptions) -> GpuKernels {
+        let hardware = !gpu.adapter.software;
         GpuKernels {
             last_selection: 0,
-            proximity_on_gpu: forced || !gpu.adapter.software,
-            backstop_on_gpu: std::env::var("SLAYER_GPU_BACKSTOP").map_or(true, |v| v != "0"),
-            clamp_ahead: std::env::var("SLAYER_GPU_AHEAD").map_or(true, |v| v != "0"),
-            run_ahead: std::env::var("SLAYER_GPU_RUN_AHEAD")
-                .map_or(!gpu.adapter.software, |v| v == "1"),
+            proximity_on_gpu: options.proximity_on_gpu.unwrap_or(hardware),
+            backstop_on_gpu: options.backstop_filter_on_gpu,
+            clamp_ahead: options.clamp_in_one_submission,
+            run_ahead: options.runs_ahead.unwrap_or(hardware),
             step: StepBuffers::new(&gpu),
             readback: ReusableBuffer::readback("step readback"),
             gpu,
@@ -766,6 +771,7 @@ impl GpuKernels {
             no_run_at: None,
             steps_taken: Vec::new(),
             plan: Vec::new(),
+            plan_first: 0,
             plan_next: 0,
             run_length: 0,
             run_taken: 0,
@@ -778,6 +784,11 @@ impl GpuKernels {
         }
     }
 
+    /// The adapter the kernels run on.
+    pub fn adapter(&self) -> &super::AdapterSummary {
+        &self.gpu.adapter
+    }
+
     /// Runs the proximity passes on the GPU (`true`) or on the CPU.
     pub fn set_proximity_on_gpu(&mut self, on: bool) {
         self.proximity_on_gpu = on;
@@ -787,10 +798,8 @@ impl GpuKernels {
         self.proximity_on_gpu
     }
 
-    /// With the proximity passes on the GPU, runs several samples of a stroke ahead in one
-    /// submission (`true`) or one submission per step. On by default on hardware adapters;
-    /// on lavapipe (`SLAYER_GPU_RUN_AHEAD=1` turns it on) the passes of a run, sized for the
-    /// move they assume rather than the one made, cost several times what they cost apart.
+    /// With the proximity passes on the GPU, runs the samples given in one call ahead in one
+    /// submission (`true`) or one submission per step ([`GpuOptions::runs_ahead`]).
     pub fn set_run_ahead(&mut self, on: bool) {
         self.run_ahead = on;
     }
@@ -812,12 +821,6 @@ impl GpuKernels {
             self.filing_error = h.check(&self.gpu, mesh).err();
             self.check_read_backs += self.gpu.read_backs() - before;
         }
-    }
-
-    /// With the proximity passes on the GPU, filters the exact backstop's pairs there too
-    /// (`true`, the default) or leaves the whole backstop to the CPU.
-    pub fn set_backstop_on_gpu(&mut self, on: bool) {
-        self.backstop_on_gpu = on;
     }
 
     /// Makes the GPU calls after the next `calls` fail, as a lost device would: for tests of
@@ -1192,30 +1195,30 @@ impl GpuKernels {
     }
 
     /// [`StepKernels::select_deform_and_clamp`] on the GPU, falling back to the CPU: the call a
-    /// run queued, else at the start of a sample (planned at `planned`, known only while runs
-    /// ahead are on) a run of the samples planned from it, else one submission for this step.
+    /// run queued, else at the start of a given sample a run of the given samples from it,
+    /// else one submission for this step.
     fn select_deform_and_clamp_on_gpu(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
-        (source, planned): (FrameSource, Option<usize>),
+        (source, at): (FrameSource, CallAt),
         step_limit: f32,
     ) -> Deformed {
         let how = (source, true);
         self.taken_filed = false;
-        let taken = match source {
-            FrameSource::Selection { normal } => {
-                let probe = (*dab, normal);
-                self.take_queued_start(mesh, &probe, state.max_edge)
+        let taken = match at {
+            CallAt::Start { sample } => {
+                let planned = self.plan_index(sample);
+                self.take_queued_start(mesh, planned, state.max_edge)
                     .or_else(|| {
                         let from = planned.filter(|&at| self.may_start_run(at))?;
                         let run = (None, Some(from));
                         self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, step_limit))?;
-                        self.take_queued_start(mesh, &probe, state.max_edge)
+                        self.take_queued_start(mesh, planned, state.max_edge)
                     })
             }
-            FrameSource::Dab => self.take_queued_step(mesh, (dab, None), state.max_edge),
+            CallAt::Step { .. } => self.take_queued_step(mesh, (at, None), state.max_edge),
         };
         if let Some(deformed) = taken {
             return deformed;
@@ -1968,33 +1971,26 @@ impl StepKernels for GpuKernels {
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
-        source: FrameSource,
+        (source, at): (FrameSource, CallAt),
         step_limit: f32,
     ) -> Deformed {
-        // Only runs ahead read the plan position: no search for it otherwise.
-        let planned = match source {
-            FrameSource::Selection { normal } if self.runs_ahead() => {
-                self.plan_position(&(*dab, normal))
-            }
-            _ => None,
-        };
         let deformed =
-            self.select_deform_and_clamp_on_gpu(state, mesh, dab, (source, planned), step_limit);
+            self.select_deform_and_clamp_on_gpu(state, mesh, dab, (source, at), step_limit);
         self.step_limit = Some(step_limit);
-        if matches!(source, FrameSource::Selection { .. }) {
+        if let CallAt::Start { sample } = at {
             self.steps_taken.clear();
             self.opened = Some(OpenedSample {
-                center: dab.frame.center,
-                selected: deformed.selection.len(),
-                planned,
+                sample,
+                planned: self.plan_index(sample),
             });
         }
         deformed
     }
 
-    fn upcoming(&mut self, mesh: &Mesh, probes: &[SampleProbe]) {
+    fn given(&mut self, mesh: &Mesh, first: usize, probes: &[SampleProbe]) {
         self.drop_queued(mesh);
         self.plan = probes.to_vec();
+        self.plan_first = first;
         self.plan_next = 0;
         self.opened = None;
         self.no_run_at = None;
@@ -2007,22 +2003,36 @@ impl StepKernels for GpuKernels {
         mesh: &Mesh,
         dab: &Dab,
         selection: &[(u32, f32)],
+        at: Option<CallAt>,
     ) -> Vec<Vec3> {
         // The first step of a sample of several: the selection its start found, under the same
         // brush (a share of the move). Its steps and the samples after it run ahead in one
         // submission; or, when they do not, the step is selected again with the deformation
         // and its passes in one submission, as a later step is, when the selection comes out
         // the same.
-        let opened = self
-            .opened
-            .take()
-            .filter(|o| (o.center, o.selected) == (dab.frame.center, selection.len()));
-        if let (Some(opened), Some(limit)) = (opened, self.step_limit)
+        let opened = self.opened.take();
+        let first_step = match (opened, at) {
+            (
+                Some(o),
+                Some(CallAt::Step {
+                    sample,
+                    k: 0,
+                    steps,
+                }),
+            ) if o.sample == sample => Some((o, steps)),
+            _ => None,
+        };
+        if let (Some((opened, steps)), Some(limit)) = (first_step, self.step_limit)
             && self.failed.is_none()
         {
-            if let Some(targets) =
-                self.run_steps_ahead(state, mesh, (dab, selection), opened.planned, limit)
-            {
+            let sample = (opened.sample, steps);
+            if let Some(targets) = self.run_steps_ahead(
+                state,
+                mesh,
+                (dab, selection),
+                (sample, opened.planned),
+                limit,
+            ) {
                 return targets;
             }
             let how = (FrameSource::Dab, true);
@@ -2037,7 +2047,7 @@ impl StepKernels for GpuKernels {
             }
         }
         self.on_gpu(|k| k.gpu_deform(state, mesh, dab, selection))
-            .unwrap_or_else(|| CpuKernels.deform(state, mesh, dab, selection))
+            .unwrap_or_else(|| CpuKernels.deform(state, mesh, dab, selection, at))
     }
 
     fn clamp(

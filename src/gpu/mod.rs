@@ -13,6 +13,7 @@ mod hash_table;
 mod kernels;
 mod layout;
 mod moving_entries;
+mod options;
 mod overlay;
 mod pages;
 mod proximity;
@@ -37,10 +38,7 @@ pub use brush_frame::{
     FRAME_WORKGROUP_SIZE, frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame,
 };
 pub use cell_keys::{record_cell_keys, run_cell_keys};
-pub use context::{
-    AdapterChoice, AdapterSummary, DEFAULT_GPU_BUDGET_MIB, GpuContext, GpuError, Workgroups,
-    list_adapters,
-};
+pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, Workgroups, list_adapters};
 pub use deform::{
     DeformBuffers, SmoothingNeighbours, brush_code, deform_params, record_deform, run_deform,
     run_framed_deform, smoothing_neighbours,
@@ -64,6 +62,7 @@ pub use moving_entries::{
     BuiltEntries, BuiltEntryBuffers, ENTRIES_WORKGROUP_SIZE, EntryBuffers, RING_STRIDE,
     entry_params, record_moving_entries, ring_bytes, run_moving_entries,
 };
+pub use options::{DEFAULT_GPU_BUDGET_MIB, GpuOptions};
 pub use overlay::{
     Filed, Filing, OverlayBuffers, SlotBuffers, TableBuffers, overlay_limit, overlay_table,
     overlay_table_sized, record_overlay_members, record_overlay_table, run_overlay_members,

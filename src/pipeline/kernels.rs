@@ -1,5 +1,5 @@
 //! The seam between Algorithm 2's control flow and where its data-parallel steps run. The
-//! pipeline (`CpuPipeline`) owns the loop — samples, steps, the exact backstop, remeshing — and
+//! pipeline ([`super::Pipeline`]) owns the loop — samples, steps, the exact backstop, remeshing — and
 //! asks its kernels to select, deform and clamp moves (the proximity passes): on the CPU
 //! ([`CpuKernels`]) or through the WGSL kernels ([`crate::gpu::GpuKernels`]). One loop for both keeps their results
 //! comparable vertex for vertex, which is what the parity figures of `bench --backend both`
@@ -52,8 +52,8 @@ pub trait StepKernels: Send {
         };
         let dab = Dab { frame, ..*dab };
         let started = Instant::now();
-        let targets =
-            (deforms && !selection.is_empty()).then(|| self.deform(state, mesh, &dab, &selection));
+        let targets = (deforms && !selection.is_empty())
+            .then(|| self.deform(state, mesh, &dab, &selection, None));
         Deformed {
             selection,
             frame,
@@ -67,28 +67,33 @@ pub trait StepKernels: Send {
     /// `step_limit` ([`steps_for`](super::step::steps_for) gives 1): the pipeline's [`StepKernels::clamp`] of exactly
     /// these moves then takes that result instead of running the passes. Where the assumption
     /// fails the kernels drop the result, and clamp whatever moves the pipeline settles on.
+    /// `at` says which sample or step of the stroke this is.
     fn select_deform_and_clamp(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
-        source: FrameSource,
+        (source, _at): (FrameSource, CallAt),
         _step_limit: f32,
     ) -> Deformed {
         self.select_and_deform(state, mesh, dab, (source, true))
     }
-    /// The samples the stroke is about to start, in order, each as the pipeline will pass it to
-    /// [`StepKernels::select_deform_and_clamp`] at the sample's start; empty when the stroke is
-    /// done. Kernels that can (the GPU's) run several of them ahead in one submission, and
-    /// answer from that while the pipeline takes exactly what they predicted.
-    fn upcoming(&mut self, _mesh: &Mesh, _probes: &[SampleProbe]) {}
-    /// Where the brush moves each selected vertex.
+    /// The samples numbered `first..` of the stroke that the pipeline is about to run, in
+    /// order, each as it will pass it to [`StepKernels::select_deform_and_clamp`] at the
+    /// sample's start; what was given before is void. Empty when no more follow (the stroke
+    /// begins or ends, or its samples are not to be run ahead). Kernels that can (the GPU's)
+    /// record several of them in one submission, and answer the pipeline's calls for them
+    /// from it, knowing each call by its [`CallAt`].
+    fn given(&mut self, _mesh: &Mesh, _first: usize, _probes: &[SampleProbe]) {}
+    /// Where the brush moves each selected vertex: for step `at` of a sample, or (`None`) for
+    /// the whole move of a sample.
     fn deform(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         dab: &Dab,
         selection: &[(u32, f32)],
+        at: Option<CallAt>,
     ) -> Vec<Vec3>;
     /// The collision response's first phase, [`super::step::clamp_moves`]: the selection
     /// moved to its targets, then pulled back where it comes too close to a face. `before`
@@ -131,6 +136,22 @@ pub trait StepKernels: Send {
     fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
         Ok(())
     }
+}
+
+/// Which call of a stroke the pipeline makes, by the number of its sample in the stroke
+/// (counting from 0 across [`StrokeInProgress::add_samples`](super::StrokeInProgress::add_samples)
+/// calls): kernels that recorded given samples ahead ([`StepKernels::given`]) know the call
+/// they recorded by this, never by comparing dabs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CallAt {
+    /// A sample's start: its selection, brush frame and whole move.
+    Start { sample: usize },
+    /// Step `k` of the `steps` a sample takes.
+    Step {
+        sample: usize,
+        k: usize,
+        steps: usize,
+    },
 }
 
 /// A sample's start as the pipeline asks for it: the probe dab (the frame still to be taken
@@ -185,8 +206,8 @@ pub struct Uploads {
     /// (`sample_gate`; a run stops there): their selection outgrew its room, a ring its room, a
     /// vertex moved farther or an edge grew longer than the passes were sized for.
     pub gated_ahead: usize,
-    /// Submissions that ran several samples of a stroke ahead, and the samples taken from them
-    /// as predicted ([`StepKernels::upcoming`]).
+    /// Submissions that ran several given samples of a stroke ([`StepKernels::given`]), and
+    /// the samples taken from them.
     pub batches: usize,
     pub samples_ahead: usize,
     /// Steps of samples of several steps taken from such submissions.
@@ -248,6 +269,7 @@ impl StepKernels for CpuKernels {
         mesh: &Mesh,
         dab: &Dab,
         selection: &[(u32, f32)],
+        _at: Option<CallAt>,
     ) -> Vec<Vec3> {
         deform(state, mesh, dab, selection)
     }

@@ -4,25 +4,29 @@
 //! one edge length; per step vertices are selected through the grid, deformed, tested against
 //! nearby triangles and clamped where they would come closer than the collision distance; an
 //! exact backstop then undoes any move that would still make two triangles cross (edge–edge
-//! cases the vertex–triangle test cannot see). After the stroke a hook runs: remeshing plugs in
-//! there. Every backend reports the same phases: selection, deformation, grid update,
+//! cases the vertex–triangle test cannot see). After the stroke the region it touched is
+//! remeshed. Every backend reports the same phases: selection, deformation, grid update,
 //! collision, remesh.
+//!
+//! Strokes stream: [`Pipeline::begin_stroke`] → [`StrokeInProgress::add_samples`] as samples
+//! are drawn → [`StrokeInProgress::finish`]. [`Pipeline::apply_stroke`] is the three at once.
 
-mod cpu;
+mod engine;
 mod kernels;
 pub mod step;
+mod stroke;
 
-pub use cpu::{CpuPipeline, Search};
+pub use engine::{Pipeline, Search};
 pub use kernels::{
-    BackstopFilter, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels, Uploads,
+    BackstopFilter, CallAt, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels,
+    Uploads,
 };
+pub use stroke::{SamplesReport, StrokeInProgress};
 
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::brush::Stroke;
-use crate::grid::{GridError, SpatialHash};
-use crate::mesh::Mesh;
+use crate::grid::GridError;
 use crate::remesh::RemeshReport;
 
 /// Tunables, in units of the mesh's edge length `L` where they are lengths.
@@ -36,9 +40,6 @@ pub struct PipelineSettings {
     /// The edge length `L`; by default the mean edge length of the mesh at the first stroke,
     /// then held constant (sLayer's edge length assumption).
     pub edge_length: Option<f32>,
-    /// Rebuild the grid at every stroke, as Algorithm 2 does. Off by default: the grid is kept
-    /// exact by every edit and rebuilt only when the mesh changed behind the pipeline's back.
-    pub rebuild_grid_every_stroke: bool,
     /// When the touched region is remeshed back to edge length `L`.
     pub remeshing: Remeshing,
 }
@@ -76,7 +77,6 @@ impl Default for PipelineSettings {
             collision_distance: 1.0,
             max_step: 1.0,
             edge_length: None,
-            rebuild_grid_every_stroke: false,
             remeshing: Remeshing::AfterStroke,
         }
     }
@@ -145,46 +145,6 @@ pub enum PipelineError {
     LayerOutOfRange { layer: u32, layer_count: usize },
     #[error(transparent)]
     Grid(#[from] GridError),
-    #[error("after-stroke hook failed: {0}")]
-    Hook(String),
-}
-
-/// Runs after every stroke with the vertices it moved and the up-to-date grid; remeshing plugs
-/// in here.
-pub trait StrokeHook: Send {
-    /// The pipeline books the time spent here under "remesh". Returns whether `grid` still
-    /// matches the mesh (a hook that edits the mesh and maintains the grid returns true; one
-    /// that does not, false, and the grid is rebuilt before the next stroke).
-    fn after_stroke(
-        &mut self,
-        mesh: &mut Mesh,
-        touched: &[u32],
-        grid: &mut SpatialHash,
-    ) -> Result<bool, PipelineError>;
-}
-
-/// A sculpting backend: applies strokes to a mesh.
-pub trait SculptPipeline {
-    /// Name for reports ("cpu", "cpu-reference", "gpu").
-    fn name(&self) -> String;
-    /// Builds what strokes need (grid, uploads) ahead of time; `apply_stroke` does it when
-    /// needed, so calling this only moves the one-time cost out of the first stroke.
-    fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError>;
-    fn apply_stroke(
-        &mut self,
-        mesh: &mut Mesh,
-        stroke: &Stroke,
-    ) -> Result<StrokeReport, PipelineError>;
-    /// Backends that keep a copy of the mesh elsewhere (the GPU): how they kept it current.
-    fn uploads(&self) -> Option<Uploads> {
-        None
-    }
-    /// Backends that filter the backstop's pairs elsewhere (the GPU): what they left the CPU.
-    fn backstop_filter(&self) -> Option<BackstopFilter> {
-        None
-    }
-    /// Backends that keep `mesh` in GPU memory: how much they hold now.
-    fn gpu_memory(&self, _mesh: &Mesh) -> Option<GpuMemory> {
-        None
-    }
+    #[error("the stroke has ended")]
+    StrokeEnded,
 }

@@ -1,7 +1,31 @@
 //! `--backend cpu|gpu|auto|both`: which pipeline sculpts, chosen the same way by every command.
 
-use slayer::gpu::{AdapterChoice, GpuContext, GpuKernels};
-use slayer::pipeline::{CpuPipeline, PipelineSettings};
+use slayer::gpu::{GpuContext, GpuKernels, GpuOptions};
+use slayer::pipeline::{Pipeline, PipelineSettings};
+
+/// The GPU options the environment sets: `WGPU_ADAPTER_NAME` (wgpu's convention) pins an
+/// adapter by name; `SLAYER_GPU_BUDGET_MIB` caps what the backend keeps resident;
+/// `SLAYER_GPU_PROXIMITY`, `SLAYER_GPU_BACKSTOP`, `SLAYER_GPU_AHEAD` and
+/// `SLAYER_GPU_RUN_AHEAD` (`1` on, `0` off) choose what runs on the GPU. The only place the
+/// program reads them.
+pub fn gpu_options(allow_software: bool) -> GpuOptions {
+    let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
+    let switch = |name: &str| var(name).map(|v| v.trim() == "1");
+    let defaults = GpuOptions::default();
+    GpuOptions {
+        allow_software,
+        adapter_name: var("WGPU_ADAPTER_NAME"),
+        budget_mib: var("SLAYER_GPU_BUDGET_MIB")
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(defaults.budget_mib),
+        proximity_on_gpu: switch("SLAYER_GPU_PROXIMITY"),
+        backstop_filter_on_gpu: switch("SLAYER_GPU_BACKSTOP")
+            .unwrap_or(defaults.backstop_filter_on_gpu),
+        clamp_in_one_submission: switch("SLAYER_GPU_AHEAD")
+            .unwrap_or(defaults.clamp_in_one_submission),
+        runs_ahead: switch("SLAYER_GPU_RUN_AHEAD"),
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Backend {
@@ -33,7 +57,7 @@ impl std::str::FromStr for Backend {
 /// A pipeline, the adapter it runs on ("none (CPU)" for the CPU), and which backend that is
 /// (`Cpu` or `Gpu`: what `auto` resolved to).
 pub struct Chosen {
-    pub pipeline: CpuPipeline,
+    pub pipeline: Pipeline,
     pub adapter: String,
     pub backend: Backend,
 }
@@ -41,7 +65,7 @@ pub struct Chosen {
 /// The CPU pipeline.
 pub fn cpu(settings: PipelineSettings) -> Chosen {
     Chosen {
-        pipeline: CpuPipeline::new(settings),
+        pipeline: Pipeline::new(settings),
         adapter: "none (CPU)".into(),
         backend: Backend::Cpu,
     }
@@ -50,21 +74,20 @@ pub fn cpu(settings: PipelineSettings) -> Chosen {
 /// The GPU pipeline on any adapter (software ones too), or a clear error naming what to
 /// install.
 pub fn gpu(settings: PipelineSettings) -> anyhow::Result<Chosen> {
-    let context = GpuContext::new(AdapterChoice {
-        allow_software: true,
-    })
-    .map_err(|e| {
+    let options = gpu_options(true);
+    let context = GpuContext::open(&options).map_err(|e| {
         anyhow::anyhow!(
             "--backend gpu: no GPU adapter ({e}); install a Vulkan driver (mesa-vulkan-drivers gives lavapipe) or use --backend cpu"
         )
     })?;
-    Ok(on_gpu(context, settings))
+    Ok(on_gpu(context, &options, settings))
 }
 
-fn on_gpu(context: GpuContext, settings: PipelineSettings) -> Chosen {
+fn on_gpu(context: GpuContext, options: &GpuOptions, settings: PipelineSettings) -> Chosen {
+    let kernels = GpuKernels::with_options(context, options);
     Chosen {
-        adapter: context.adapter.to_string(),
-        pipeline: CpuPipeline::with_kernels(settings, Box::new(GpuKernels::new(context))),
+        adapter: kernels.adapter().to_string(),
+        pipeline: Pipeline::with_kernels(settings, Box::new(kernels)),
         backend: Backend::Gpu,
     }
 }
@@ -78,11 +101,9 @@ pub fn choose(backend: Backend, settings: PipelineSettings) -> anyhow::Result<Ch
         Backend::Both => anyhow::bail!(
             "--backend both compares the two paths in `slayer bench`; here use cpu, gpu or auto"
         ),
-        Backend::Auto => match GpuContext::new(AdapterChoice {
-            allow_software: false,
-        }) {
+        Backend::Auto => match GpuContext::open(&gpu_options(false)) {
             Ok(context) => {
-                let chosen = on_gpu(context, settings);
+                let chosen = on_gpu(context, &gpu_options(false), settings);
                 println!("backend auto: the GPU, on {}", chosen.adapter);
                 Ok(chosen)
             }

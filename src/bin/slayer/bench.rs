@@ -7,7 +7,7 @@ use slayer::bench::{
     run_strokes, scaling_svg, scaling_table,
 };
 use slayer::mesh::Mesh;
-use slayer::pipeline::{PipelineSettings, Remeshing, SculptPipeline};
+use slayer::pipeline::{PipelineSettings, Remeshing};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 
 use crate::backend::{self, Backend};
@@ -132,7 +132,7 @@ fn bench_scene(
 }
 
 /// A GPU that failed mid-run finished on the CPU: say so, the figures mix both.
-fn report_fallback(pipeline: &slayer::pipeline::CpuPipeline) {
+fn report_fallback(pipeline: &slayer::pipeline::Pipeline) {
     if let Some(why) = pipeline.kernel_failure() {
         eprintln!("warning: the GPU failed ({why}); the run finished on the CPU");
     }
@@ -143,7 +143,7 @@ pub fn sculpt_with_progress(
     name: &str,
     mesh: &mut slayer::mesh::Mesh,
     strokes: &[slayer::brush::Stroke],
-    pipeline: &mut dyn SculptPipeline,
+    pipeline: &mut slayer::pipeline::Pipeline,
 ) -> anyhow::Result<SceneResult> {
     let bar = Bar::new(name, strokes.len() as u64);
     let result = run_strokes(name, mesh, strokes, pipeline, |_| bar.inc(), true)?;

@@ -7,7 +7,7 @@ use slayer::bench::{ScriptSpec, generate_script, gpu_memory_lines, paper_table};
 use slayer::brush::{BrushKind, PaintSpec, StencilSpec, StrokeFile};
 use slayer::gpu::GpuContext;
 use slayer::mesh::Mesh;
-use slayer::pipeline::{PipelineSettings, SculptPipeline};
+use slayer::pipeline::PipelineSettings;
 use slayer::render::{Image, RenderOptions};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 

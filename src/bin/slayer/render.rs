@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use slayer::gpu::{AdapterChoice, GpuContext};
+use slayer::gpu::GpuContext;
 use slayer::mesh::{LayerId, Mesh};
 use slayer::render::{CameraSpec, RenderOptions, Rendered, render};
 
@@ -57,10 +57,7 @@ fn resolve_layers(mesh: &Mesh, names: &[String]) -> anyhow::Result<Vec<LayerId>>
 /// The GPU the preview renders on: any adapter, software ones included, since headless
 /// machines render on lavapipe.
 pub fn open_gpu() -> anyhow::Result<GpuContext> {
-    GpuContext::new(AdapterChoice {
-        allow_software: true,
-    })
-    .context(
+    GpuContext::open(&crate::backend::gpu_options(true)).context(
         "rendering needs a Vulkan adapter; without a GPU install Mesa's lavapipe \
          (`apt-get install mesa-vulkan-drivers`, or run tools/test.sh)",
     )

@@ -3,7 +3,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use slayer::brush::StrokeFile;
-use slayer::pipeline::{PipelineSettings, Remeshing, SculptPipeline, StrokeReport};
+use slayer::pipeline::{PipelineSettings, Remeshing, StrokeReport};
 
 use crate::progress::Bar;
 

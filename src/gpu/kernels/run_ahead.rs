@@ -1,5 +1,6 @@
-//! A stroke's samples recorded ahead, several in one submission. The pipeline tells the
-//! kernels the samples it will ask for ([`StepKernels::upcoming`]); at a sample's start the
+//! A stroke's samples recorded ahead, several in one submission. The pipeline gives the
+//! kernels the samples of its current call ([`StepKernels::given`]), and names each call by
+//! its sample's number in the stroke ([`CallAt`]), never by its dab; at a sample's start the
 //! kernels record that sample and the next ones one after another — each one's selection,
 //! brush frame, deformation, moving entries, proximity passes, backstop filter, the normals
 //! its moves turned (`moved_normals`) and the filing of its moved vertices in the hash table's
@@ -30,7 +31,7 @@
 //! normals from before the sample, as the pipeline's do; the normals its moves turned are
 //! recomputed after its last step.
 //!
-//! [`StepKernels::upcoming`]: crate::pipeline::StepKernels::upcoming
+//! [`StepKernels::given`]: crate::pipeline::StepKernels::given
 
 use std::collections::VecDeque;
 
@@ -49,7 +50,7 @@ use crate::gpu::{
 };
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
-use crate::pipeline::{Deformed, FrameSource, SampleProbe};
+use crate::pipeline::{CallAt, Deformed, FrameSource, SampleProbe};
 
 /// At most this many samples in one submission: the read-back grows with each, and each later
 /// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
@@ -85,11 +86,16 @@ pub(super) enum RunCall {
     /// deformation (`select_deform_and_clamp` with the sample's probe), and the passes of its
     /// one step.
     Start(usize),
-    /// Step `k` of the `steps` of a sample of several, each under `dab` (the sample's frame, a
-    /// share of its move): selected again and deformed, with the step's passes. The pipeline
-    /// asks for step 0 with `deform` on the sample's selection, and for the later ones with
-    /// `select_deform_and_clamp` under the dab.
-    Step { dab: Dab, k: usize, steps: usize },
+    /// Step `k` of the `steps` of the stroke's sample numbered `sample`, each under `dab` (the
+    /// sample's frame, a share of its move): selected again and deformed, with the step's
+    /// passes. The pipeline asks for step 0 with `deform` on the sample's selection, and for
+    /// the later ones with `select_deform_and_clamp` under the dab.
+    Step {
+        sample: usize,
+        dab: Dab,
+        k: usize,
+        steps: usize,
+    },
 }
 
 impl RunCall {
@@ -128,29 +134,22 @@ fn moved_by(queued: &QueuedCall) -> &[u32] {
     queued.ahead.as_ref().map_or(&[], |a| a.vertices.as_slice())
 }
 
-/// The steps a sample takes when the pipeline deforms a step at `share` of its move (it
-/// gives each step `1 / steps`), when there are at most [`MAX_STEPS_AHEAD`] and more than one.
-fn steps_of_share(share: f32) -> Option<usize> {
-    (2..=MAX_STEPS_AHEAD).find(|&steps| 1.0 / steps as f32 == share)
-}
-
 impl GpuKernels {
-    /// Where the sample the pipeline starts with `probe` is in the plan, looking from the
-    /// sample after the last one taken ahead.
-    pub(super) fn plan_position(&self, probe: &SampleProbe) -> Option<usize> {
-        let from = self.plan_next.min(self.plan.len());
-        self.plan[from..]
-            .iter()
-            .position(|p| p == probe)
-            .map(|at| from + at)
+    /// Where the stroke's sample numbered `sample` is among the samples given, if it is.
+    pub(super) fn plan_index(&self, sample: usize) -> Option<usize> {
+        let index = sample.checked_sub(self.plan_first)?;
+        (index < self.plan.len()).then_some(index)
     }
 
-    /// Whether a run may start at planned sample `at`: not the last of the plan (a run of one
+    /// Whether a run may start at planned sample `at`: runs ahead on, not the last of the plan (a run of one
     /// sample is a single step), not one a run reached already (its queued start was dropped
     /// for moving farther than assumed), nor one that stopped a run where the next would stop
     /// too ([`GpuKernels::after_stop`]).
     pub(super) fn may_start_run(&self, at: usize) -> bool {
-        at + 1 < self.plan.len() && at >= self.plan_next && Some(at) != self.no_run_at
+        self.runs_ahead()
+            && at + 1 < self.plan.len()
+            && at >= self.plan_next
+            && Some(at) != self.no_run_at
     }
 
     /// Whether runs ahead are recorded at all: the passes on the GPU, run ahead of the
@@ -169,7 +168,7 @@ impl GpuKernels {
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
-        (steps, from): (Option<(Dab, usize)>, Option<usize>),
+        (steps, from): (Option<(usize, Dab, usize)>, Option<usize>),
         limit: f32,
     ) -> Result<(), GpuError> {
         self.check_injected_failure()?;
@@ -177,7 +176,14 @@ impl GpuKernels {
         self.drop_all_ahead(mesh);
         let mut calls: Vec<RunCall> = steps
             .into_iter()
-            .flat_map(|(dab, steps)| (0..steps).map(move |k| RunCall::Step { dab, k, steps }))
+            .flat_map(|(sample, dab, steps)| {
+                (0..steps).map(move |k| RunCall::Step {
+                    sample,
+                    dab,
+                    k,
+                    steps,
+                })
+            })
             .collect();
         let step_count = calls.len();
         if let Some(from) = from {
@@ -407,26 +413,33 @@ impl GpuKernels {
         Ok(())
     }
 
-    /// The first step of a sample of several (planned at `planned`) under `dab`, on the
-    /// sample's `selection`: records the sample's steps and the samples after it in one run
-    /// and takes the first step's targets from it. `None` when the sample has no plan position
-    /// (runs ahead off at its start; a stroke not planned: a grab deforms what its first sample
-    /// caught at every step, remeshing between samples), when the steps are too many, or when
-    /// the run does not give the step.
+    /// The first step of the stroke's sample numbered `sample`, of `steps`, under `dab` (given
+    /// at `planned`), on the sample's `selection`: records the sample's steps and the given
+    /// samples after it in one run and takes the first step's targets from it. `None` when the
+    /// sample was not given or runs ahead are off (a grab deforms what its first sample caught
+    /// at every step; remeshing between samples), when the steps are too many, or when the
+    /// run does not give the step.
     pub(super) fn run_steps_ahead(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
         (dab, selection): (&Dab, &[(u32, f32)]),
-        planned: Option<usize>,
+        ((sample, steps), planned): ((usize, usize), Option<usize>),
         limit: f32,
     ) -> Option<Vec<Vec3>> {
-        let at = planned?;
-        let steps = steps_of_share(dab.share)?;
+        let at = planned.filter(|_| self.runs_ahead())?;
+        if !(2..=MAX_STEPS_AHEAD).contains(&steps) {
+            return None;
+        }
         let from = Some(at + 1).filter(|&next| next < self.plan.len());
-        let run = (Some((*dab, steps)), from);
+        let run = (Some((sample, *dab, steps)), from);
         self.on_gpu(|k| k.gpu_run_ahead(state, mesh, run, limit))?;
-        self.take_queued_step(mesh, (dab, Some(selection)), state.max_edge)?
+        let first = CallAt::Step {
+            sample,
+            k: 0,
+            steps,
+        };
+        self.take_queued_step(mesh, (first, Some(selection)), state.max_edge)?
             .targets
     }
 
@@ -454,36 +467,34 @@ impl GpuKernels {
         status.stopped == GateStatus::MOVE && several_steps && longest.is_finite()
     }
 
-    /// The queued start of the sample the pipeline starts with `probe` (see
-    /// [`GpuKernels::take_queued`]).
+    /// The queued start of the given sample at `planned` (see [`GpuKernels::take_queued`]).
     pub(super) fn take_queued_start(
         &mut self,
         mesh: &Mesh,
-        probe: &SampleProbe,
+        planned: Option<usize>,
         max_edge: f32,
     ) -> Option<Deformed> {
         let is_start = self.queued.front().is_some_and(
-            |head| matches!(head.call, RunCall::Start(index) if self.plan[index] == *probe),
+            |head| matches!(head.call, RunCall::Start(index) if Some(index) == planned),
         );
         self.take_queued(mesh, is_start, max_edge)
     }
 
-    /// The queued step the pipeline asks for under `dab`: the first of a sample of several,
-    /// deformed on the sample's `selection` (found again under the dab on the GPU), or a later
-    /// one (see [`GpuKernels::take_queued`]).
+    /// The queued step the pipeline asks for at `at`: the first of a sample of several,
+    /// deformed on the sample's `selection` (found again on the GPU: it must come out the
+    /// same), or a later one (see [`GpuKernels::take_queued`]).
     pub(super) fn take_queued_step(
         &mut self,
         mesh: &Mesh,
-        (dab, selection): (&Dab, Option<&[(u32, f32)]>),
+        (at, selection): (CallAt, Option<&[(u32, f32)]>),
         max_edge: f32,
     ) -> Option<Deformed> {
         let is_step = self.queued.front().is_some_and(|head| match head.call {
-            RunCall::Step { dab: d, k, .. } => {
-                d == *dab
-                    && match selection {
-                        Some(selection) => k == 0 && head.deformed.selection == selection,
-                        None => k > 0,
-                    }
+            RunCall::Step {
+                sample, k, steps, ..
+            } => {
+                at == CallAt::Step { sample, k, steps }
+                    && selection.is_none_or(|selection| head.deformed.selection == selection)
             }
             RunCall::Start(_) => false,
         });

@@ -1,0 +1,307 @@
+//! [`Pipeline`]: what lasts between strokes — the grid, the collision set-up, the kernels that
+//! select and deform (the CPU's or the GPU's) — and the door strokes come in by
+//! ([`Pipeline::begin_stroke`]).
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::kernels::{CpuKernels, StepKernels};
+use super::step::Region;
+use super::stroke::StrokeInProgress;
+use super::{
+    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, StrokeReport, Uploads,
+};
+use crate::brush::{Stroke, StrokeSettings};
+use crate::collide::neighbourhood::exclusion_ring;
+use crate::grid::SpatialHash;
+use crate::mesh::{Mesh, MeshVersion};
+use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
+
+/// How nearby elements are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Search {
+    /// Through the spatial hash and a per-step face grid.
+    Grid,
+    /// By scanning every vertex and face: slow, obviously right, the reference.
+    Scan,
+}
+
+/// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
+/// remeshing run here on the CPU; selection, deformation and (on a GPU) the proximity passes
+/// run in its [`StepKernels`].
+pub struct Pipeline {
+    pub(super) settings: PipelineSettings,
+    pub(super) search: Search,
+    pub(super) parallel: bool,
+    pub(super) edge_length: Option<f32>,
+    /// Where selection and deformation run.
+    pub(super) kernels: Box<dyn StepKernels>,
+    /// Kept between strokes so that a stroke does not allocate them anew (reset where used).
+    pub(super) scratch: Scratch,
+    pub(super) prepared: Option<Prepared>,
+}
+
+/// Per-vertex scratch and the collision region, kept between strokes.
+#[derive(Default)]
+pub(super) struct Scratch {
+    pub region: Region,
+    /// Per vertex: its index in the current step's selection, or `INVALID`.
+    pub target_of: Vec<u32>,
+    /// Per vertex: whether the stroke moved it.
+    pub touched: Vec<bool>,
+}
+
+/// What lasts between strokes: the grid and the collision set-up, with the mesh version they
+/// match. Nothing here is recomputed over the whole mesh per stroke.
+pub(super) struct Prepared {
+    pub grid: SpatialHash,
+    pub version: MeshVersion,
+    /// Exclusion ring, and the face count it was derived at.
+    pub ring: u32,
+    pub ring_faces: usize,
+    /// A running upper bound on edge lengths, and the exact value it started from.
+    pub max_edge: f32,
+    pub exact_max_edge: f32,
+}
+
+/// The ring is re-derived when the face count has drifted this much since (remeshing keeps
+/// triangle quality, so the ring changes only with large changes of the mesh).
+const RING_REFRESH_DRIFT: f64 = 0.05;
+/// The edge bound is recomputed exactly when it has grown past this multiple of the exact value.
+const EDGE_BOUND_SLACK: f32 = 2.0;
+
+impl Pipeline {
+    /// The fast backend: grids and all cores.
+    pub fn new(settings: PipelineSettings) -> Pipeline {
+        Pipeline::with_search(settings, Search::Grid, true)
+    }
+
+    /// The reference: brute-force search on one thread.
+    pub fn reference(settings: PipelineSettings) -> Pipeline {
+        Pipeline::with_search(settings, Search::Scan, false)
+    }
+
+    pub fn with_search(settings: PipelineSettings, search: Search, parallel: bool) -> Pipeline {
+        Pipeline {
+            edge_length: settings.edge_length,
+            settings,
+            search,
+            parallel,
+            kernels: Box::new(CpuKernels),
+            scratch: Scratch::default(),
+            prepared: None,
+        }
+    }
+
+    /// Grids and all cores, with selection and deformation done by `kernels` (the GPU's, for
+    /// the GPU backend).
+    pub fn with_kernels(settings: PipelineSettings, kernels: Box<dyn StepKernels>) -> Pipeline {
+        Pipeline {
+            kernels,
+            ..Pipeline::new(settings)
+        }
+    }
+
+    pub fn settings(&self) -> &PipelineSettings {
+        &self.settings
+    }
+
+    /// Starts a stroke on `mesh`: its samples come in with
+    /// [`StrokeInProgress::add_samples`] as they are drawn, and
+    /// [`StrokeInProgress::finish`] remeshes what it touched. Brings the grid up to date with
+    /// `mesh` first (nothing to do when the last stroke left it as it is).
+    pub fn begin_stroke<'a>(
+        &'a mut self,
+        mesh: &'a mut Mesh,
+        stroke: StrokeSettings,
+    ) -> Result<StrokeInProgress<'a>, PipelineError> {
+        StrokeInProgress::begin(self, mesh, stroke)
+    }
+
+    /// A whole stroke: [`Pipeline::begin_stroke`], its samples in one
+    /// [`StrokeInProgress::add_samples`], and [`StrokeInProgress::finish`].
+    pub fn apply_stroke(
+        &mut self,
+        mesh: &mut Mesh,
+        stroke: &Stroke,
+    ) -> Result<StrokeReport, PipelineError> {
+        let mut in_progress = self.begin_stroke(mesh, stroke.settings())?;
+        in_progress.add_samples(&stroke.samples)?;
+        in_progress.finish()
+    }
+
+    /// Name for reports: "cpu", "cpu-reference", or what runs where on the GPU.
+    pub fn name(&self) -> String {
+        let kernels = self.kernels.name();
+        if kernels != "cpu" {
+            return if self.kernels.collides_on_gpu() {
+                format!(
+                    "gpu (select, deform, proximity on {kernels}; exact backstop, remesh on the cpu)"
+                )
+            } else {
+                format!("gpu (select, deform on {kernels}; collide, remesh on the cpu)")
+            };
+        }
+        match (self.search, self.parallel) {
+            (Search::Grid, true) => "cpu".into(),
+            (Search::Scan, false) => "cpu-reference".into(),
+            (Search::Grid, false) => "cpu-1-thread".into(),
+            (Search::Scan, true) => "cpu-scan".into(),
+        }
+    }
+
+    /// Builds what strokes need (grid, uploads) ahead of time; a stroke does it when needed,
+    /// so calling this only moves the one-time cost out of the first stroke.
+    pub fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
+        self.prepare_state(mesh)?;
+        if let Some(prepared) = &self.prepared {
+            self.kernels.warm_up(mesh, prepared.grid.cell_size());
+        }
+        Ok(())
+    }
+
+    /// Why the GPU kernels gave up and the pipeline went on with the CPU's, if they did.
+    pub fn kernel_failure(&self) -> Option<String> {
+        self.kernels.failure()
+    }
+
+    /// Compares the kernels' copy of the mesh (the GPU's), if they keep one, with `mesh`;
+    /// `Err` names the first difference. Reads everything back: for tests.
+    pub fn check_kernel_copy(&self, mesh: &Mesh) -> Result<(), String> {
+        self.kernels.check_copy(mesh)
+    }
+
+    /// Kernels that keep a copy of the mesh elsewhere (the GPU's): how they kept it current.
+    pub fn uploads(&self) -> Option<Uploads> {
+        self.kernels.uploads()
+    }
+
+    /// Kernels that filter the backstop's pairs elsewhere (the GPU's): what they left the CPU.
+    pub fn backstop_filter(&self) -> Option<BackstopFilter> {
+        self.kernels.backstop_filter()
+    }
+
+    /// Kernels that keep `mesh` in GPU memory: how much they hold now.
+    pub fn gpu_memory(&self, mesh: &Mesh) -> Option<GpuMemory> {
+        self.kernels.gpu_memory(mesh)
+    }
+
+    /// The edge length `L` the pipeline works with (known after the first stroke).
+    pub fn edge_length(&self) -> Option<f32> {
+        self.edge_length
+    }
+
+    /// Brings the grid and the collision set-up up to date with `mesh`: nothing when the mesh
+    /// is as the last stroke left it, a rebuild when something else changed it.
+    fn prepare_state(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
+        let edge = match self.edge_length {
+            Some(l) => l,
+            None => {
+                let l = mesh.mean_edge_length();
+                if !(l.is_finite() && l > 0.0) {
+                    return Err(PipelineError::NoEdges);
+                }
+                self.edge_length = Some(l);
+                l
+            }
+        };
+        let version = mesh.version();
+        if let Some(prepared) = &mut self.prepared
+            && prepared.version == version
+        {
+            if prepared.max_edge > EDGE_BOUND_SLACK * prepared.exact_max_edge {
+                prepared.exact_max_edge = longest_edge(mesh, None);
+                prepared.max_edge = prepared.exact_max_edge;
+            }
+            return Ok(());
+        }
+        // Algorithm 2 rebuilds the grid per stroke. Ours is kept exact by every edit, so it is
+        // rebuilt only when something else changed the mesh.
+        let grid = SpatialHash::build(mesh, edge)?;
+        let faces = mesh.face_count();
+        let (ring, ring_faces) = match &self.prepared {
+            Some(p)
+                if (faces as f64 - p.ring_faces as f64).abs()
+                    <= RING_REFRESH_DRIFT * p.ring_faces as f64 =>
+            {
+                (p.ring, p.ring_faces)
+            }
+            _ => (
+                exclusion_ring(mesh, self.settings.collision_distance * edge),
+                faces,
+            ),
+        };
+        let exact_max_edge = longest_edge(mesh, None);
+        self.prepared = Some(Prepared {
+            grid,
+            version,
+            ring,
+            ring_faces,
+            max_edge: exact_max_edge,
+            exact_max_edge,
+        });
+        Ok(())
+    }
+
+    /// [`Pipeline::prepare`], timed: the milliseconds it took, and what it prepared (taken out
+    /// of the pipeline for the stroke, which puts it back when it ends).
+    pub(super) fn take_prepared(
+        &mut self,
+        mesh: &Mesh,
+    ) -> Result<(Prepared, PhaseTimes), PipelineError> {
+        let started = Instant::now();
+        self.prepare(mesh)?;
+        let times = PhaseTimes {
+            grid_update: millis(started),
+            ..PhaseTimes::default()
+        };
+        let prepared = self.prepared.take().ok_or(PipelineError::NoEdges)?;
+        Ok((prepared, times))
+    }
+}
+
+/// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring,
+/// keeping `grid` exact, and tells `kernels` what changed; returns what it did and the
+/// vertices it changed (ascending).
+pub(super) fn remesh_touched(
+    mesh: &mut Mesh,
+    (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
+    seeds: &[u32],
+    (edge, distance, ring): (f32, f32, u32),
+) -> (RemeshReport, Vec<u32>) {
+    let settings = RemeshSettings {
+        collision_distance: distance,
+        exclusion_ring: ring,
+        ..RemeshSettings::new(edge)
+    };
+    let since = mesh.version();
+    let (report, changed) = remesh_region(mesh, grid, seeds, &settings);
+    kernels.remeshed(mesh, since, &changed);
+    (report, changed)
+}
+
+/// Longest edge of the given faces (all live faces when `faces` is `None`).
+pub(super) fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
+    let edge_max = |f: usize| {
+        if mesh.is_face_dead(f) {
+            return 0.0f32;
+        }
+        let [a, b, c] = mesh.face_positions(f);
+        a.distance(b).max(b.distance(c)).max(c.distance(a))
+    };
+    match faces {
+        Some(list) => list
+            .iter()
+            .map(|&f| edge_max(f as usize))
+            .fold(0.0, f32::max),
+        None => (0..mesh.face_count())
+            .into_par_iter()
+            .map(edge_max)
+            .reduce(|| 0.0, f32::max),
+    }
+}
+
+pub(super) fn millis(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}

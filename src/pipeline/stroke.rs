@@ -1,0 +1,586 @@
+//! A stroke while it is drawn: [`StrokeInProgress`] takes samples as they arrive (one per
+//! pointer event in the app, a whole stroke file in the batch), resamples them at the stroke's
+//! spacing across calls, and runs Algorithm 2's per-sample loop on each: select, deform in
+//! steps of at most `max_step`, collide, update the grid. [`StrokeInProgress::finish`]
+//! remeshes what the stroke touched. Feeding the samples one at a time or all at once runs the
+//! same samples through the same arithmetic, so the CPU backend's meshes are bit-identical.
+
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::engine::{Pipeline, Prepared, Scratch, Search, longest_edge, millis, remesh_touched};
+use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
+use super::step::{StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
+use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
+use crate::brush::{BrushKind, Dab, DabFrame, Resampler, Sample, StrokeSettings};
+use crate::geom::largest_move;
+use crate::mesh::{INVALID, Mesh};
+
+/// A stroke begun with [`Pipeline::begin_stroke`]. Dropping it without
+/// [`StrokeInProgress::finish`] ends the stroke where it is, unremeshed; the pipeline stays
+/// ready for the next.
+pub struct StrokeInProgress<'a> {
+    pipeline: &'a mut Pipeline,
+    mesh: &'a mut Mesh,
+    /// `None` once ended.
+    active: Option<Active>,
+}
+
+/// What one [`StrokeInProgress::add_samples`] call did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SamplesReport {
+    /// Samples after resampling that the call ran.
+    pub samples: usize,
+    pub steps: usize,
+    pub moves: usize,
+    pub clamped: usize,
+    pub reverted: usize,
+    /// Vertices whose position, normal or BRDF changed in this call (ascending): what a
+    /// viewer uploads again. Vertices remeshing added are among them.
+    pub changed: Vec<u32>,
+    /// Remeshing between samples rewrote faces ([`Remeshing::AfterSample`]): the index
+    /// buffer must be sent again.
+    pub topology_changed: bool,
+    pub phases: PhaseTimes,
+}
+
+/// The state of a stroke between calls.
+struct Active {
+    stroke: StrokeSettings,
+    resampler: Resampler,
+    prepared: Prepared,
+    scratch: Scratch,
+    /// Per layer: whether the stroke moves it.
+    active: Vec<bool>,
+    lengths: Lengths,
+    /// Where the last sample was: the next one's motion starts there.
+    previous: Option<Vec3>,
+    /// Samples run so far (the next one's number, [`CallAt`]).
+    samples_run: usize,
+    /// What a grab caught at its first sample.
+    captured: Option<Vec<(u32, f32)>>,
+    touched_list: Vec<u32>,
+    report: StrokeReport,
+}
+
+/// The stroke's lengths in world units.
+#[derive(Clone, Copy)]
+struct Lengths {
+    edge: f32,
+    collision_distance: f32,
+    step_limit: f32,
+}
+
+/// The start of one sample: what it selected and where the brush frame is.
+struct Opened {
+    probe: Dab,
+    selection: Vec<(u32, f32)>,
+    frame: DabFrame,
+    targets: Option<Vec<Vec3>>,
+}
+
+impl<'a> StrokeInProgress<'a> {
+    pub(super) fn begin(
+        pipeline: &'a mut Pipeline,
+        mesh: &'a mut Mesh,
+        stroke: StrokeSettings,
+    ) -> Result<StrokeInProgress<'a>, PipelineError> {
+        if let Some(&layer) = stroke
+            .layers
+            .iter()
+            .find(|&&l| l as usize >= mesh.layer_count())
+        {
+            return Err(PipelineError::LayerOutOfRange {
+                layer,
+                layer_count: mesh.layer_count(),
+            });
+        }
+        let (prepared, phases) = pipeline.take_prepared(mesh)?;
+        let edge = pipeline.edge_length.unwrap_or(1.0);
+        let mut scratch = std::mem::take(&mut pipeline.scratch);
+        scratch.target_of.resize(mesh.vertex_count(), INVALID);
+        scratch.touched.resize(mesh.vertex_count(), false);
+        let mut active = vec![false; mesh.layer_count()];
+        for &l in &stroke.layers {
+            active[l as usize] = true;
+        }
+        // A new stroke: nothing given to the kernels yet.
+        pipeline.kernels.given(mesh, 0, &[]);
+        let settings = pipeline.settings;
+        Ok(StrokeInProgress {
+            pipeline,
+            mesh,
+            active: Some(Active {
+                resampler: Resampler::new(stroke.resampling_step()),
+                stroke,
+                prepared,
+                scratch,
+                active,
+                lengths: Lengths {
+                    edge,
+                    collision_distance: settings.collision_distance * edge,
+                    step_limit: settings.max_step * edge,
+                },
+                previous: None,
+                samples_run: 0,
+                captured: None,
+                touched_list: Vec::new(),
+                report: StrokeReport {
+                    phases,
+                    ..StrokeReport::default()
+                },
+            }),
+        })
+    }
+
+    /// The mesh as the stroke has left it so far.
+    pub fn mesh(&self) -> &Mesh {
+        self.mesh
+    }
+
+    /// Runs every sample `samples` completes at the stroke's spacing (the last one given is
+    /// held until the next call or [`StrokeInProgress::finish`] shows where the stroke goes).
+    /// Returns when their moves are in the mesh: nothing is left running for later calls.
+    pub fn add_samples(&mut self, samples: &[Sample]) -> Result<SamplesReport, PipelineError> {
+        let active = self.active.as_mut().ok_or(PipelineError::StrokeEnded)?;
+        let mut resampled = Vec::new();
+        for &sample in samples {
+            active.resampler.push(sample, &mut resampled);
+        }
+        Ok(self.run_samples(&resampled))
+    }
+
+    /// Ends the stroke: runs the last sample given, remeshes what the stroke touched (as the
+    /// pipeline's settings say), and reports the whole stroke.
+    pub fn finish(mut self) -> Result<StrokeReport, PipelineError> {
+        let mut last = Vec::new();
+        if let Some(active) = self.active.as_mut() {
+            active.resampler.finish(&mut last);
+        }
+        self.run_samples(&last);
+        let mut active = self.active.take().ok_or(PipelineError::StrokeEnded)?;
+        let kernels = self.pipeline.kernels.as_mut();
+        kernels.given(self.mesh, active.samples_run, &[]);
+        active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
+        let report = std::mem::take(&mut active.report);
+        self.pipeline.end_stroke(self.mesh, active);
+        Ok(report)
+    }
+
+    /// Runs resampled `samples`, telling the kernels of them first where they may run ahead.
+    fn run_samples(&mut self, samples: &[Sample]) -> SamplesReport {
+        let Some(active) = self.active.as_mut() else {
+            return SamplesReport::default();
+        };
+        let pipeline = &mut *self.pipeline;
+        let kernels = pipeline.kernels.as_mut();
+        let search = (pipeline.search == Search::Grid, pipeline.parallel);
+        if active.plans_ahead(pipeline.settings.remeshing) {
+            let probes = active.probes(samples);
+            kernels.given(self.mesh, active.samples_run, &probes);
+        }
+        let mut call = SamplesReport::default();
+        let remesh_each = pipeline.settings.remeshing == Remeshing::AfterSample
+            && active.stroke.brush.kind != BrushKind::Grab;
+        for sample in samples {
+            let moved = active.run_sample(kernels, self.mesh, sample, search, &mut call);
+            if let Some(moved) = moved.filter(|_| remesh_each) {
+                active.remesh_after_sample(kernels, self.mesh, &moved, &mut call);
+            }
+        }
+        call.changed.sort_unstable();
+        call.changed.dedup();
+        active.report.phases.add(&call.phases);
+        call
+    }
+}
+
+impl Drop for StrokeInProgress<'_> {
+    fn drop(&mut self) {
+        if let Some(active) = self.active.take() {
+            let samples = active.samples_run;
+            self.pipeline.kernels.given(self.mesh, samples, &[]);
+            self.pipeline.end_stroke(self.mesh, active);
+        }
+    }
+}
+
+impl Pipeline {
+    /// Takes back what the stroke borrowed: the grid (current with `mesh`) and the scratch.
+    fn end_stroke(&mut self, mesh: &Mesh, active: Active) {
+        let Active {
+            mut prepared,
+            mut scratch,
+            touched_list,
+            ..
+        } = active;
+        for &v in &touched_list {
+            if let Some(t) = scratch.touched.get_mut(v as usize) {
+                *t = false;
+            }
+        }
+        prepared.version = mesh.version();
+        self.prepared = Some(prepared);
+        self.scratch = scratch;
+    }
+}
+
+impl Active {
+    /// Whether the kernels may run the samples of a call ahead: each is one step that nothing
+    /// else touches between — not a grab (it moves what its first sample caught), not with
+    /// remeshing between samples.
+    fn plans_ahead(&self, remeshing: Remeshing) -> bool {
+        let kind = self.stroke.brush.kind;
+        kind.deforms() && kind != BrushKind::Grab && remeshing != Remeshing::AfterSample
+    }
+
+    /// The dabs `samples` start with, as [`Active::open_sample`] will ask for them.
+    fn probes(&self, samples: &[Sample]) -> Vec<SampleProbe> {
+        let mut previous = self.previous;
+        samples
+            .iter()
+            .map(|sample| {
+                let probe = self.probe_at(sample, previous);
+                previous = Some(sample.position);
+                (probe, sample.normal)
+            })
+            .collect()
+    }
+
+    /// The dab a sample starts with: at the sample's position, moving from the previous
+    /// sample's, its frame still to be taken from the selection.
+    fn probe_at(&self, sample: &Sample, previous: Option<Vec3>) -> Dab {
+        Dab {
+            brush: self.stroke.brush,
+            frame: DabFrame {
+                center: sample.position,
+                normal: Vec3::Z,
+                plane_point: sample.position,
+                motion: previous.map_or(Vec3::ZERO, |p| sample.position - p),
+            },
+            pressure: sample.pressure,
+            share: 1.0,
+        }
+    }
+
+    /// What a step reads that lasts for the stroke.
+    fn state(&self, search: (bool, bool)) -> StrokeState<'_> {
+        stroke_state(&self.prepared, &self.active, self.lengths, search)
+    }
+
+    /// One sample of Algorithm 2: select, paint, deform in steps, collide, update the grid,
+    /// refresh the normals around what moved. Returns the vertices it moved (`None` when it
+    /// deformed nothing: an empty selection, or a brush that only paints).
+    fn run_sample(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        sample: &Sample,
+        search: (bool, bool),
+        call: &mut SamplesReport,
+    ) -> Option<Vec<u32>> {
+        let number = self.samples_run;
+        self.samples_run += 1;
+        call.samples += 1;
+        self.report.samples += 1;
+        let opened = self.open_sample(kernels, mesh, sample, number, search, &mut call.phases);
+        if opened.selection.is_empty() {
+            return None;
+        }
+        // Paint in the same pass as the deformation, where the brush is before it moves
+        // anything; booked under deformation.
+        if let Some(spec) = &self.stroke.paint {
+            let started = Instant::now();
+            let dab = Dab {
+                frame: opened.frame,
+                ..opened.probe
+            };
+            let painted = paint(&self.state(search), mesh, &dab, &opened.selection, spec);
+            let brdfs = mesh.brdfs_mut();
+            for (&(v, _), brdf) in opened.selection.iter().zip(painted) {
+                brdfs[v as usize] = brdf;
+            }
+            call.changed
+                .extend(opened.selection.iter().map(|&(v, _)| v));
+            call.phases.deformation += millis(started);
+        }
+        if !self.stroke.brush.kind.deforms() {
+            return None;
+        }
+        let moved = self.deform_in_steps(kernels, mesh, opened, (number, search), call);
+
+        // Normals of the moved vertices and of their neighbours, whose faces also turned.
+        let started = Instant::now();
+        let mut refresh: Vec<u32> = moved
+            .iter()
+            .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
+            .collect();
+        refresh.sort_unstable();
+        refresh.dedup();
+        mesh.recompute_normals_at(&refresh);
+        kernels.normals_changed(mesh, &refresh);
+        call.changed.extend_from_slice(&refresh);
+        call.phases.deformation += millis(started);
+        Some(moved)
+    }
+
+    /// The sample's selection and brush frame: a grab keeps the vertices it caught at its
+    /// first sample; anything else selects anew, and the kernels take the frame and the whole
+    /// sample's targets with it (on the GPU in one submission, booked under selection: it
+    /// cannot be split).
+    fn open_sample(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &Mesh,
+        sample: &Sample,
+        number: usize,
+        search: (bool, bool),
+        phases: &mut PhaseTimes,
+    ) -> Opened {
+        let started = Instant::now();
+        let probe = self.probe_at(sample, self.previous);
+        self.previous = Some(sample.position);
+        let kind = self.stroke.brush.kind;
+        let deformed = match (&self.captured, kind == BrushKind::Grab) {
+            (Some(held), true) => Deformed {
+                selection: held.clone(),
+                frame: brush_frame(mesh, held, &probe, sample.normal),
+                targets: None,
+                deform_millis: 0.0,
+            },
+            _ => {
+                let state = self.state(search);
+                let source = FrameSource::Selection {
+                    normal: sample.normal,
+                };
+                let at = CallAt::Start { sample: number };
+                if kind.deforms() {
+                    let limit = self.lengths.step_limit;
+                    kernels.select_deform_and_clamp(&state, mesh, &probe, (source, at), limit)
+                } else {
+                    kernels.select_and_deform(&state, mesh, &probe, (source, false))
+                }
+            }
+        };
+        if kind == BrushKind::Grab && self.captured.is_none() {
+            self.captured = Some(deformed.selection.clone());
+        }
+        phases.selection += millis(started) - deformed.deform_millis;
+        phases.deformation += deformed.deform_millis;
+        Opened {
+            probe,
+            selection: deformed.selection,
+            frame: deformed.frame,
+            targets: deformed.targets,
+        }
+    }
+
+    /// Splits the sample's motion into steps of at most `max_step` edge lengths and runs
+    /// each; returns the vertices the sample moved.
+    fn deform_in_steps(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        opened: Opened,
+        (number, search): (usize, (bool, bool)),
+        call: &mut SamplesReport,
+    ) -> Vec<u32> {
+        let started = Instant::now();
+        let is_grab = self.stroke.brush.kind == BrushKind::Grab;
+        let whole = Dab {
+            frame: opened.frame,
+            ..opened.probe
+        };
+        let first_selection = opened.selection;
+        let mut full = match opened.targets {
+            Some(targets) => targets,
+            None => kernels.deform(&self.state(search), mesh, &whole, &first_selection, None),
+        };
+        let limit = self.lengths.step_limit;
+        let steps = steps_for(longest_move(mesh, &first_selection, &full), limit);
+        call.phases.deformation += millis(started);
+        let mut moved_in_sample = Vec::new();
+        for k in 0..steps {
+            let dab = Dab {
+                share: 1.0 / steps as f32,
+                ..whole
+            };
+            let at = CallAt::Step {
+                sample: number,
+                k,
+                steps,
+            };
+            // A sample taken in one step moves the selection exactly as its whole motion did
+            // (same vertices, share 1): its targets are already known. Later steps select anew
+            // under the dab and deform in the same call (one submission on the GPU, booked
+            // under selection there).
+            let started = Instant::now();
+            let state = self.state(search);
+            let (selection, targets) = if k == 0 || is_grab {
+                let targets = if steps == 1 {
+                    std::mem::take(&mut full)
+                } else {
+                    kernels.deform(&state, mesh, &dab, &first_selection, Some(at))
+                };
+                call.phases.deformation += millis(started);
+                (first_selection.clone(), targets)
+            } else {
+                let source = (FrameSource::Dab, at);
+                let pass = kernels.select_deform_and_clamp(&state, mesh, &dab, source, limit);
+                call.phases.selection += millis(started) - pass.deform_millis;
+                call.phases.deformation += pass.deform_millis;
+                (pass.selection, pass.targets.unwrap_or_default())
+            };
+            let moved = self.take_step(kernels, mesh, (&selection, &targets), search, call);
+            moved_in_sample.extend(moved);
+        }
+        moved_in_sample
+    }
+
+    /// One step's collision phase (clamp, exact backstop) and grid update; returns the
+    /// vertices it moved.
+    fn take_step(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        (selection, targets): (&[(u32, f32)], &[Vec3]),
+        search: (bool, bool),
+        call: &mut SamplesReport,
+    ) -> Vec<u32> {
+        let started = Instant::now();
+        let target_of = &mut self.scratch.target_of;
+        for (i, &(v, _)) in selection.iter().enumerate() {
+            target_of[v as usize] = i as u32;
+        }
+        let before: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| mesh.positions()[v as usize])
+            .collect();
+        let state = stroke_state(&self.prepared, &self.active, self.lengths, search);
+        let moves = (selection, targets, target_of.as_slice());
+        let outcome = collide_with(
+            &state,
+            &mut self.scratch.region,
+            mesh,
+            moves,
+            |region, mesh, before| kernels.clamp(&state, region, mesh, moves, before),
+        );
+        for &(v, _) in selection {
+            target_of[v as usize] = INVALID;
+        }
+        let moved: Vec<u32> = selection
+            .iter()
+            .zip(&before)
+            .zip(&outcome.positions)
+            .filter(|((_, p), q)| p != q)
+            .map(|((&(v, _), _), _)| v)
+            .collect();
+        let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
+        kernels.moved(mesh, &selected, largest_move(&before, &outcome.positions));
+        let mut moved_faces: Vec<u32> = moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
+        moved_faces.sort_unstable();
+        moved_faces.dedup();
+        let prepared = &mut self.prepared;
+        prepared.max_edge = prepared
+            .max_edge
+            .max(longest_edge(mesh, Some(&moved_faces)));
+        call.phases.collision += millis(started);
+
+        let started = Instant::now();
+        for &v in &moved {
+            prepared.grid.move_to(v, mesh.positions()[v as usize]);
+        }
+        call.phases.grid_update += millis(started);
+
+        self.report.steps += 1;
+        self.report.moves += moved.len();
+        self.report.clamped += outcome.clamped;
+        self.report.reverted += outcome.reverted;
+        call.steps += 1;
+        call.moves += moved.len();
+        call.clamped += outcome.clamped;
+        call.reverted += outcome.reverted;
+        for &v in &moved {
+            if !self.scratch.touched[v as usize] {
+                self.scratch.touched[v as usize] = true;
+                self.touched_list.push(v);
+            }
+        }
+        moved
+    }
+
+    /// [`Remeshing::AfterSample`]: remeshes around `moved`, what the last sample moved (a
+    /// grab keeps moving what it caught, so its region is remeshed once, after the stroke).
+    fn remesh_after_sample(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        moved: &[u32],
+        call: &mut SamplesReport,
+    ) {
+        let started = Instant::now();
+        let lengths = (
+            self.lengths.edge,
+            self.lengths.collision_distance,
+            self.prepared.ring,
+        );
+        let (pass, changed) =
+            remesh_touched(mesh, (&mut self.prepared.grid, kernels), moved, lengths);
+        self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.report.remesh.add(&pass);
+        self.scratch.target_of.resize(mesh.vertex_count(), INVALID);
+        self.scratch.touched.resize(mesh.vertex_count(), false);
+        call.changed.extend_from_slice(&changed);
+        call.topology_changed |= pass.splits + pass.collapses + pass.flips > 0;
+        call.phases.remesh += millis(started);
+    }
+
+    /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved.
+    fn remesh_after_stroke(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        remeshing: Remeshing,
+    ) {
+        self.touched_list.sort_unstable();
+        self.report.touched = self.touched_list.len();
+        let remesh_now = match remeshing {
+            Remeshing::Off => false,
+            Remeshing::AfterStroke => true,
+            Remeshing::AfterSample => self.stroke.brush.kind == BrushKind::Grab,
+        };
+        if !remesh_now {
+            return;
+        }
+        let started = Instant::now();
+        let lengths = (
+            self.lengths.edge,
+            self.lengths.collision_distance,
+            self.prepared.ring,
+        );
+        let seeds = &self.touched_list;
+        let (pass, _) = remesh_touched(mesh, (&mut self.prepared.grid, kernels), seeds, lengths);
+        self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.report.remesh.add(&pass);
+        self.report.phases.remesh += millis(started);
+    }
+}
+
+/// What a step reads that lasts for the stroke (a free function so that a step can borrow the
+/// stroke's scratch beside it).
+fn stroke_state<'s>(
+    prepared: &'s Prepared,
+    active: &'s [bool],
+    lengths: Lengths,
+    (use_grid, parallel): (bool, bool),
+) -> StrokeState<'s> {
+    StrokeState {
+        grid: use_grid.then_some(&prepared.grid),
+        active,
+        parallel,
+        collision_distance: lengths.collision_distance,
+        ring: prepared.ring,
+        max_edge: prepared.max_edge,
+    }
+}
