@@ -15,12 +15,8 @@
 
 use super::context::check_fits;
 use super::{GpuContext, GpuError};
-
-/// Bindings a paged array may span (the kernel declares this many in bind group 1).
-pub const PAGE_COUNT: u64 = 4;
-
-/// The pipeline-overridable constant in `wgsl/shared/pages.wgsl`.
-pub const PAGE_SHIFT_CONSTANT: &str = "PAGE_SHIFT";
+use crate::abi::PAGE_COUNT;
+pub(super) use crate::abi::PAGE_SHIFT_CONSTANT;
 
 /// Every paged array is of 32-bit words.
 const WORD: u64 = 4;
