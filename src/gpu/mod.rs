@@ -11,6 +11,7 @@ mod dispatch_args;
 mod gate;
 mod hash_table;
 mod kernels;
+mod limits;
 mod moving_entries;
 mod overlay;
 mod pages;
