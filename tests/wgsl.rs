@@ -101,9 +101,9 @@ fn every_shared_file_is_registered() {
     }
 }
 
-/// Each kernel's parity tests in `tests/gpu_parity.rs`: the tests that dispatch it on the GPU
-/// and compare it with its CPU mirror. Adding a kernel to `wgsl/` without naming its parity
-/// tests here fails `every_kernel_has_a_cpu_mirror_and_a_parity_test`.
+/// Each kernel's parity tests in `tests/gpu_parity/` (in any of its modules): the tests that
+/// dispatch it on the GPU and compare it with its CPU mirror. Adding a kernel to `wgsl/`
+/// without naming its parity tests here fails `every_kernel_has_a_cpu_mirror_and_a_parity_test`.
 const PARITY_TESTS: &[(&str, &[&str])] = &[
     (
         "cell_keys",
@@ -220,6 +220,23 @@ const PARITY_TESTS: &[(&str, &[&str])] = &[
     ),
 ];
 
+/// The sources of the parity tests: `folder/main.rs` and each module it declares (a file the
+/// test target does not declare runs nothing, so its tests do not count).
+fn parity_sources(folder: &Path) -> Vec<String> {
+    let read = |file: &str| {
+        let path = folder.join(file);
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    };
+    let main = read("main.rs");
+    let modules: Vec<String> = main
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mod ")?.strip_suffix(';'))
+        .map(|module| read(&format!("{module}.rs")))
+        .collect();
+    assert!(!modules.is_empty(), "{}: no modules", folder.display());
+    std::iter::once(main).chain(modules).collect()
+}
+
 #[test]
 fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
     // DESIGN §6: every kernel in `wgsl/` has a mirror of the same name in `src/cpu/` (a module
@@ -227,7 +244,7 @@ fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
     // one parity test, and every test named here is a test.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cpu_mod = std::fs::read_to_string(root.join("src/cpu/mod.rs")).unwrap();
-    let parity = std::fs::read_to_string(root.join("tests/gpu_parity.rs")).unwrap();
+    let parity = parity_sources(&root.join("tests/gpu_parity"));
     for name in wgsl_files(&root.join("wgsl")) {
         assert!(
             cpu_mod.lines().any(|l| l.trim() == format!("mod {name};")),
@@ -240,9 +257,10 @@ fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
             .unwrap_or_else(|| panic!("wgsl/{name}.wgsl has no parity test in PARITY_TESTS"));
         assert!(!tests.is_empty(), "{name}: no parity test named");
         for test in tests {
+            let declared = format!("#[test]\nfn {test}()");
             assert!(
-                parity.contains(&format!("#[test]\nfn {test}()")),
-                "{name}: tests/gpu_parity.rs has no test `{test}`"
+                parity.iter().any(|source| source.contains(&declared)),
+                "{name}: no module of tests/gpu_parity/ has a test `{test}`"
             );
         }
     }
