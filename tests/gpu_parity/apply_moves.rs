@@ -3,11 +3,10 @@
 
 use glam::Vec3;
 use slayer::grid::SpatialHash;
-use slayer::mesh::INVALID;
 
 use crate::common::{
-    PROXIMITY_TOLERANCE, ProximityScene, SIZES, folded_sheet, gpu, longest_edge, pressed_sheets,
-    random_positions, random_u32s, shuffled,
+    PROXIMITY_TOLERANCE, ProximityScene, SIZES, folded_sheet, gathered_region, gpu, longest_edge,
+    packed, pressed_sheets, random_positions, random_u32s, shuffled,
 };
 
 /// Random moving entries over distinct vertices of `vertex_count`, with targets, verdicts (about
@@ -62,11 +61,11 @@ fn apply_moves_matches_cpu_mirror_in_every_mode() {
             let actual = run_apply_moves(&gpu, mode, &moving, &targets, &pulls, &positions, &marks)
                 .expect("GPU run");
             let mut mirror_pulls = pulls.clone();
-            let mut flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+            let mut flat = packed(&positions);
             let mut mirror_marks = marks.clone();
             let mut next_count = 0;
             let mut finals = vec![0.0f32; 3 * count];
-            let target_words: Vec<f32> = targets.iter().flat_map(|p| p.to_array()).collect();
+            let target_words = packed(&targets);
             slayer::cpu::apply_moves(
                 &ApplyParams::new(count, mode),
                 &mut slayer::cpu::ApplyBuffers {
@@ -95,7 +94,7 @@ fn apply_moves_matches_cpu_mirror_in_every_mode() {
             // What each mode means, on the mirror: untouched vertices stay, entries move, and
             // a pull lands where `verdicts` (and `pull_back`) put it.
             let any_pulled = pulls.iter().any(|&p| p != 0);
-            let flat_before: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+            let flat_before = packed(&positions);
             let verdicts = slayer::gpu::verdicts(&moving, &flat_before, &pulls);
             for (k, entry) in moving.iter().enumerate() {
                 let v = entry.vertex as usize;
@@ -163,12 +162,7 @@ fn check_clamp_loop(scene: ProximityScene) {
             ring: 2,
             max_edge: longest_edge(mesh),
         };
-        let mut target_of = vec![INVALID; mesh.vertex_count()];
-        for (i, &(v, _)) in selection.iter().enumerate() {
-            target_of[v as usize] = i as u32;
-        }
-        let mut region = slayer::pipeline::step::Region::default();
-        region.gather(&state, mesh, &selection, &targets, &target_of);
+        let (region, target_of) = gathered_region(&state, mesh, &selection, &targets);
         let mut on_cpu = mesh.clone();
         slayer::pipeline::step::clamp_moves(
             &state,

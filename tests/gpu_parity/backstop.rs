@@ -6,7 +6,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::gpu::table_size_for;
 
-use crate::common::{ProximityScene, gpu, longest_edge, pressed_sheets, shuffled};
+use crate::common::{
+    ProximityScene, gpu, longest_edge, mesh_table, packed, pressed_sheets, shuffled,
+};
 
 /// A step for the backstop filter: `scene`'s mesh at the step's start, with `order` moved to
 /// `targets` unclamped, so that faces cross, turn over and fold onto their neighbours.
@@ -108,10 +110,8 @@ fn backstop_filter_matches_cpu_mirror_and_keeps_every_crossing() {
                 topology.layout.vertex_rows_base,
                 table_size,
             );
-            let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
-            let table =
-                slayer::cpu::hash_table(mesh.positions(), &flags, params.inv_cell_size, table_size);
-            let flat: Vec<f32> = current.iter().flat_map(|p| p.to_array()).collect();
+            let table = mesh_table(mesh, params.inv_cell_size, table_size);
+            let flat = packed(&current);
             let mut mirror = slayer::cpu::backstop(
                 &params,
                 &slayer::cpu::BackstopInputs {

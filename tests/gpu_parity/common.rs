@@ -5,8 +5,11 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::brush::Falloff;
-use slayer::gpu::{AdapterChoice, GpuContext, SelectedVertex};
+use slayer::gpu::{
+    AdapterChoice, CsrTable, GpuContext, MovingVertex, NormalParams, PackedTopology, SelectedVertex,
+};
 use slayer::mesh::{INVALID, Mesh, VertexFlags};
+use slayer::pipeline::step::{Region, StrokeState};
 
 pub fn gpu() -> GpuContext {
     let gpu = GpuContext::new(AdapterChoice {
@@ -285,4 +288,67 @@ pub fn gpu_for_normals(binding: Binding, mesh: &Mesh) -> GpuContext {
             gpu_with_binding_limit(binding_limit_paging(unpaged, &[topology]))
         }
     }
+}
+
+/// Packed x, y, z triples, as the kernels and their mirrors read positions and normals.
+pub fn packed(points: &[Vec3]) -> Vec<f32> {
+    points.iter().flat_map(|p| p.to_array()).collect()
+}
+
+/// The mesh's vertex flags as the kernels read them.
+pub fn flag_bits(mesh: &Mesh) -> Vec<u32> {
+    mesh.flags().iter().map(|f| f.bits()).collect()
+}
+
+/// The mirror's hash table of `mesh`'s live vertices where the mesh has them (a step's start),
+/// as the proximity and backstop kernels query it.
+pub fn mesh_table(mesh: &Mesh, inv_cell_size: f32, table_size: u32) -> CsrTable {
+    slayer::cpu::hash_table(
+        mesh.positions(),
+        &flag_bits(mesh),
+        inv_cell_size,
+        table_size,
+    )
+}
+
+/// The host's moving list (and rings of `ring`) over `selection`, each entry starting where
+/// `mesh` has its vertex.
+pub fn host_moving_list(
+    mesh: &Mesh,
+    selection: &[u32],
+    ring: u32,
+) -> (Vec<MovingVertex>, Vec<u32>) {
+    let starts: Vec<Vec3> = selection
+        .iter()
+        .map(|&v| mesh.positions()[v as usize])
+        .collect();
+    slayer::gpu::moving_vertices(mesh, selection, &starts, ring)
+}
+
+/// The parameters of a normals pass (`vertex_normals`, `moved_normals`, `moved_edges`) over
+/// `count` entries of `topology`.
+pub fn normal_params(count: usize, topology: &PackedTopology) -> NormalParams {
+    NormalParams {
+        count: count as u32,
+        vertex_rows_base: topology.layout.vertex_rows_base,
+        _pad0: 0,
+        _pad1: 0,
+    }
+}
+
+/// The CPU pipeline's region of a step moving `selection` (vertex, weight) to `targets`, and
+/// each vertex's index in the selection (`INVALID` where not selected), as a step gathers them.
+pub fn gathered_region(
+    state: &StrokeState<'_>,
+    mesh: &Mesh,
+    selection: &[(u32, f32)],
+    targets: &[Vec3],
+) -> (Region, Vec<u32>) {
+    let mut target_of = vec![INVALID; mesh.vertex_count()];
+    for (i, &(v, _)) in selection.iter().enumerate() {
+        target_of[v as usize] = i as u32;
+    }
+    let mut region = Region::default();
+    region.gather(state, mesh, selection, targets, &target_of);
+    (region, target_of)
 }

@@ -9,7 +9,7 @@ use slayer::mesh::INVALID;
 
 use crate::common::{
     Binding, SIZES, bumpy_sheets, gpu, gpu_for_normals, half_moved_list, longest_edge,
-    random_positions, shuffled,
+    normal_params, packed, random_positions, shuffled,
 };
 
 #[test]
@@ -22,7 +22,7 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
     let mut gpu = gpu();
     let vertex_count = 9000;
     let positions = random_positions(vertex_count, 920, 3.0);
-    let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+    let flat = packed(&positions);
     let order = shuffled((0..vertex_count as u32).collect(), 921);
     let mut rng = ChaCha8Rng::seed_from_u64(922);
     for (k, &size) in SIZES.iter().enumerate() {
@@ -40,7 +40,7 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
             .iter()
             .map(|s| positions[s.vertex as usize] + random_positions(1, rng.random(), 0.29)[0])
             .collect();
-        let flat_targets: Vec<f32> = targets.iter().flat_map(|p| p.to_array()).collect();
+        let flat_targets = packed(&targets);
         for capacity in [size, size - size / 3, size + 5] {
             let count = size as u32;
             let params =
@@ -96,7 +96,7 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
             .expect("GPU run");
     assert_eq!(kept.longest_move(), 5.0);
     targets[57] = Vec3::new(f32::NAN, 0.0, 0.0);
-    let flat_targets: Vec<f32> = targets.iter().flat_map(|p| p.to_array()).collect();
+    let flat_targets = packed(&targets);
     let params = slayer::gpu::GateParams::new(100, slayer::gpu::GateStage::Decide, (0.0, 0.0));
     let mut mirror = slayer::gpu::GateStatus::default();
     slayer::cpu::longest_move(
@@ -289,13 +289,8 @@ fn check_moved_edges(binding: Binding) {
             }),
         );
         let before = slayer::gpu::GateStatus::starting(0.5 * initial);
-        let params = slayer::gpu::NormalParams {
-            count: size as u32,
-            vertex_rows_base: topology.layout.vertex_rows_base,
-            _pad0: 0,
-            _pad1: 0,
-        };
-        let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+        let params = normal_params(size, &topology);
+        let flat = packed(mesh.positions());
         let mut mirror = before;
         slayer::cpu::moved_edges(&params, (&flat, &topology.words), &moving, &mut mirror);
         // What the pipeline's bound grows to: the longest edge of the faces around the moved

@@ -9,7 +9,7 @@ use slayer::gpu::{
 use slayer::grid::{SpatialHash, cell_coordinates, hash_cell};
 use slayer::mesh::{INVALID, VertexFlags};
 
-use crate::common::{SIZES, gpu, random_flags, random_positions, random_u32s};
+use crate::common::{SIZES, flag_bits, gpu, packed, random_flags, random_positions, random_u32s};
 
 fn cpu_cell_keys(positions: &[Vec3], inv_cell_size: f32, table_size: u32) -> Vec<u32> {
     let params = CellKeyParams {
@@ -18,7 +18,7 @@ fn cpu_cell_keys(positions: &[Vec3], inv_cell_size: f32, table_size: u32) -> Vec
         inv_cell_size,
         _pad: 0,
     };
-    let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+    let flat = packed(positions);
     let mut keys = vec![0u32; positions.len()];
     slayer::cpu::cell_keys(&params, &flat, &mut keys);
     keys
@@ -229,7 +229,7 @@ fn hash_table_of_stacked_sheets_matches_the_meshs_grid() {
     let gpu = gpu();
     let mesh = slayer::scene::shapes::stacked_sheets(3, 40, 30, 0.1, 0.05);
     let grid = SpatialHash::build(&mesh, 0.1).unwrap();
-    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let flags = flag_bits(&mesh);
     let table = run_hash_table(
         &gpu,
         mesh.positions(),

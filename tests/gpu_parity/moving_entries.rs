@@ -1,12 +1,12 @@
 //! `moving_entries` against its mirror and the host's moving list and rings, with the topology
 //! whole and paged.
 
-use glam::Vec3;
 use slayer::gpu::SelectedVertex;
 use slayer::mesh::INVALID;
 
 use crate::common::{
-    Binding, SIZES, binding_limit_paging, bumpy_sheets, gpu, gpu_with_binding_limit, shuffled,
+    Binding, SIZES, binding_limit_paging, bumpy_sheets, gpu, gpu_with_binding_limit,
+    host_moving_list, shuffled,
 };
 
 /// The mirror of `moving_entries` over `selected` with `capacity` slots.
@@ -98,12 +98,7 @@ fn check_moving_entries(binding: Binding) {
                     assert_eq!(actual.overflows, 0, "{label}: a ring of {ring} fits");
                     let built = selected.len().min(capacity);
                     let vertices: Vec<u32> = selected[..built].iter().map(|s| s.vertex).collect();
-                    let starts: Vec<Vec3> = vertices
-                        .iter()
-                        .map(|&v| mesh.positions()[v as usize])
-                        .collect();
-                    let (host, host_rings) =
-                        slayer::gpu::moving_vertices(&mesh, &vertices, &starts, ring);
+                    let (host, host_rings) = host_moving_list(&mesh, &vertices, ring);
                     for (i, entry) in actual.moving.iter().enumerate() {
                         if i >= built {
                             assert_eq!(entry.vertex, INVALID, "{label}: slot {i} is vacant");

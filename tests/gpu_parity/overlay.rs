@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use slayer::gpu::table_size_for;
 use slayer::mesh::INVALID;
 
-use crate::common::{SIZES, gpu, half_moved_list, random_positions, shuffled};
+use crate::common::{SIZES, gpu, half_moved_list, packed, random_positions, shuffled};
 
 /// Overlay slots over `vertex_count` vertices at `filed` (packed): `held` members in slots in
 /// the order given, marks slot + 1, room for `room`.
@@ -16,7 +16,7 @@ fn overlay_slots(filed: &[Vec3], held: &[u32], room: usize) -> slayer::cpu::Over
         marks: vec![0; filed.len()],
         members: vec![INVALID; room],
         member_count: held.len() as u32,
-        filed_at: filed.iter().flat_map(|p| p.to_array()).collect(),
+        filed_at: packed(filed),
     };
     for (slot, &v) in held.iter().enumerate() {
         slots.members[slot] = v;
@@ -67,7 +67,7 @@ fn overlay_members_file_the_moved_entries_as_the_cpu_mirror_does() {
         );
         let room = held.len() + size;
         let before = overlay_slots(&start, &held, room);
-        let flat: Vec<f32> = positions.iter().flat_map(|p| p.to_array()).collect();
+        let flat = packed(&positions);
         let params = slayer::gpu::OverlayParams {
             count: size as u32,
             room: room as u32,
@@ -88,7 +88,7 @@ fn overlay_members_file_the_moved_entries_as_the_cpu_mirror_does() {
         for &v in &moved {
             filed[v as usize] = positions[v as usize];
         }
-        let filed: Vec<f32> = filed.iter().flat_map(|p| p.to_array()).collect();
+        let filed = packed(&filed);
         assert_eq!(
             mirror.filed_at, filed,
             "mirror filed positions at size {size}"

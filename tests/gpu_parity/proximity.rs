@@ -4,11 +4,11 @@
 use glam::Vec3;
 use slayer::gpu::table_size_for;
 use slayer::grid::SpatialHash;
-use slayer::mesh::INVALID;
 
 use crate::common::{
-    Binding, PROXIMITY_TOLERANCE, ProximityScene, binding_limit_paging, folded_sheet, gpu,
-    gpu_with_binding_limit, longest_edge, pressed_sheets,
+    Binding, PROXIMITY_TOLERANCE, ProximityScene, binding_limit_paging, folded_sheet,
+    gathered_region, gpu, gpu_with_binding_limit, host_moving_list, longest_edge, mesh_table,
+    packed, pressed_sheets,
 };
 
 /// The proximity mirror's verdicts for `selection` of `scene`, with `current` positions.
@@ -17,18 +17,12 @@ fn cpu_proximity(
     query: &slayer::gpu::ProximityQuery<'_>,
 ) -> Vec<slayer::gpu::PulledVertex> {
     let mesh = &scene.mesh;
-    let starts: Vec<Vec3> = query
-        .selection
-        .iter()
-        .map(|&v| mesh.positions()[v as usize])
-        .collect();
-    let (moving, rings) = slayer::gpu::moving_vertices(mesh, query.selection, &starts, query.ring);
+    let (moving, rings) = host_moving_list(mesh, query.selection, query.ring);
     let topology = slayer::gpu::PackedTopology::of(mesh);
     let table_size = table_size_for(mesh.vertex_count());
     let params = slayer::gpu::proximity_params(query, topology.layout.vertex_rows_base, table_size);
-    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
-    let table = slayer::cpu::hash_table(mesh.positions(), &flags, params.inv_cell_size, table_size);
-    let flat: Vec<f32> = query.current.iter().flat_map(|p| p.to_array()).collect();
+    let table = mesh_table(mesh, params.inv_cell_size, table_size);
+    let flat = packed(query.current);
     let mut pulls = vec![0u32; query.selection.len()];
     slayer::cpu::proximity(
         &params,
@@ -76,12 +70,7 @@ fn reference_pull_back(
         .iter()
         .map(|&v| scene.targets[v as usize])
         .collect();
-    let mut target_of = vec![INVALID; mesh.vertex_count()];
-    for (i, &v) in selection.iter().enumerate() {
-        target_of[v as usize] = i as u32;
-    }
-    let mut region = slayer::pipeline::step::Region::default();
-    region.gather(&state, mesh, &pairs, &targets, &target_of);
+    let (region, _) = gathered_region(&state, mesh, &pairs, &targets);
     let mut scratch = slayer::pipeline::step::Scratch::default();
     selection
         .iter()
@@ -142,11 +131,7 @@ fn check_proximity(scene: ProximityScene, binding: Binding) {
             // Whole: positions, the hash table, the largest selection's entries. Paged: the
             // topology and the exclusion rings.
             let largest = &scene.order[..sizes[sizes.len() - 1]];
-            let starts: Vec<Vec3> = largest
-                .iter()
-                .map(|&v| scene.mesh.positions()[v as usize])
-                .collect();
-            let (moving, rings) = slayer::gpu::moving_vertices(&scene.mesh, largest, &starts, ring);
+            let (moving, rings) = host_moving_list(&scene.mesh, largest, ring);
             let vertices = scene.mesh.vertex_count() as u64;
             let unpaged = [
                 12 * vertices,

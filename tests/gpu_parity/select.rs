@@ -7,7 +7,7 @@ use slayer::gpu::{BrushSphere, SelectedVertex, run_select, select_params, table_
 use slayer::grid::SpatialHash;
 use slayer::mesh::VertexFlags;
 
-use crate::common::{FALLOFFS, SIZES, gpu, random_positions, random_vertices};
+use crate::common::{FALLOFFS, SIZES, flag_bits, gpu, random_positions, random_vertices};
 
 /// Vertices within this share of the radius of the rim may be in one selection and not the
 /// other: `|p − c|² ≤ r²` and `t < 1` are decided on rounded values, and GPUs may fuse the
@@ -323,7 +323,7 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         ring: 2,
         max_edge: 0.15,
     };
-    let flags: Vec<u32> = mesh.flags().iter().map(|f| f.bits()).collect();
+    let flags = flag_bits(&mesh);
     let layers = mesh.vertex_layers().to_vec();
     let mut worst = 0.0f32;
     for (k, &falloff) in FALLOFFS.iter().enumerate() {

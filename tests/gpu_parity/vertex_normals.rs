@@ -6,7 +6,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::common::{
-    Binding, SIZES, bumpy_sheets, gpu_for_normals, half_moved_list, shuffled, worst_relative,
+    Binding, SIZES, bumpy_sheets, gpu_for_normals, half_moved_list, normal_params, packed,
+    shuffled, worst_relative,
 };
 
 /// Normals may differ by this much (unit vectors): the GPU may fuse the cross products'
@@ -36,7 +37,7 @@ fn check_vertex_normals(binding: Binding) {
     }
     let order = shuffled((0..mesh.vertex_count() as u32).collect(), 601);
     let topology = slayer::gpu::PackedTopology::of(&mesh);
-    let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+    let flat = packed(mesh.positions());
     let mut worst = 0.0f32;
     for (k, &size) in SIZES.iter().enumerate() {
         if k + 1 == SIZES.len() {
@@ -45,13 +46,8 @@ fn check_vertex_normals(binding: Binding) {
         let listed = &order[..size];
         let mut reference = mesh.clone();
         reference.recompute_normals_at(listed);
-        let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
-        let params = slayer::gpu::NormalParams {
-            count: size as u32,
-            vertex_rows_base: topology.layout.vertex_rows_base,
-            _pad0: 0,
-            _pad1: 0,
-        };
+        let mut mirror = packed(mesh.normals());
+        let params = normal_params(size, &topology);
         slayer::cpu::vertex_normals(&params, &flat, &topology.words, listed, &mut mirror);
         let mirror: Vec<Vec3> = mirror.chunks(3).map(Vec3::from_slice).collect();
         assert_eq!(mirror, reference.normals(), "mirror at size {size}");
@@ -112,14 +108,9 @@ fn check_moved_normals(binding: Binding) {
         refreshed_any |= !corners.is_empty();
         let mut reference = mesh.clone();
         reference.recompute_normals_at(&corners);
-        let flat: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
-        let mut mirror: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
-        let params = slayer::gpu::NormalParams {
-            count: size as u32,
-            vertex_rows_base: topology.layout.vertex_rows_base,
-            _pad0: 0,
-            _pad1: 0,
-        };
+        let flat = packed(mesh.positions());
+        let mut mirror = packed(mesh.normals());
+        let params = normal_params(size, &topology);
         slayer::cpu::moved_normals(&params, &flat, &topology.words, &moving, &mut mirror);
         let mirror: Vec<Vec3> = mirror.chunks(3).map(Vec3::from_slice).collect();
         assert_eq!(mirror, reference.normals(), "mirror at size {size}");
