@@ -6,6 +6,7 @@
 //!
 //! Data flows one way: [`mesh`] ← [`grid`] ← [`collide`] ← the program.
 
+pub mod abi;
 pub mod bench;
 pub mod brush;
 pub mod check;

@@ -20,6 +20,22 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// A path as a command-line argument.
+fn arg(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// Writes `scene` with about `triangles` triangles to `path` (`slayer scene`, with `extra`
+/// options before `-o`), which must succeed: the input most tests start from.
+fn write_scene(scene: &str, triangles: u32, extra: &[&str], path: &Path) {
+    let triangles = triangles.to_string();
+    let mut args = vec!["scene", scene, "--triangles", &triangles];
+    args.extend_from_slice(extra);
+    args.extend(["-o", arg(path)]);
+    let out = slayer(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
 fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
     assert!(!output.status.success(), "expected failure");
     let stderr = text(&output.stderr);
@@ -36,16 +52,8 @@ fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
 fn scene_then_check_reports_clean_layers_as_json() {
     let dir = scratch("scene");
     let obj = dir.join("p.obj");
-    let out = slayer(&[
-        "scene",
-        "plaster",
-        "--triangles",
-        "20000",
-        "-o",
-        obj.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    let out = slayer(&["check", obj.to_str().unwrap(), "--json"]);
+    write_scene("plaster", 20000, &[], &obj);
+    let out = slayer(&["check", arg(&obj), "--json"]);
     assert!(out.status.success(), "{}", text(&out.stdout));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     for field in [
@@ -88,17 +96,7 @@ fn same_scene_arguments_write_identical_files() {
             continue;
         }
         for path in [&a, &b] {
-            let out = slayer(&[
-                "scene",
-                "bark",
-                "--triangles",
-                "6000",
-                "--seed",
-                "9",
-                "-o",
-                path.to_str().unwrap(),
-            ]);
-            assert!(out.status.success());
+            write_scene("bark", 6000, &["--seed", "9"], path);
         }
         assert!(
             std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
@@ -111,7 +109,7 @@ fn same_scene_arguments_write_identical_files() {
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
-    path.to_str().unwrap().to_string()
+    arg(&path).to_string()
 }
 
 #[test]
@@ -202,13 +200,7 @@ fn bad_arguments_are_clear() {
 #[test]
 fn demo_writes_and_checks_the_default_material() {
     let dir = scratch("demo");
-    let out = slayer(&[
-        "demo",
-        "--out",
-        dir.to_str().unwrap(),
-        "--triangles",
-        "20000",
-    ]);
+    let out = slayer(&["demo", "--out", arg(&dir), "--triangles", "20000"]);
     assert!(
         out.status.success(),
         "{}{}",
@@ -240,12 +232,7 @@ fn strokes_then_sculpt_round_trip_with_stats() {
     let strokes = dir.join("s.json");
     let output = dir.join("out.obj");
     let stats = dir.join("stats.json");
-    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
-    assert!(
-        slayer(&["scene", "plaster", "--triangles", "20000", "-o", &p(&input)])
-            .status
-            .success()
-    );
+    write_scene("plaster", 20000, &[], &input);
     let out = slayer(&[
         "strokes",
         "--scene",
@@ -255,22 +242,22 @@ fn strokes_then_sculpt_round_trip_with_stats() {
         "--count",
         "3",
         "-o",
-        &p(&strokes),
+        arg(&strokes),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let out = slayer(&[
         "sculpt",
         "--input",
-        &p(&input),
+        arg(&input),
         "--strokes",
-        &p(&strokes),
+        arg(&strokes),
         "--output",
-        &p(&output),
+        arg(&output),
         "--stats",
-        &p(&stats),
+        arg(&stats),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let check = slayer(&["check", &p(&output), "--json"]);
+    let check = slayer(&["check", arg(&output), "--json"]);
     assert!(check.status.success(), "{}", text(&check.stdout));
     let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(stats["strokes"].as_array().unwrap().len(), 3);
@@ -286,12 +273,7 @@ fn strokes_then_sculpt_round_trip_with_stats() {
 fn sculpt_with_a_bad_stroke_file_fails_cleanly_and_touches_nothing() {
     let dir = scratch("bad-strokes");
     let input = dir.join("in.obj");
-    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
-    assert!(
-        slayer(&["scene", "plane", "--triangles", "2000", "-o", &p(&input)])
-            .status
-            .success()
-    );
+    write_scene("plane", 2000, &[], &input);
     let original = std::fs::read(&input).unwrap();
     let modified = std::fs::metadata(&input).unwrap().modified().unwrap();
     let cases = [
@@ -319,11 +301,11 @@ fn sculpt_with_a_bad_stroke_file_fails_cleanly_and_touches_nothing() {
         let out = slayer(&[
             "sculpt",
             "--input",
-            &p(&input),
+            arg(&input),
             "--strokes",
             &strokes,
             "--output",
-            &p(&output),
+            arg(&output),
         ]);
         assert_one_line_error(&out, &[expected]);
         assert!(!output.exists(), "no output is written");
@@ -352,7 +334,7 @@ fn bench_writes_the_fixed_json_fields() {
         "--strokes",
         "3",
         "--json",
-        json.to_str().unwrap(),
+        arg(&json),
     ]);
     assert!(
         out.status.success(),
@@ -421,20 +403,12 @@ fn render_writes_a_png_of_the_requested_size() {
     let dir = scratch("render");
     let ply = dir.join("p.ply");
     let png = dir.join("p.png");
-    let out = slayer(&[
-        "scene",
-        "plaster",
-        "--triangles",
-        "2000",
-        "-o",
-        ply.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    write_scene("plaster", 2000, &[], &ply);
     let out = slayer_headless(&[
         "render",
-        ply.to_str().unwrap(),
+        arg(&ply),
         "-o",
-        png.to_str().unwrap(),
+        arg(&png),
         "--size",
         "120×80",
         "--camera",
@@ -463,7 +437,7 @@ fn render_of_an_empty_mesh_file_is_a_clear_error() {
          property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
     )
     .unwrap();
-    let out = slayer_headless(&["render", ply.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    let out = slayer_headless(&["render", arg(&ply), "-o", arg(&png)]);
     assert_one_line_error(&out, &["empty.ply", "no faces"]);
     assert!(!png.exists());
 }
@@ -472,20 +446,12 @@ fn render_of_an_empty_mesh_file_is_a_clear_error() {
 fn render_mistakes_are_one_line_errors() {
     let dir = scratch("render-errors");
     let ply = dir.join("p.ply");
-    let out = slayer(&[
-        "scene",
-        "plane",
-        "--triangles",
-        "200",
-        "-o",
-        ply.to_str().unwrap(),
-    ]);
-    assert!(out.status.success());
+    write_scene("plane", 200, &[], &ply);
     let png = dir.join("x.png");
-    let (ply, png) = (ply.to_str().unwrap(), png.to_str().unwrap());
+    let (ply, png) = (arg(&ply), arg(&png));
     let missing = dir.join("missing.ply");
     assert_one_line_error(
-        &slayer_headless(&["render", missing.to_str().unwrap(), "-o", png]),
+        &slayer_headless(&["render", arg(&missing), "-o", png]),
         &["missing.ply"],
     );
     assert_one_line_error(
@@ -497,7 +463,7 @@ fn render_mistakes_are_one_line_errors() {
         &["--layers", "no layer `7`"],
     );
     assert_one_line_error(
-        &slayer_headless(&["render", ply, "-o", dir.join("x.jpg").to_str().unwrap()]),
+        &slayer_headless(&["render", ply, "-o", arg(&dir.join("x.jpg"))]),
         &[".png"],
     );
     // Clap rejects malformed values before anything runs.
@@ -518,19 +484,9 @@ fn render_mistakes_are_one_line_errors() {
 fn remesh_makes_a_jittered_scene_uniform_and_clean() {
     let dir = scratch("remesh");
     let (rough, smooth) = (dir.join("rough.ply"), dir.join("smooth.ply"));
-    let out = slayer(&[
-        "scene",
-        "plaster",
-        "--triangles",
-        "8000",
-        "--jitter",
-        "0.4",
-        "-o",
-        rough.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    write_scene("plaster", 8000, &["--jitter", "0.4"], &rough);
     let cv = |path: &Path| {
-        let out = slayer(&["check", path.to_str().unwrap(), "--json"]);
+        let out = slayer(&["check", arg(path), "--json"]);
         assert!(out.status.success(), "{}", text(&out.stdout));
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
         assert_eq!(report["intersections"], 0);
@@ -538,25 +494,13 @@ fn remesh_makes_a_jittered_scene_uniform_and_clean() {
     };
     let before = cv(&rough);
     assert!(before > 0.2, "the jittered scene is irregular: cv {before}");
-    let out = slayer(&[
-        "remesh",
-        rough.to_str().unwrap(),
-        "-o",
-        smooth.to_str().unwrap(),
-    ]);
+    let out = slayer(&["remesh", arg(&rough), "-o", arg(&smooth)]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("smallest angle"));
     let after = cv(&smooth);
     assert!(after < 0.15, "cv {before} -> {after}");
     assert_one_line_error(
-        &slayer(&[
-            "scene",
-            "plaster",
-            "--jitter",
-            "0.9",
-            "-o",
-            rough.to_str().unwrap(),
-        ]),
+        &slayer(&["scene", "plaster", "--jitter", "0.9", "-o", arg(&rough)]),
         &["--jitter"],
     );
     std::fs::remove_dir_all(dir).unwrap();
@@ -588,7 +532,7 @@ fn bench_on_both_backends_writes_parity() {
         "--backend",
         "both",
         "--json",
-        json.to_str().unwrap(),
+        arg(&json),
     ]);
     assert!(
         out.status.success(),

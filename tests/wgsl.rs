@@ -1,19 +1,20 @@
-//! Every shader in `wgsl/` is registered, validates with naga, and the host structs match
-//! naga's layout of their WGSL declarations.
+//! Every shader in `wgsl/` is registered, validates with naga, and the host structs and
+//! constants (`slayer::abi`, the contract between `wgsl/`, the CPU mirrors and the GPU host
+//! code) match naga's layout and values of their WGSL declarations.
 
 use std::path::Path;
 
+use slayer::abi::{
+    ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
+    DispatchParams, EntryParams, FrameParams, GateParams, GateStage, GateStatus, MovingVertex,
+    NormalParams, OverlayParams, ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex,
+    brush_code, falloff_code,
+};
 use slayer::brush::BrushKind;
 use slayer::brush::Falloff;
 use slayer::gpu::shaders::{
     FRAGMENT_ENTRY, KERNELS, RENDER_SHADERS, SHARED, VERTEX_ENTRY, expand_imports, kernel_source,
     render_source, validate,
-};
-use slayer::gpu::{
-    ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, GateParams, GateStage, GateStatus, MovingVertex,
-    NormalParams, OverlayParams, ProximityParams, SCAN_BLOCK, SelectParams, SelectedVertex,
-    brush_code, falloff_code,
 };
 use slayer::mesh::{INVALID, VertexFlags};
 use slayer::render::{PreviewUniforms, RenderVertex};
@@ -100,9 +101,9 @@ fn every_shared_file_is_registered() {
     }
 }
 
-/// Each kernel's parity tests in `tests/gpu_parity.rs`: the tests that dispatch it on the GPU
-/// and compare it with its CPU mirror. Adding a kernel to `wgsl/` without naming its parity
-/// tests here fails `every_kernel_has_a_cpu_mirror_and_a_parity_test`.
+/// Each kernel's parity tests in `tests/gpu_parity/` (in any of its modules): the tests that
+/// dispatch it on the GPU and compare it with its CPU mirror. Adding a kernel to `wgsl/`
+/// without naming its parity tests here fails `every_kernel_has_a_cpu_mirror_and_a_parity_test`.
 const PARITY_TESTS: &[(&str, &[&str])] = &[
     (
         "cell_keys",
@@ -219,6 +220,23 @@ const PARITY_TESTS: &[(&str, &[&str])] = &[
     ),
 ];
 
+/// The sources of the parity tests: `folder/main.rs` and each module it declares (a file the
+/// test target does not declare runs nothing, so its tests do not count).
+fn parity_sources(folder: &Path) -> Vec<String> {
+    let read = |file: &str| {
+        let path = folder.join(file);
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    };
+    let main = read("main.rs");
+    let modules: Vec<String> = main
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mod ")?.strip_suffix(';'))
+        .map(|module| read(&format!("{module}.rs")))
+        .collect();
+    assert!(!modules.is_empty(), "{}: no modules", folder.display());
+    std::iter::once(main).chain(modules).collect()
+}
+
 #[test]
 fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
     // DESIGN §6: every kernel in `wgsl/` has a mirror of the same name in `src/cpu/` (a module
@@ -226,7 +244,7 @@ fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
     // one parity test, and every test named here is a test.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cpu_mod = std::fs::read_to_string(root.join("src/cpu/mod.rs")).unwrap();
-    let parity = std::fs::read_to_string(root.join("tests/gpu_parity.rs")).unwrap();
+    let parity = parity_sources(&root.join("tests/gpu_parity"));
     for name in wgsl_files(&root.join("wgsl")) {
         assert!(
             cpu_mod.lines().any(|l| l.trim() == format!("mod {name};")),
@@ -239,9 +257,10 @@ fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
             .unwrap_or_else(|| panic!("wgsl/{name}.wgsl has no parity test in PARITY_TESTS"));
         assert!(!tests.is_empty(), "{name}: no parity test named");
         for test in tests {
+            let declared = format!("#[test]\nfn {test}()");
             assert!(
-                parity.contains(&format!("#[test]\nfn {test}()")),
-                "{name}: tests/gpu_parity.rs has no test `{test}`"
+                parity.iter().any(|source| source.contains(&declared)),
+                "{name}: no module of tests/gpu_parity/ has a test `{test}`"
             );
         }
     }
@@ -435,10 +454,10 @@ fn wgsl_constants_match_the_host() {
         );
     }
     for (name, flag) in [
-        ("FRAME_PLANE_FROM_SUMS", slayer::cpu::FRAME_PLANE_FROM_SUMS),
+        ("FRAME_PLANE_FROM_SUMS", slayer::abi::FRAME_PLANE_FROM_SUMS),
         (
             "FRAME_NORMAL_FROM_SUMS",
-            slayer::cpu::FRAME_NORMAL_FROM_SUMS,
+            slayer::abi::FRAME_NORMAL_FROM_SUMS,
         ),
     ] {
         assert_eq!(naga_u32_constant("deform", name), flag, "{name}");
@@ -479,16 +498,16 @@ fn wgsl_constants_match_the_host() {
     }
     assert_eq!(
         naga_f32_constant("proximity", "CLAMP_SLACK"),
-        slayer::pipeline::step::CLAMP_SLACK
+        slayer::abi::CLAMP_SLACK
     );
     assert_eq!(
         naga_f32_constant("backstop", "MARGIN"),
-        slayer::cpu::BACKSTOP_MARGIN
+        slayer::abi::BACKSTOP_MARGIN
     );
     for kernel in ["proximity", "apply_moves"] {
         assert_eq!(
             naga_f32_constant(kernel, "PULL_SCALE"),
-            slayer::cpu::PULL_SCALE
+            slayer::abi::PULL_SCALE
         );
     }
     // One scan workgroup is one block on the host side.
@@ -497,20 +516,32 @@ fn wgsl_constants_match_the_host() {
     }
     // Kernels dispatched indirectly, and the gate's: the host sizes the dispatch with its own
     // constant, and a smaller one than the shader's would leave entries out without a word.
-    for (kernel, host) in [
-        ("brush_frame", slayer::gpu::FRAME_WORKGROUP_SIZE),
-        ("apply_moves", slayer::gpu::APPLY_WORKGROUP_SIZE),
-        ("proximity", slayer::gpu::PROXIMITY_WORKGROUP_SIZE),
-        ("backstop", slayer::gpu::BACKSTOP_WORKGROUP_SIZE),
-        ("moving_entries", slayer::gpu::ENTRIES_WORKGROUP_SIZE),
-        ("longest_move", slayer::gpu::GATE_WORKGROUP_SIZE),
-        ("sample_gate", slayer::gpu::GATE_WORKGROUP_SIZE),
-    ] {
+    let named = [
+        ("brush_frame", slayer::abi::FRAME_WORKGROUP_SIZE),
+        ("apply_moves", slayer::abi::APPLY_WORKGROUP_SIZE),
+        ("proximity", slayer::abi::PROXIMITY_WORKGROUP_SIZE),
+        ("backstop", slayer::abi::BACKSTOP_WORKGROUP_SIZE),
+        ("moving_entries", slayer::abi::ENTRIES_WORKGROUP_SIZE),
+        ("longest_move", slayer::abi::GATE_WORKGROUP_SIZE),
+        ("sample_gate", slayer::abi::GATE_WORKGROUP_SIZE),
+    ];
+    for (kernel, host) in named {
         assert_eq!(
             naga_u32_constant(kernel, "WORKGROUP_SIZE"),
             host,
             "{kernel}"
         );
+    }
+    // Every other kernel but `dispatch_args` (one invocation) runs the common size, in whose
+    // workgroups the CPU mirrors walk the invocations.
+    for (kernel, _) in KERNELS {
+        if named.iter().any(|(k, _)| k == kernel)
+            || ["scan", "scan_add", "dispatch_args"].contains(kernel)
+        {
+            continue;
+        }
+        let size = naga_u32_constant(kernel, "WORKGROUP_SIZE");
+        assert_eq!(size, slayer::abi::WORKGROUP_SIZE, "{kernel}");
     }
 }
 
@@ -740,11 +771,11 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
             .find(|(k, _)| k == kernel)
             .map_or(0, |&(_, g)| g);
         let expected: Vec<(u32, u32)> = (1..=groups)
-            .flat_map(|g| (0..slayer::gpu::PAGE_COUNT as u32).map(move |b| (g, b)))
+            .flat_map(|g| (0..slayer::abi::PAGE_COUNT as u32).map(move |b| (g, b)))
             .collect();
         assert_eq!(pages, expected, "{kernel}: page bindings");
         if groups > 0 {
-            assert_eq!(overrides, [slayer::gpu::PAGE_SHIFT_CONSTANT], "{kernel}");
+            assert_eq!(overrides, [slayer::abi::PAGE_SHIFT_CONSTANT], "{kernel}");
         } else {
             assert!(overrides.is_empty(), "{kernel}: {overrides:?}");
         }

@@ -91,7 +91,7 @@ fn position(v: u32) -> vec3<f32> {
 
 // Whether the triangle abc touches the entry's exclusion ring. One pass without an early exit:
 // a `return` inside this loop, inlined into the face loop, made Mesa 22.3's lavapipe skip
-// later faces (tests/gpu_parity.rs, folded sheet).
+// later faces (tests/gpu_parity/proximity.rs, folded sheet).
 fn touches_ring(entry: MovingVertex, a: u32, b: u32, c: u32) -> bool {
     var touches = false;
     for (var r = entry.ring_start; r < entry.ring_end; r++) {

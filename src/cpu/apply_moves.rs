@@ -3,8 +3,7 @@
 use super::shared::{invocations, packed_position};
 use glam::Vec3;
 
-use super::proximity::PULL_SCALE;
-use crate::gpu::{ApplyMode, ApplyParams, MovingVertex};
+use crate::abi::{ApplyMode, ApplyParams, MovingVertex, PULL_SCALE};
 use crate::mesh::INVALID;
 
 /// What the kernel binds besides its parameters.

@@ -8,12 +8,9 @@
 use glam::{IVec3, UVec3, Vec3};
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::{BackstopParams, MovingVertex};
+use crate::abi::{BACKSTOP_MARGIN, BackstopParams, MovingVertex};
 use crate::grid::{cell_coordinates, hash_cell};
 use crate::mesh::INVALID;
-
-/// Share of a pair's size below which a separation is not trusted (`MARGIN` of the shader).
-pub const BACKSTOP_MARGIN: f32 = 1.0 / 4096.0;
 
 /// What the kernel binds besides its parameters and output.
 pub struct BackstopInputs<'a> {

@@ -5,18 +5,15 @@
 
 use glam::Vec3;
 
-use super::shared::{WORKGROUP_SIZE, invocations};
-use crate::gpu::{FrameParams, SelectedVertex};
+use super::shared::invocations;
+use crate::abi::{
+    FRAME_NORMAL_FROM_SUMS, FRAME_PLANE_FROM_SUMS, FrameParams, FrameSums, SelectedVertex,
+    WORKGROUP_SIZE,
+};
 
-/// Words of `brush_frame`'s output: seven three-word sums (weight · normal x, y, z; weight ·
-/// offset from the centre over the radius x, y, z; weight) and three spare.
-pub const FRAME_SUM_WORDS: usize = 24;
 const FRAME_SUMS: usize = 7;
 const FIXED_WORD: f32 = 4294967296.0;
 const FIXED_LIMIT: f32 = 2147483520.0;
-
-/// `brush_frame`'s output.
-pub type FrameSums = [u32; FRAME_SUM_WORDS];
 
 /// A 96-bit two's-complement fixed-point number with 64 fraction bits: (low, middle, high
 /// word).
@@ -125,10 +122,6 @@ pub fn brush_frame(params: &FrameParams, inputs: &FrameInputs<'_>, sums: &mut Fr
         }
     }
 }
-
-/// Which parts of the dab's frame `deform` takes from the sums (`DeformParams::frame`).
-pub const FRAME_PLANE_FROM_SUMS: u32 = 1;
-pub const FRAME_NORMAL_FROM_SUMS: u32 = 2;
 
 /// `resolve_frame` of `wgsl/deform.wgsl`: the normal and plane point of a dab about `center`
 /// of `radius`, from the sums as `flags` says, else `normal` and `plane_point` as given.

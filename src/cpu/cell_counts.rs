@@ -3,7 +3,7 @@
 //! arbitrary and only the bucket's set is comparable.
 
 use super::shared::invocations;
-use crate::gpu::CountParams;
+use crate::abi::CountParams;
 use crate::mesh::{INVALID, VertexFlags};
 
 /// `counts[keys[i]] += 1` for every live vertex `i`, and `ranks[i]` = its count before that.

@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/cell_keys.wgsl`.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::CellKeyParams;
+use crate::abi::CellKeyParams;
 use crate::grid::{cell_coordinates, hash_cell};
 
 /// `keys[i]` = hash-table slot of the cell of `positions[i]`.

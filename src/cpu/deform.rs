@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::brush_frame::frame_from_sums;
 use super::shared::invocations;
-use crate::gpu::{DeformParams, SelectedVertex};
+use crate::abi::{DeformParams, FrameSums, SelectedVertex};
 
 const DRAW_RATE: f32 = 0.1;
 const PINCH_RATE: f32 = 0.25;
@@ -20,7 +20,7 @@ pub struct DeformInputs<'a> {
     pub neighbour_rows: &'a [u32],
     pub neighbours: &'a [u32],
     /// `brush_frame`'s sums, read where `DeformParams::frame` asks.
-    pub frame_sums: &'a crate::cpu::FrameSums,
+    pub frame_sums: &'a FrameSums,
 }
 
 fn ring_centroid(inputs: &DeformInputs<'_>, v: u32, p: Vec3) -> Vec3 {

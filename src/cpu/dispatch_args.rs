@@ -1,6 +1,6 @@
 //! Mirror of `wgsl/dispatch_args.wgsl`.
 
-use crate::gpu::DispatchParams;
+use crate::abi::DispatchParams;
 
 /// `[x, y, z]` workgroup counts covering `min(count, capacity) · per_item` invocations.
 pub fn dispatch_args(params: &DispatchParams, count: u32, args: &mut [u32; 3]) {

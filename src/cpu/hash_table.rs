@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::{
     OverlaySlots, cell_counts, cell_keys, overlay_entries, overlay_keys, scan, scan_add, scatter,
 };
-use crate::gpu::{CellKeyParams, CountParams, CsrTable, OverlayParams, SCAN_BLOCK};
+use crate::abi::{CellKeyParams, CountParams, CsrTable, OverlayParams, SCAN_BLOCK};
 
 /// Exclusive prefix sum in place, by the same levels of blocks as `record_exclusive_scan`.
 pub fn exclusive_scan(values: &mut [u32]) {

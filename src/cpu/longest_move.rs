@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/longest_move.wgsl`: a sample's longest move, as f32 bits in the gate status.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::{GateParams, GateStatus, SelectedVertex};
+use crate::abi::{GateParams, GateStatus, SelectedVertex};
 
 /// Over the first `min(selection_count, params.capacity)` entries of `selected`: the largest
 /// distance from the vertex's position in `positions` to its target in `targets` (both packed

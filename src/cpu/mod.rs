@@ -3,6 +3,9 @@
 //! guards) so the two read side by side;
 //! they are the reference every GPU result is compared with. `hash_table` chains the hash-build
 //! mirrors as the GPU host code chains the kernels.
+//!
+//! The mirrors speak the kernels' language through [`crate::abi`] alone: nothing here reads
+//! the GPU path or the pipeline, so either can change without the reference moving.
 
 mod apply_moves;
 mod backstop;
@@ -28,12 +31,16 @@ mod select;
 mod shared;
 mod vertex_normals;
 
-pub use apply_moves::{ApplyBuffers, apply_moves};
-pub use backstop::{BACKSTOP_MARGIN, BackstopInputs, backstop};
-pub use brush_frame::{
-    FRAME_NORMAL_FROM_SUMS, FRAME_PLANE_FROM_SUMS, FRAME_SUM_WORDS, FrameInputs, FrameSums,
-    brush_frame, frame_from_sums, from_fixed, to_fixed,
+// The constants the mirrors share with the kernels live in `crate::abi`; they stay reachable
+// here under the names the pipeline and the tests have always used.
+pub use crate::abi::{
+    BACKSTOP_MARGIN, FRAME_NORMAL_FROM_SUMS, FRAME_PLANE_FROM_SUMS, FRAME_SUM_WORDS, FrameSums,
+    PULL_SCALE,
 };
+
+pub use apply_moves::{ApplyBuffers, apply_moves};
+pub use backstop::{BackstopInputs, backstop};
+pub use brush_frame::{FrameInputs, brush_frame, frame_from_sums, from_fixed, to_fixed};
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;
 pub use deform::{DeformInputs, deform};
@@ -46,7 +53,7 @@ pub use moving_entries::{EntryInputs, EntryOutputs, moving_entries};
 pub use overlay_entries::overlay_entries;
 pub use overlay_keys::overlay_keys;
 pub use overlay_members::{OverlaySlots, overlay_members};
-pub use proximity::{PULL_SCALE, ProximityInputs, proximity};
+pub use proximity::{ProximityInputs, proximity};
 pub use sample_gate::{GateState, sample_gate};
 pub use scan::scan;
 pub use scan_add::scan_add;

@@ -2,7 +2,7 @@
 //! vertices a sample moved.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::{GateStatus, MovingVertex, NormalParams};
+use crate::abi::{GateStatus, MovingVertex, NormalParams};
 use crate::mesh::INVALID;
 
 /// Over the first `params.count` slots of `moving`: for each entry whose vertex is away from

@@ -3,7 +3,7 @@
 
 use super::shared::{invocations, packed_position};
 use super::vertex_normals::{vertex_normal, write_normal};
-use crate::gpu::{MovingVertex, NormalParams};
+use crate::abi::{MovingVertex, NormalParams};
 use crate::mesh::INVALID;
 
 /// Over the first `params.count` slots of `moving`: for each entry whose vertex is away from its

@@ -2,7 +2,7 @@
 //! selection list, each ring grown breadth first over the packed topology's rows.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::{EntryParams, MovingVertex, SelectedVertex};
+use crate::abi::{EntryParams, MovingVertex, SelectedVertex};
 use crate::mesh::INVALID;
 
 /// What the kernel reads besides its parameters.
@@ -12,7 +12,7 @@ pub struct EntryInputs<'a> {
     pub layers: &'a [u32],
     pub selected: &'a [SelectedVertex],
     pub selection_count: u32,
-    /// Packed topology words (`crate::gpu::PackedTopology`).
+    /// Packed topology words (the GPU path's `PackedTopology`).
     pub topology: &'a [u32],
 }
 

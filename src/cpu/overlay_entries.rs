@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/overlay_entries.wgsl`.
 
 use super::shared::invocations;
-use crate::gpu::OverlayParams;
+use crate::abi::OverlayParams;
 
 /// Each filed entry (the first `offsets[table_mask + 1]`, within `params.count`) turned from
 /// a slot into that slot's member.

@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/overlay_keys.wgsl`.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::OverlayParams;
+use crate::abi::OverlayParams;
 use crate::grid::{cell_coordinates, hash_cell};
 use crate::mesh::VertexFlags;
 

@@ -2,7 +2,7 @@
 //! where they now are.
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::{MovingVertex, OverlayParams};
+use crate::abi::{MovingVertex, OverlayParams};
 use crate::mesh::INVALID;
 
 /// The overlay's slots as `overlay_members` and `overlay_keys` read and write them.

@@ -7,15 +7,12 @@
 use glam::{UVec3, Vec3};
 
 use super::shared::{invocations, packed_position};
+use crate::abi::{CLAMP_SLACK, MovingVertex, PULL_SCALE, ProximityParams};
 use crate::geom::closest_point_on_triangle;
-use crate::gpu::{MovingVertex, ProximityParams};
 use crate::grid::{cell_coordinates, hash_cell};
 use crate::mesh::INVALID;
-use crate::pipeline::step::CLAMP_SLACK;
 
 const CLAMP_ROUNDS: u32 = 16;
-/// Bisection fractions are multiples of 1 / PULL_SCALE.
-pub const PULL_SCALE: f32 = 65536.0;
 /// What the kernel binds besides its parameters and output.
 pub struct ProximityInputs<'a> {
     /// Current packed x, y, z triples.

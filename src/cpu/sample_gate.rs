@@ -2,7 +2,7 @@
 //! per call as the host records them.
 
 use super::shared::invocations;
-use crate::gpu::{GateParams, GateStage, GateStatus, MovingVertex};
+use crate::abi::{GateParams, GateStage, GateStatus, MovingVertex};
 use crate::mesh::INVALID;
 
 /// The buffers `sample_gate` writes.

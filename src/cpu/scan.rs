@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/scan.wgsl`: per block of `SCAN_BLOCK` values, an exclusive prefix sum in
 //! place and the block's total in `block_sums`, by the same Hillis–Steele rounds.
 
-use crate::gpu::{CountParams, SCAN_BLOCK};
+use crate::abi::{CountParams, SCAN_BLOCK};
 
 pub fn scan(params: &CountParams, values: &mut [u32], block_sums: &mut [u32]) {
     let block_size = SCAN_BLOCK as usize;

@@ -1,6 +1,6 @@
 //! Mirror of `wgsl/scan_add.wgsl`.
 
-use crate::gpu::{CountParams, SCAN_BLOCK};
+use crate::abi::{CountParams, SCAN_BLOCK};
 
 /// Adds `block_offsets[b]` to every value of block `b`.
 pub fn scan_add(params: &CountParams, values: &mut [u32], block_offsets: &[u32]) {

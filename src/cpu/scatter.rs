@@ -1,7 +1,7 @@
 //! Mirror of `wgsl/scatter.wgsl`.
 
 use super::shared::invocations;
-use crate::gpu::CountParams;
+use crate::abi::CountParams;
 use crate::mesh::INVALID;
 
 /// `entries[offsets[keys[i]] + ranks[i]] = i` for every vertex with a rank.

@@ -5,7 +5,7 @@
 use glam::{IVec3, UVec3, Vec3};
 
 use super::shared::{falloff_weight, invocations, packed_position};
-use crate::gpu::{SelectParams, SelectedVertex};
+use crate::abi::{SelectParams, SelectedVertex};
 use crate::grid::{cell_coordinates, hash_cell};
 use crate::mesh::VertexFlags;
 

@@ -1,7 +1,9 @@
 //! Mirrors of the functions in `wgsl/shared/` that the grid module does not already provide
 //! (`cell_of` and `hash_cell` are `crate::grid::cell_coordinates` and `crate::grid::hash_cell`).
 
-/// `falloff_weight` of `wgsl/shared/brush.wgsl`: the codes of `crate::gpu::falloff_code`, and
+use crate::abi::WORKGROUP_SIZE;
+
+/// `falloff_weight` of `wgsl/shared/brush.wgsl`: the codes of `crate::abi::falloff_code`, and
 /// blend's powers as repeated products in the shader's order (so the mirror may differ from
 /// `Falloff::weight`'s `powi` by a few ulps).
 pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
@@ -30,9 +32,6 @@ pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
     }
 }
 
-/// Workgroup size of the one-dimensional kernels.
-pub const WORKGROUP_SIZE: u32 = 64;
-
 /// The invocation indices a dispatch over `count` items runs, workgroup by workgroup as the GPU
 /// numbers them (`flat_index` in `wgsl/shared/grid.wgsl`), without those past `count` that
 /// return at the kernel's first guard.
@@ -53,8 +52,8 @@ pub fn packed_position(positions: &[f32], v: u32) -> glam::Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::abi::falloff_code;
     use crate::brush::Falloff;
-    use crate::gpu::falloff_code;
 
     #[test]
     fn falloff_mirror_matches_the_brush_falloff() {

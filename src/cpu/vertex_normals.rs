@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use super::shared::{invocations, packed_position};
-use crate::gpu::NormalParams;
+use crate::abi::NormalParams;
 
 /// Writes the normal of each of the first `params.count` `vertices` into `normals` (packed
 /// x, y, z per mesh vertex).

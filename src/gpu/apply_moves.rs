@@ -3,9 +3,8 @@
 
 use glam::Vec3;
 
-use super::{ApplyMode, ApplyParams, GpuContext, GpuError, MovingVertex};
-
-pub const APPLY_WORKGROUP_SIZE: u32 = 64;
+use super::{GpuContext, GpuError};
+use crate::abi::{APPLY_WORKGROUP_SIZE, ApplyMode, ApplyParams, MovingVertex};
 
 /// What `apply_moves` binds besides its parameters.
 pub struct ApplyMovesBuffers<'a> {

@@ -7,12 +7,11 @@
 use glam::Vec3;
 
 use super::{
-    BackstopParams, GpuContext, GpuError, MovingVertex, PackedTopology, Workgroups,
-    cells_per_entry, moving_vertices, table_size_for,
+    GpuContext, GpuError, PackedTopology, Workgroups, cells_per_entry, moving_vertices,
+    table_size_for,
 };
+use crate::abi::{BACKSTOP_WORKGROUP_SIZE, BackstopParams, MovingVertex};
 use crate::mesh::Mesh;
-
-pub const BACKSTOP_WORKGROUP_SIZE: u32 = 64;
 
 /// Margin on the reaches, as the proximity kernel's: rounding never drops a candidate.
 const REACH_SLACK: f32 = 1.01;

@@ -4,10 +4,8 @@
 
 use glam::Vec3;
 
-use super::{FrameParams, GpuContext, GpuError, SelectedVertex, SelectionBuffers, Workgroups};
-use crate::cpu::{FRAME_SUM_WORDS, FrameSums};
-
-pub const FRAME_WORKGROUP_SIZE: u32 = 64;
+use super::{GpuContext, GpuError, SelectionBuffers, Workgroups};
+use crate::abi::{FRAME_SUM_WORDS, FRAME_WORKGROUP_SIZE, FrameParams, FrameSums, SelectedVertex};
 
 pub fn frame_params(center: Vec3, radius: f32, capacity: usize) -> FrameParams {
     FrameParams {

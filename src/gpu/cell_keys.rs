@@ -2,10 +2,8 @@
 
 use glam::Vec3;
 
-use super::{CellKeyParams, GpuContext, GpuError};
-
-/// Workgroup size declared in the shader.
-const WORKGROUP_SIZE: u32 = 64;
+use super::{GpuContext, GpuError};
+use crate::abi::{CellKeyParams, WORKGROUP_SIZE};
 
 /// Records the pass writing `keys[i]`, the hash-table slot of the cell of vertex `i`, for the
 /// first `count` packed positions.

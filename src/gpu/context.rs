@@ -247,7 +247,7 @@ impl GpuContext {
     /// compiled on first use and kept. Kernels with a paged array (`shared/pages`) are
     /// compiled for the page size the limits give now, and kept per page size.
     pub fn compute_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
-        let key = format!("{name}@{}", self.page_shift());
+        let key = format!("{name}@{}", super::limits::page_shift(&self.limits));
         let cached = self
             .pipelines
             .lock()
@@ -265,8 +265,9 @@ impl GpuContext {
 
     fn compile_pipeline(&self, name: &str) -> Result<wgpu::ComputePipeline, GpuError> {
         let source = super::shaders::kernel_source(name)?;
-        let page_shift = [(super::pages::PAGE_SHIFT_CONSTANT, self.page_shift() as f64)];
-        let constants: &[(&str, f64)] = if source.contains(super::pages::PAGE_SHIFT_CONSTANT) {
+        let shift = super::limits::page_shift(&self.limits) as f64;
+        let page_shift = [(crate::abi::PAGE_SHIFT_CONSTANT, shift)];
+        let constants: &[(&str, f64)] = if source.contains(crate::abi::PAGE_SHIFT_CONSTANT) {
             &page_shift
         } else {
             &[]
@@ -510,7 +511,10 @@ impl GpuContext {
         let pages: Vec<wgpu::BindGroup> = paged
             .iter()
             .enumerate()
-            .map(|(k, buffer)| self.page_bind_group(pipeline, k as u32 + 1, label, buffer))
+            .map(|(k, buffer)| {
+                let device = (&self.device, &self.limits);
+                super::limits::page_bind_group(device, pipeline, k as u32 + 1, label, buffer)
+            })
             .collect();
         let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
             .iter()

@@ -2,32 +2,16 @@
 
 use glam::Vec3;
 
-use super::brush_frame::{
-    FRAME_WORKGROUP_SIZE, frame_params, frame_sums_buffer, record_brush_frame,
-};
+use super::brush_frame::{frame_params, frame_sums_buffer, record_brush_frame};
 use super::reusable::Patches;
 use super::rows::SlottedRows;
-use super::{DeformParams, GpuContext, GpuError, SelectedVertex, SelectionBuffers, Workgroups};
-use crate::brush::{BrushKind, Dab};
+use super::{GpuContext, GpuError, SelectionBuffers, Workgroups};
+use crate::abi::{
+    DeformParams, FRAME_SUM_WORDS, FRAME_WORKGROUP_SIZE, FrameSums, SelectedVertex, WORKGROUP_SIZE,
+    brush_code,
+};
+use crate::brush::Dab;
 use crate::mesh::{INVALID, Mesh, next};
-
-const WORKGROUP_SIZE: u32 = 64;
-
-/// The `BRUSH_*` code of `wgsl/shared/brush.wgsl`.
-pub fn brush_code(kind: BrushKind) -> u32 {
-    match kind {
-        BrushKind::Draw => 0,
-        BrushKind::Inflate => 1,
-        BrushKind::Deflate => 2,
-        BrushKind::Grab => 3,
-        BrushKind::Smooth => 4,
-        BrushKind::Flatten => 5,
-        BrushKind::Pinch => 6,
-        BrushKind::Crease => 7,
-        BrushKind::Twist => 8,
-        BrushKind::Paint => 9,
-    }
-}
 
 pub fn deform_params(dab: &Dab, capacity: usize) -> DeformParams {
     let frame = &dab.frame;
@@ -162,7 +146,7 @@ pub fn run_deform(
     Ok(run_framed_deform(gpu, mesh, dab, selection, 0)?.1)
 }
 
-/// [`run_deform`] with the frame parts `frame` names (`crate::cpu::FRAME_*`) taken from
+/// [`run_deform`] with the frame parts `frame` names (`crate::abi::FRAME_*`) taken from
 /// `brush_frame`'s sums over the selection, in the same submission as the GPU backend runs
 /// them; also returns the sums.
 pub fn run_framed_deform(
@@ -171,7 +155,7 @@ pub fn run_framed_deform(
     dab: &Dab,
     selection: &[SelectedVertex],
     frame: u32,
-) -> Result<(crate::cpu::FrameSums, Vec<Vec3>), GpuError> {
+) -> Result<(FrameSums, Vec<Vec3>), GpuError> {
     gpu.check_binding::<Vec3>("vertex positions", mesh.vertex_count())?;
     let neighbours = smoothing_neighbours(mesh, mesh.vertex_count());
     gpu.check_paged("smoothing neighbours", neighbours.words.len())?;
@@ -217,7 +201,7 @@ pub fn run_framed_deform(
         &targets,
     )?;
     gpu.queue.submit([encoder.finish()]);
-    let words = gpu.read_buffer::<u32>(&sums, crate::cpu::FRAME_SUM_WORDS)?;
+    let words = gpu.read_buffer::<u32>(&sums, FRAME_SUM_WORDS)?;
     let targets = gpu.read_buffer(&targets, selection.len())?;
     Ok((words.try_into().expect("the sums' words"), targets))
 }

@@ -1,6 +1,7 @@
 //! Host side of `wgsl/dispatch_args.wgsl`: indirect dispatch arguments from a GPU-side count.
 
-use super::{DispatchParams, GpuContext, GpuError};
+use super::{GpuContext, GpuError};
+use crate::abi::DispatchParams;
 
 /// A buffer of three `u32` workgroup counts usable by `dispatch_workgroups_indirect`.
 pub fn indirect_args_buffer(gpu: &GpuContext, label: &str) -> wgpu::Buffer {

@@ -6,13 +6,11 @@
 use glam::Vec3;
 
 use super::vertex_normals::MovedPass;
-use super::{
-    GateParams, GateStage, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
+use super::{GpuContext, GpuError};
+use crate::abi::{
+    GATE_WORKGROUP_SIZE, GateParams, GateStage, GateStatus, MovingVertex, SelectedVertex,
 };
 use crate::mesh::Mesh;
-
-/// Workgroup size of `longest_move` and `sample_gate` (`moved_edges` runs as `moved_normals`).
-pub const GATE_WORKGROUP_SIZE: u32 = 64;
 
 /// What the gate reads and writes.
 pub struct GateBuffers<'a> {

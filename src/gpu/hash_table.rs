@@ -13,41 +13,8 @@
 use glam::Vec3;
 
 use super::scan::record_exclusive_scan;
-use super::{CountParams, GpuContext, GpuError, record_cell_keys};
-
-/// Workgroup size of `cell_counts` and `scatter`.
-const WORKGROUP_SIZE: u32 = 64;
-
-/// A CSR hash table read back to the CPU (or built by the CPU mirrors).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct CsrTable {
-    /// `table_size + 1` bucket starts; the last is the number of filed vertices.
-    pub offsets: Vec<u32>,
-    /// Vertex ids, bucket by bucket.
-    pub entries: Vec<u32>,
-}
-
-impl CsrTable {
-    pub fn table_size(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
-    }
-
-    /// The vertices filed in bucket `bucket`, in table order.
-    pub fn bucket(&self, bucket: u32) -> &[u32] {
-        let b = bucket as usize;
-        &self.entries[self.offsets[b] as usize..self.offsets[b + 1] as usize]
-    }
-
-    /// The same table with each bucket sorted by vertex id, so that tables built in different
-    /// atomic orders compare equal.
-    pub fn canonical(mut self) -> Self {
-        for b in 0..self.table_size() {
-            let (start, end) = (self.offsets[b] as usize, self.offsets[b + 1] as usize);
-            self.entries[start..end].sort_unstable();
-        }
-        self
-    }
-}
+use super::{GpuContext, GpuError, record_cell_keys};
+use crate::abi::{CountParams, CsrTable, WORKGROUP_SIZE};
 
 /// Buckets for `vertices` vertices, as [`crate::grid::SpatialHash`] sizes its table: a power
 /// of two, at least twice the count and at least 1024.

@@ -11,7 +11,7 @@ mod dispatch_args;
 mod gate;
 mod hash_table;
 mod kernels;
-mod layout;
+mod limits;
 mod moving_entries;
 mod options;
 mod overlay;
@@ -26,41 +26,42 @@ mod topology;
 mod vertex_normals;
 mod vertices;
 
-pub use apply_moves::{
-    APPLY_WORKGROUP_SIZE, AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves,
+// The kernels' structs and constants live in `crate::abi`, shared with the CPU mirrors; they
+// stay reachable here under the names the host code has always used.
+pub use crate::abi::{
+    APPLY_WORKGROUP_SIZE, ApplyMode, ApplyParams, BACKSTOP_WORKGROUP_SIZE, BackstopParams,
+    BrushSphere, CellKeyParams, CountParams, CsrTable, DeformParams, DispatchParams,
+    ENTRIES_WORKGROUP_SIZE, EntryParams, FACE_WORDS, FRAME_WORKGROUP_SIZE, FrameParams,
+    GATE_WORKGROUP_SIZE, GateParams, GateStage, GateStatus, MovingVertex, NormalParams,
+    OverlayParams, PAGE_COUNT, PAGE_SHIFT_CONSTANT, PROXIMITY_WORKGROUP_SIZE, ProximityParams,
+    PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
 };
+
+pub use apply_moves::{AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves};
 pub use backstop::{
-    BACKSTOP_WORKGROUP_SIZE, BackstopBuffers, BackstopQuery, PAIRS_GUESS, UndecidedPairs,
-    backstop_inputs, backstop_params, backstop_query_params, check_backstop_invocations,
-    moved_edge_bound, record_backstop, run_backstop,
+    BackstopBuffers, BackstopQuery, PAIRS_GUESS, UndecidedPairs, backstop_inputs, backstop_params,
+    backstop_query_params, check_backstop_invocations, moved_edge_bound, record_backstop,
+    run_backstop,
 };
-pub use brush_frame::{
-    FRAME_WORKGROUP_SIZE, frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame,
-};
+pub use brush_frame::{frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, Workgroups, list_adapters};
 pub use deform::{
-    DeformBuffers, SmoothingNeighbours, brush_code, deform_params, record_deform, run_deform,
+    DeformBuffers, SmoothingNeighbours, deform_params, record_deform, run_deform,
     run_framed_deform, smoothing_neighbours,
 };
 pub use dispatch_args::{indirect_args_buffer, record_dispatch_args, run_dispatch_args};
 pub use gate::{
-    GATE_WORKGROUP_SIZE, GateBuffers, record_gate_check, record_gate_open, record_gate_vacate,
-    record_moved_edges, run_longest_move, run_moved_edges, run_sample_gate,
+    GateBuffers, record_gate_check, record_gate_open, record_gate_vacate, record_moved_edges,
+    run_longest_move, run_moved_edges, run_sample_gate,
 };
 pub use hash_table::{
-    CsrTable, GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter,
-    table_size_for,
+    GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
 pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
-pub use layout::{
-    ApplyMode, ApplyParams, BackstopParams, CellKeyParams, CountParams, DeformParams,
-    DispatchParams, EntryParams, FrameParams, GateParams, GateStage, GateStatus, MovingVertex,
-    NormalParams, OverlayParams, ProximityParams, PulledVertex, SelectParams, SelectedVertex,
-};
 pub use moving_entries::{
-    BuiltEntries, BuiltEntryBuffers, ENTRIES_WORKGROUP_SIZE, EntryBuffers, RING_STRIDE,
-    entry_params, record_moving_entries, ring_bytes, run_moving_entries,
+    BuiltEntries, BuiltEntryBuffers, EntryBuffers, RING_STRIDE, entry_params,
+    record_moving_entries, ring_bytes, run_moving_entries,
 };
 pub use options::{DEFAULT_GPU_BUDGET_MIB, GpuOptions};
 pub use overlay::{
@@ -68,19 +69,17 @@ pub use overlay::{
     overlay_table_sized, record_overlay_members, record_overlay_table, run_overlay_members,
     run_overlay_table,
 };
-pub use pages::{PAGE_COUNT, PAGE_SHIFT_CONSTANT};
 pub use proximity::{
-    PROXIMITY_WORKGROUP_SIZE, ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations,
-    moving_vertices, pass_params, proximity_params, proximity_reaches, record_proximity,
-    run_proximity, verdicts,
+    ProximityBuffers, ProximityQuery, cells_per_entry, check_invocations, moving_vertices,
+    pass_params, proximity_params, proximity_reaches, record_proximity, run_proximity, verdicts,
 };
 pub use rows::SlottedRows;
-pub use scan::{SCAN_BLOCK, record_exclusive_scan, run_exclusive_scan};
+pub use scan::{record_exclusive_scan, run_exclusive_scan};
 pub use select::{
-    BrushSphere, GpuSelection, HashedVertices, SELECTION_GUESS, SelectionBuffers, SelectionRead,
-    falloff_code, record_select, run_select, run_select_with_overlay, select_params,
+    GpuSelection, HashedVertices, SELECTION_GUESS, SelectionBuffers, SelectionRead, record_select,
+    run_select, run_select_with_overlay, select_params,
 };
-pub use topology::{FACE_WORDS, PackedTopology, TopologyLayout};
+pub use topology::{PackedTopology, TopologyLayout};
 pub use vertex_normals::{
     record_moved_normals, record_vertex_normals, run_moved_normals, run_vertex_normals,
 };

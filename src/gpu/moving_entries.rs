@@ -3,10 +3,9 @@
 
 use glam::Vec3;
 
-use super::{EntryParams, GpuContext, GpuError, MovingVertex, PackedTopology, SelectedVertex};
+use super::{GpuContext, GpuError, PackedTopology};
+use crate::abi::{ENTRIES_WORKGROUP_SIZE, EntryParams, MovingVertex, SelectedVertex};
 use crate::mesh::Mesh;
-
-pub const ENTRIES_WORKGROUP_SIZE: u32 = 64;
 
 /// Words of room per entry for its exclusion ring. A ring of three on a mesh of valence six
 /// holds 37 vertices, of four (the largest `exclusion_ring` gives) 61; a ring past the room is

@@ -18,7 +18,8 @@ use glam::Vec3;
 
 use super::hash_table::{read_table, record_counting_sort};
 use super::reusable::ReusableBuffer;
-use super::{CsrTable, GpuContext, GpuError, MovingVertex, OverlayParams, table_size_for};
+use super::{GpuContext, GpuError, table_size_for};
+use crate::abi::{CsrTable, MovingVertex, OverlayParams, WORKGROUP_SIZE};
 use crate::cpu::OverlaySlots;
 
 /// Vertices the overlay holds before the main table is rebuilt instead: a sixteenth of the
@@ -102,9 +103,6 @@ pub struct OverlayBuffers<'a> {
     /// Per vertex: nonzero for members.
     pub marks: &'a wgpu::Buffer,
 }
-
-/// Workgroup size of the overlay kernels.
-const OVERLAY_WORKGROUP_SIZE: u32 = 64;
 
 /// The overlay's slots on the GPU (see `wgsl/shared/overlay.wgsl`): the members, their count,
 /// and the rebuild's scratch (a key, a flag word and a rank per slot).
@@ -208,7 +206,7 @@ pub fn record_overlay_members(
             filed.filed_at,
         ],
         moving_slots,
-        OVERLAY_WORKGROUP_SIZE,
+        WORKGROUP_SIZE,
     );
     Ok(())
 }
@@ -241,7 +239,7 @@ pub fn record_overlay_table(
             slots.flags.buffer(),
         ],
         slots.room,
-        OVERLAY_WORKGROUP_SIZE,
+        WORKGROUP_SIZE,
     );
     // The counts start from nothing.
     encoder.clear_buffer(table.offsets, 0, None);
@@ -269,7 +267,7 @@ pub fn record_overlay_table(
             table.entries,
         ],
         slots.room,
-        OVERLAY_WORKGROUP_SIZE,
+        WORKGROUP_SIZE,
     );
     Ok(())
 }

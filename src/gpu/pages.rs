@@ -14,37 +14,20 @@
 //! `TooLarge` and the strokes run on the CPU.
 
 use super::context::check_fits;
+use super::limits::{WORD, page_bytes, page_shift};
 use super::{GpuContext, GpuError};
-
-/// Bindings a paged array may span (the kernel declares this many in bind group 1).
-pub const PAGE_COUNT: u64 = 4;
-
-/// The pipeline-overridable constant in `wgsl/shared/pages.wgsl`.
-pub const PAGE_SHIFT_CONSTANT: &str = "PAGE_SHIFT";
-
-/// Every paged array is of 32-bit words.
-const WORD: u64 = 4;
-
-/// Pages never pass 2 GiB: four of them then hold 2³¹ words, all a `u32` index can reach in
-/// arrays whose indices are themselves words, and `PAGE_SHIFT` stays below 32.
-const MAX_PAGE_BYTES: u64 = 1 << 31;
+use crate::abi::PAGE_COUNT;
 
 impl GpuContext {
     /// Bytes in one page: the largest power of two one storage binding (and one buffer) may
     /// hold, and at least the offset alignment, so every page starts at a legal offset.
     pub fn page_bytes(&self) -> u64 {
-        let limit = self
-            .limits
-            .max_storage_buffer_binding_size
-            .min(self.limits.max_buffer_size)
-            .clamp(WORD, MAX_PAGE_BYTES);
-        let largest = 1u64 << (63 - limit.leading_zeros());
-        largest.max(self.limits.min_storage_buffer_offset_alignment as u64)
+        page_bytes(&self.limits)
     }
 
     /// log2 of the words in a page, as the kernels' `PAGE_SHIFT`.
     pub fn page_shift(&self) -> u32 {
-        (self.page_bytes() / WORD).trailing_zeros()
+        page_shift(&self.limits)
     }
 
     /// Pages `words` words span (at least one).
@@ -58,38 +41,5 @@ impl GpuContext {
         let bytes = words as u64 * WORD;
         let limit = (PAGE_COUNT * self.page_bytes()).min(self.limits.max_buffer_size);
         check_fits(what, bytes, limit)
-    }
-
-    /// Bind group `group` of `pipeline`: `buffer` page by page. Pages past the end of the
-    /// buffer bind its first page again (a binding must cover something; the kernel never
-    /// reads them).
-    pub(super) fn page_bind_group(
-        &self,
-        pipeline: &wgpu::ComputePipeline,
-        group: u32,
-        label: &str,
-        buffer: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        let page = self.page_bytes();
-        let size = buffer.size();
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = (0..PAGE_COUNT)
-            .map(|k| {
-                let start = if k * page < size { k * page } else { 0 };
-                let length = page.min(size - start);
-                wgpu::BindGroupEntry {
-                    binding: k as u32,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer,
-                        offset: start,
-                        size: wgpu::BufferSize::new(length),
-                    }),
-                }
-            })
-            .collect();
-        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(label),
-            layout: &pipeline.get_bind_group_layout(group),
-            entries: &entries,
-        })
     }
 }

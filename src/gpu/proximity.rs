@@ -10,14 +10,12 @@
 
 use glam::Vec3;
 
-use super::{
-    GpuContext, GpuError, MovingVertex, PackedTopology, ProximityParams, PulledVertex, Workgroups,
-    table_size_for,
+use super::{GpuContext, GpuError, PackedTopology, Workgroups, table_size_for};
+use crate::abi::{
+    MovingVertex, PROXIMITY_WORKGROUP_SIZE, PULL_SCALE, ProximityParams, PulledVertex,
 };
 use crate::collide::neighbourhood::ring_vertices;
 use crate::mesh::Mesh;
-
-pub const PROXIMITY_WORKGROUP_SIZE: u32 = 64;
 
 /// Margin on the broad phase's reaches so that rounding never drops a face exact arithmetic
 /// keeps; extra candidates cost time, never results.
@@ -94,7 +92,7 @@ pub fn verdicts(moving: &[MovingVertex], positions: &[f32], pulls: &[u32]) -> Ve
                 };
             }
             let start = Vec3::from_array(entry.start);
-            let t = (65536 - pull) as f32 / crate::cpu::PULL_SCALE;
+            let t = (65536 - pull) as f32 / PULL_SCALE;
             PulledVertex {
                 position: (start + (x - start) * t).to_array(),
                 pulled: 1,

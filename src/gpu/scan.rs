@@ -3,10 +3,8 @@
 //! sums are scanned the same way until one block remains, then added back level by level. A
 //! million values take three levels; nothing limits the length but the buffer size.
 
-use super::{CountParams, GpuContext, GpuError};
-
-/// Values per block: the workgroup size of both scan kernels.
-pub const SCAN_BLOCK: u32 = 256;
+use super::{GpuContext, GpuError};
+use crate::abi::{CountParams, SCAN_BLOCK};
 
 /// Records an exclusive scan of the first `count` u32s of `values`, in place.
 pub fn record_exclusive_scan(

@@ -5,34 +5,12 @@ use glam::Vec3;
 
 use super::overlay::{Filing, OverlayBuffers, TableBuffers, overlay_table};
 use super::reusable::ReusableBuffer;
-use super::{
-    GpuContext, GpuError, GpuHashTable, SelectParams, SelectedVertex, VertexBuffers, table_size_for,
-};
-use crate::brush::Falloff;
+use super::{GpuContext, GpuError, GpuHashTable, VertexBuffers, table_size_for};
+use crate::abi::{BrushSphere, SelectParams, SelectedVertex, WORKGROUP_SIZE, falloff_code};
 use crate::grid::cell_coordinates;
-
-const WORKGROUP_SIZE: u32 = 64;
 
 /// Entries read back with the count when nothing better is known.
 pub const SELECTION_GUESS: usize = 256;
-
-/// Where a brush is and how its effect fades: all selection needs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BrushSphere {
-    pub center: Vec3,
-    pub radius: f32,
-    pub falloff: Falloff,
-}
-
-/// `(FALLOFF_* code, blend exponent)` of a falloff, as `wgsl/shared/brush.wgsl` reads them.
-pub fn falloff_code(falloff: Falloff) -> (u32, u32) {
-    match falloff {
-        Falloff::Blend { n } => (0, n),
-        Falloff::Smooth => (1, 0),
-        Falloff::Sphere => (2, 0),
-        Falloff::Linear => (3, 0),
-    }
-}
 
 /// The kernel's parameters: one invocation per cell of the brush's box (grown by `drift`, how
 /// far any vertex has moved since the table was built), or per vertex when the box has more

@@ -13,10 +13,8 @@
 use super::reusable::Patches;
 use super::rows::SlottedRows;
 use super::{GpuContext, GpuError};
+use crate::abi::FACE_WORDS;
 use crate::mesh::{INVALID, Mesh};
-
-/// Words per face in the packed topology.
-pub const FACE_WORDS: usize = 4;
 
 /// Where everything lives in the packed topology; kept beside its buffer to patch it.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -5,10 +5,9 @@
 
 use glam::Vec3;
 
-use super::{GpuContext, GpuError, MovingVertex, NormalParams, PackedTopology, Workgroups};
+use super::{GpuContext, GpuError, PackedTopology, Workgroups};
+use crate::abi::{MovingVertex, NormalParams, WORKGROUP_SIZE};
 use crate::mesh::Mesh;
-
-const WORKGROUP_SIZE: u32 = 64;
 
 /// Records the pass rewriting the normals (packed x, y, z per vertex) of the first `count`
 /// entries of `vertices`, from `positions` and the packed topology (paged).

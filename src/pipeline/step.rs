@@ -101,7 +101,7 @@ pub fn longest_move(mesh: &Mesh, selection: &[(u32, f32)], targets: &[Vec3]) -> 
 /// changes it by rounding only; without the slack, whether such a vertex is stopped would
 /// depend on the last bits of the arithmetic, which differ between the CPU and a GPU (fused
 /// multiply-adds), and the stop moves it by a whole step. `wgsl/proximity.wgsl` has the same.
-pub const CLAMP_SLACK: f32 = 1.0 / 1024.0;
+pub use crate::abi::CLAMP_SLACK;
 
 /// Everything a step reads that lasts for the whole stroke.
 pub struct StrokeState<'a> {

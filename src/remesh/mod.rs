@@ -20,9 +20,8 @@ use serde::Serialize;
 use crate::collide::Stamps;
 use crate::collide::neighbourhood::ring_vertices;
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
-use crate::grid::SpatialHash;
+use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh, next, prev};
-use crate::pipeline::PipelineError;
 use reference::ReferenceSurface;
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
@@ -144,11 +143,9 @@ fn remesh(
     (report, changed)
 }
 
-/// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`).
-pub fn remesh_all(
-    mesh: &mut Mesh,
-    settings: &RemeshSettings,
-) -> Result<RemeshReport, PipelineError> {
+/// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`). Fails only where the
+/// grid does: a `target_edge` that is no positive finite length.
+pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshReport, GridError> {
     let mut grid = SpatialHash::build(mesh, settings.target_edge)?;
     let seeds: Vec<u32> = (0..mesh.vertex_count() as u32)
         .filter(|&v| {

@@ -1,7 +1,7 @@
 // Brushes on the GPU: falloff curves (as `src/brush/falloff.rs::Falloff::weight`), brush
 // kinds, and the selection list `select` writes and `deform` reads. Codes as
-// `src/gpu/select.rs::falloff_code` and `src/gpu/deform.rs::brush_code` write them
-// (tests/wgsl.rs checks the values).
+// `src/abi/brush.rs::falloff_code` and `brush_code` write them (tests/wgsl.rs checks the
+// values).
 
 // One entry of the compacted selection.
 struct SelectedVertex {

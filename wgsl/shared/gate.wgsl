@@ -4,7 +4,7 @@
 // were sized for, no edge longer than they were sized for — and the first sample where one fails stops the run there: its moves are
 // vacated before they are applied, and every later sample of the run selects nothing. The host
 // reads each sample's status back and takes the samples before the stop.
-// Codes as `src/gpu/layout.rs` writes them (tests/wgsl.rs checks the values).
+// Codes as `src/abi/gate.rs` writes them (tests/wgsl.rs checks the values).
 
 // Host struct: `GateParams`.
 struct GateParams {
