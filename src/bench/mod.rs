@@ -12,7 +12,9 @@ use serde::Serialize;
 use crate::brush::Stroke;
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
-use crate::pipeline::{BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, Uploads};
+use crate::pipeline::{
+    BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, StrokeReport, Uploads,
+};
 use crate::remesh::RemeshReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
@@ -107,6 +109,79 @@ pub struct SceneResult {
     pub gpu_backstop: Option<BackstopFilter>,
     /// GPU backends: the most GPU memory they held after any stroke.
     pub gpu_memory: Option<GpuMemory>,
+    /// GPU backends: submissions and blocking read-backs over the strokes, per sample, per
+    /// stroke and per `add_samples` call: what a stroke costs in round trips, whatever the
+    /// adapter's speed.
+    pub gpu_calls: Option<GpuCalls>,
+}
+
+/// Round trips to the GPU over a run of strokes (set-up before the first excluded).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct GpuCalls {
+    /// Samples given per `add_samples` call (`None`: each stroke's samples in one call, the
+    /// batch).
+    pub samples_per_call: Option<usize>,
+    pub calls: usize,
+    pub submissions: usize,
+    pub read_backs: usize,
+    pub submissions_per_sample: f64,
+    pub read_backs_per_sample: f64,
+    pub read_backs_per_stroke: f64,
+    pub read_backs_per_call: f64,
+    /// Samples and steps recorded in runs ahead that the GPU's gate stopped, and the share of
+    /// samples that is.
+    pub gate_stops: usize,
+    pub gate_stops_per_sample: f64,
+    /// Samples and steps taken from runs ahead.
+    pub samples_ahead: usize,
+    pub steps_ahead: usize,
+}
+
+impl GpuCalls {
+    /// The figures between two readings of a backend's uploads.
+    fn between(
+        before: Uploads,
+        after: Uploads,
+        (samples, strokes, calls): (usize, usize, usize),
+    ) -> GpuCalls {
+        let per = |count: usize, over: usize| count as f64 / over.max(1) as f64;
+        let read_backs = after.read_backs - before.read_backs;
+        let gate_stops = after.gated_ahead - before.gated_ahead;
+        GpuCalls {
+            samples_per_call: None,
+            calls,
+            submissions: after.submissions - before.submissions,
+            read_backs,
+            submissions_per_sample: per(after.submissions - before.submissions, samples),
+            read_backs_per_sample: per(read_backs, samples),
+            read_backs_per_stroke: per(read_backs, strokes),
+            read_backs_per_call: per(read_backs, calls),
+            gate_stops,
+            gate_stops_per_sample: per(gate_stops, samples),
+            samples_ahead: after.samples_ahead - before.samples_ahead,
+            steps_ahead: after.steps_ahead - before.steps_ahead,
+        }
+    }
+}
+
+/// Runs `stroke` on `mesh` as an app would feed it: `samples_per_call` samples per
+/// `add_samples` call (`None`: all of them in one call). Returns the stroke's report and the
+/// calls it took, `finish` included.
+pub fn feed_stroke(
+    pipeline: &mut Pipeline,
+    mesh: &mut Mesh,
+    stroke: &Stroke,
+    samples_per_call: Option<usize>,
+) -> Result<(StrokeReport, usize), PipelineError> {
+    let mut in_progress = pipeline.begin_stroke(mesh, stroke.settings())?;
+    let chunk = samples_per_call.unwrap_or(stroke.samples.len()).max(1);
+    // `finish` runs the last sample: a call too.
+    let mut calls = 1;
+    for samples in stroke.samples.chunks(chunk) {
+        in_progress.add_samples(samples)?;
+        calls += 1;
+    }
+    Ok((in_progress.finish()?, calls))
 }
 
 /// One row of the scaling run.
@@ -130,7 +205,7 @@ pub fn run_strokes(
     strokes: &[Stroke],
     pipeline: &mut Pipeline,
     mut progress: impl FnMut(usize),
-    check_intersections: bool,
+    (check_intersections, samples_per_call): (bool, Option<usize>),
 ) -> Result<SceneResult, PipelineError> {
     let (vertices, faces) = (mesh.live_vertex_count(), mesh.live_face_count());
     // Where the strokes went: vertices that moved or were made; the edge band is measured there.
@@ -144,8 +219,11 @@ pub fn run_strokes(
     let mut remesh = RemeshReport::default();
     let (mut samples, mut steps, mut collisions, mut reverted, mut moves) = (0, 0, 0, 0, 0);
     let mut gpu_memory = pipeline.gpu_memory(mesh);
+    let uploads_before = pipeline.uploads();
+    let mut calls = 0;
     for (i, stroke) in strokes.iter().enumerate() {
-        let report = pipeline.apply_stroke(mesh, stroke)?;
+        let (report, stroke_calls) = feed_stroke(pipeline, mesh, stroke, samples_per_call)?;
+        calls += stroke_calls;
         gpu_memory = gpu_memory
             .into_iter()
             .chain(pipeline.gpu_memory(mesh))
@@ -160,6 +238,12 @@ pub fn run_strokes(
         progress(i + 1);
     }
     let sampling_ms = phases.total() - phases.remesh;
+    let gpu_calls = uploads_before
+        .zip(pipeline.uploads())
+        .map(|(before, after)| GpuCalls {
+            samples_per_call,
+            ..GpuCalls::between(before, after, (samples, strokes.len(), calls))
+        });
     let validation = mesh.validate();
     let intersections = if check_intersections {
         find_intersections(mesh).total()
@@ -211,6 +295,7 @@ pub fn run_strokes(
         gpu_uploads: pipeline.uploads(),
         gpu_backstop: pipeline.backstop_filter(),
         gpu_memory,
+        gpu_calls,
     })
 }
 

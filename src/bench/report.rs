@@ -4,8 +4,9 @@ use std::fmt::Write;
 
 use super::{ScalingRow, SceneResult};
 
-/// One line per scene run on the GPU: the most GPU memory it held after any stroke, as the
-/// allocator reports it and as the budget counts the mesh's copy.
+/// Lines per scene run on the GPU: the most GPU memory it held after any stroke, as the
+/// allocator reports it and as the budget counts the mesh's copy; its submissions and
+/// blocking read-backs.
 pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
     let mut out = String::new();
@@ -27,6 +28,26 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
             mib(m.budget_bytes),
             mib(m.budget_limit_bytes)
         );
+        if let Some(c) = &r.gpu_calls {
+            let feed = c
+                .samples_per_call
+                .map_or("a stroke".to_string(), |n| format!("{n} samples"));
+            let _ = writeln!(
+                out,
+                "gpu calls {}: {:.2} submissions and {:.2} blocking read-backs per sample, \
+                 {:.2} read-backs per stroke, {:.2} per call ({feed} per call); {} samples and \
+                 {} steps taken from runs ahead, the gate stopped {} ({:.1}% of samples)",
+                r.name,
+                c.submissions_per_sample,
+                c.read_backs_per_sample,
+                c.read_backs_per_stroke,
+                c.read_backs_per_call,
+                c.samples_ahead,
+                c.steps_ahead,
+                c.gate_stops,
+                100.0 * c.gate_stops_per_sample
+            );
+        }
     }
     out
 }

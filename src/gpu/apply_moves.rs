@@ -100,7 +100,7 @@ pub fn run_apply_moves(
         &ApplyParams::new(moving.len(), mode),
         None,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok(AppliedMoves {
         positions: gpu.read_buffer(&buffers[3], positions.len())?,
         marks: gpu.read_buffer(&buffers[4], marks.len())?,

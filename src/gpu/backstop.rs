@@ -282,7 +282,7 @@ pub fn run_backstop(
         &params,
         (&pairs, &pair_count),
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     let count = gpu.read_buffer::<u32>(&pair_count, 1)?[0];
     let kept = (count as usize).min(query.capacity);
     let pairs = gpu.read_buffer::<[u32; 2]>(&pairs, kept)?;

@@ -91,7 +91,7 @@ pub fn run_brush_frame(
         &sums,
         Workgroups::Indirect(&args),
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     let words = gpu.read_buffer::<u32>(&sums, FRAME_SUM_WORDS)?;
     Ok(words.try_into().expect("the sums' words"))
 }

@@ -56,6 +56,6 @@ pub fn run_cell_keys(
         inv_cell_size,
         table_size,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     gpu.read_buffer(&keys, positions.len())
 }

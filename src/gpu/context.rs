@@ -168,6 +168,8 @@ pub struct GpuContext {
     /// Blocking read-backs so far (each a submission the CPU waited for): the figure that one
     /// submission per step saves, whatever the adapter's speed.
     read_backs: std::sync::atomic::AtomicUsize,
+    /// Submissions so far ([`GpuContext::submit`]).
+    submissions: std::sync::atomic::AtomicUsize,
 }
 
 impl GpuContext {
@@ -240,6 +242,7 @@ impl GpuContext {
             budget_bytes: budget_mib << 20,
             pipelines: Default::default(),
             read_backs: Default::default(),
+            submissions: Default::default(),
         })
     }
 
@@ -396,9 +399,22 @@ impl GpuContext {
                 label: Some("readback"),
             });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        self.queue.submit([encoder.finish()]);
+        self.submit(encoder);
         let bytes = self.map_read(&staging)?;
         Ok(bytemuck::pod_collect_to_vec::<u8, T>(&bytes))
+    }
+
+    /// Submits what `encoder` recorded, counting the submission: per stroke sample it is, with
+    /// the blocking read-backs, the cost a hardware GPU pays beside its kernels.
+    pub fn submit(&self, encoder: wgpu::CommandEncoder) {
+        self.submissions
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.queue.submit([encoder.finish()]);
+    }
+
+    /// Submissions so far ([`GpuContext::submit`]).
+    pub fn submissions(&self) -> usize {
+        self.submissions.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Waits until the GPU has done everything submitted so far.

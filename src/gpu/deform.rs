@@ -200,7 +200,7 @@ pub fn run_framed_deform(
         },
         &targets,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     let words = gpu.read_buffer::<u32>(&sums, FRAME_SUM_WORDS)?;
     let targets = gpu.read_buffer(&targets, selection.len())?;
     Ok((words.try_into().expect("the sums' words"), targets))

@@ -64,7 +64,7 @@ pub fn run_dispatch_args(
         workgroup_size,
         &args,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     let values = gpu.read_buffer::<u32>(&args, 3)?;
     Ok([values[0], values[1], values[2]])
 }

@@ -148,7 +148,7 @@ pub fn run_longest_move(
         capacity,
         GATE_WORKGROUP_SIZE,
     );
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok(gpu.read_buffer::<GateStatus>(&status, 1)?[0])
 }
 
@@ -176,7 +176,7 @@ pub fn run_sample_gate(
     };
     let mut encoder = gpu.encoder("sample_gate");
     record_stage(gpu, &mut encoder, &gate, params)?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok((
         gpu.read_buffer::<u32>(&count, 1)?[0],
         gpu.read_buffer(&moving_buffer, moving.len())?,

@@ -162,7 +162,7 @@ pub fn run_hash_table(
         inv_cell_size,
         table_size,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     table.read(gpu)
 }
 
@@ -188,7 +188,7 @@ pub fn run_cell_counts(
         keys.len(),
         WORKGROUP_SIZE,
     );
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok((
         gpu.read_buffer(&counts, table_size as usize + 1)?,
         gpu.read_buffer(&ranks, keys.len())?,
@@ -220,6 +220,6 @@ pub fn run_scatter(
         keys.len(),
         WORKGROUP_SIZE,
     );
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     gpu.read_buffer(&entries, filed)
 }

@@ -889,7 +889,7 @@ impl GpuKernels {
                 1.0 / cell,
                 table_size_for(count),
             )?;
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(encoder);
             r.hashed = Some(Hashed {
                 table,
                 positions,
@@ -2119,6 +2119,7 @@ impl StepKernels for GpuKernels {
 
     fn uploads(&self) -> Option<Uploads> {
         Some(Uploads {
+            submissions: self.gpu.submissions(),
             read_backs: self.gpu.read_backs() - self.check_read_backs,
             ..self.uploads
         })

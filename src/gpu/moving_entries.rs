@@ -130,7 +130,7 @@ pub fn run_moving_entries(
             overflows: &overflows,
         },
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok(BuiltEntries {
         moving: gpu.read_buffer(&moving, capacity)?,
         rings: gpu.read_buffer(&rings, words)?,

@@ -301,7 +301,7 @@ pub fn run_overlay_members(
         &slots,
         filed,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     Ok(OverlaySlots {
         marks: gpu.read_buffer(&marks, before.marks.len())?,
         members: gpu.read_buffer(slots.members.buffer(), room)?,
@@ -332,7 +332,7 @@ pub fn run_overlay_table(
     };
     let mut encoder = gpu.encoder("overlay table");
     record_overlay_table(gpu, &mut encoder, &buffers, &filed_at, table, inv_cell_size)?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     read_table(gpu, (&offsets, &entries), table_size)
 }
 

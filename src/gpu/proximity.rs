@@ -325,7 +325,7 @@ pub fn run_proximity(
         &pulls,
         None,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     let pulls: Vec<u32> = gpu.read_buffer(&pulls, query.selection.len())?;
     Ok(verdicts(
         &moving_list,

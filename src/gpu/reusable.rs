@@ -128,7 +128,7 @@ impl ReusableBuffer {
         encoder: wgpu::CommandEncoder,
         total: u64,
     ) -> Result<Vec<u8>, GpuError> {
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit(encoder);
         let mut data = gpu.map_read(self.buffer())?;
         data.truncate(total as usize);
         Ok(data)
@@ -214,6 +214,6 @@ impl<'a> Patches<'a> {
                 range.len() as u64,
             );
         }
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit(encoder);
     }
 }

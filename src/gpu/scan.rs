@@ -67,6 +67,6 @@ pub fn run_exclusive_scan(gpu: &GpuContext, values: &[u32]) -> Result<Vec<u32>, 
     let buffer = gpu.storage_buffer("scan values", values, true);
     let mut encoder = gpu.encoder("scan");
     record_exclusive_scan(gpu, &mut encoder, &buffer, values.len())?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     gpu.read_buffer(&buffer, values.len())
 }

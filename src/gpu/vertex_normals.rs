@@ -67,7 +67,7 @@ pub fn run_vertex_normals(
         vertices.len(),
         &normals,
     )?;
-    gpu.queue.submit([encoder.finish()]);
+    gpu.submit(encoder);
     gpu.read_buffer(&normals, mesh.vertex_count())
 }
 
@@ -169,7 +169,7 @@ impl MovedPass<'_> {
             (&moving_buffer, moving.len()),
             &output_buffer,
         )?;
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit(encoder);
         gpu.read_buffer(&output_buffer, output.len())
     }
 }

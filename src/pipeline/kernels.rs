@@ -193,8 +193,10 @@ pub struct Uploads {
     /// Times the vertices remeshing changed went into the table's small overlay instead of a
     /// rebuild.
     pub overlay_filings: usize,
-    /// Blocking read-backs: submissions whose results the CPU waited for (per sample, the
-    /// round trips a hardware GPU pays beside its kernels).
+    /// Submissions of recorded GPU work, and the blocking read-backs among them (the CPU
+    /// waited for their results): per sample, the round trips a hardware GPU pays beside its
+    /// kernels.
+    pub submissions: usize,
     pub read_backs: usize,
     /// Steps whose proximity passes ran in the submission that selected and deformed
     /// ([`StepKernels::select_deform_and_clamp`]), and those whose passes so run moved vertices

@@ -24,6 +24,8 @@ pub struct Options {
     pub backend: Backend,
     /// When the touched region is remeshed.
     pub remeshing: Remeshing,
+    /// Samples per `add_samples` call (`None`: a stroke's samples in one call).
+    pub samples_per_call: Option<usize>,
 }
 
 /// `--scene`: one scene name, `all` (the paper's three materials) or `none` (scaling only).
@@ -85,8 +87,7 @@ fn bench_scene(
     triangles: usize,
     strokes: usize,
     seed: u64,
-    remeshing: Remeshing,
-    chosen: Backend,
+    (remeshing, chosen, feed): (Remeshing, Backend, Option<usize>),
 ) -> anyhow::Result<SceneRun> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
@@ -115,13 +116,14 @@ fn bench_scene(
         Backend::Both => backend::cpu(settings),
         single => backend::choose(single, settings)?,
     };
-    let result = sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut first.pipeline)?;
+    let result = sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut first.pipeline, feed)?;
     report_fallback(&first.pipeline);
     let gpu = if chosen == Backend::Both {
         let mut second = backend::gpu(settings)?;
         let mut on_gpu = start;
         let name = format!("{} (gpu)", kind.name());
-        let gpu_result = sculpt_with_progress(&name, &mut on_gpu, &strokes, &mut second.pipeline)?;
+        let gpu_result =
+            sculpt_with_progress(&name, &mut on_gpu, &strokes, &mut second.pipeline, feed)?;
         report_fallback(&second.pipeline);
         let compared = parity((&result, &mesh), (&gpu_result, &on_gpu));
         Some((gpu_result, compared))
@@ -138,15 +140,17 @@ fn report_fallback(pipeline: &slayer::pipeline::Pipeline) {
     }
 }
 
-/// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does.
+/// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does, `feed`
+/// samples per `add_samples` call (`None`: each stroke's samples in one call).
 pub fn sculpt_with_progress(
     name: &str,
     mesh: &mut slayer::mesh::Mesh,
     strokes: &[slayer::brush::Stroke],
     pipeline: &mut slayer::pipeline::Pipeline,
+    feed: Option<usize>,
 ) -> anyhow::Result<SceneResult> {
     let bar = Bar::new(name, strokes.len() as u64);
-    let result = run_strokes(name, mesh, strokes, pipeline, |_| bar.inc(), true)?;
+    let result = run_strokes(name, mesh, strokes, pipeline, |_| bar.inc(), (true, feed))?;
     bar.finish();
     Ok(result)
 }
@@ -172,8 +176,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
             triangles,
             options.strokes,
             options.seed,
-            options.remeshing,
-            resolved,
+            (options.remeshing, resolved, options.samples_per_call),
         )?);
     }
     let scenes: Vec<SceneResult> = runs.iter().map(|r| r.result.clone()).collect();
@@ -222,12 +225,15 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
                 faces,
                 options.strokes.min(8),
                 options.seed,
-                options.remeshing,
-                if resolved == Backend::Both {
-                    Backend::Cpu
-                } else {
-                    resolved
-                },
+                (
+                    options.remeshing,
+                    if resolved == Backend::Both {
+                        Backend::Cpu
+                    } else {
+                        resolved
+                    },
+                    options.samples_per_call,
+                ),
             )?
             .result;
             scaling.push(ScalingRow {

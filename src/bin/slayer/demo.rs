@@ -134,7 +134,8 @@ pub fn run(
         pipeline.name(),
         strokes_path.display()
     );
-    let result = crate::bench::sculpt_with_progress("plaster", &mut mesh, &strokes, &mut pipeline)?;
+    let result =
+        crate::bench::sculpt_with_progress("plaster", &mut mesh, &strokes, &mut pipeline, None)?;
     if let Some(why) = pipeline.kernel_failure() {
         eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
     }

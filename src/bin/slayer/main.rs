@@ -144,6 +144,10 @@ enum Command {
         /// Remesh the touched region: after every stroke, after every stroke sample, or off.
         #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
         remesh: slayer::pipeline::Remeshing,
+        /// Feed each stroke this many samples per call, as an app does pointer event by
+        /// pointer event (default: the whole stroke in one call, the batch).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+        samples_per_call: Option<u64>,
     },
     /// Render a mesh file to a PNG with the preview renderer (headless; lavapipe without a GPU).
     ///
@@ -248,6 +252,7 @@ fn main() -> ExitCode {
             scaling_sizes,
             backend,
             remesh,
+            samples_per_call,
         } => {
             let scenes = match bench::parse_scenes(&scene) {
                 Ok(scenes) => scenes,
@@ -266,6 +271,7 @@ fn main() -> ExitCode {
                 scaling_sizes,
                 backend,
                 remeshing: remesh,
+                samples_per_call: samples_per_call.map(|n| n as usize),
             })
         }
     };
