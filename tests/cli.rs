@@ -516,7 +516,7 @@ fn a_missing_file_is_one_plain_line() {
 }
 
 /// `--backend both` runs the same strokes on the CPU and with the GPU's kernels (lavapipe here)
-/// and writes BENCHMARK.md's `parity` object; an unknown backend is a one-line error.
+/// and writes docs/bench.md's `parity` object; an unknown backend is a one-line error.
 #[test]
 fn bench_on_both_backends_writes_parity() {
     let dir = scratch("bench-both");

@@ -1,4 +1,4 @@
-//! `slayer bench` (BENCHMARK.md): generated scenes, a seeded stroke script, the paper's Table 1
+//! `slayer bench` (docs/bench.md): generated scenes, a seeded stroke script, the paper's Table 1
 //! layout, and the scaling run.
 
 mod report;
@@ -67,7 +67,7 @@ pub fn smallest_angle_degrees([a, b, c]: [glam::Vec3; 3]) -> f64 {
     angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
 }
 
-/// Figures for one scene; field names are the fixed JSON interface of BENCHMARK.md.
+/// Figures for one scene; field names are the fixed JSON interface of docs/bench.md.
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneResult {
     pub name: String,

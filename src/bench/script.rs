@@ -1,4 +1,4 @@
-//! Seeded stroke scripts (BENCHMARK.md): strokes that push, drag, inflate, smooth and flatten
+//! Seeded stroke scripts (docs/bench.md): strokes that push, drag, inflate, smooth and flatten
 //! the upper layers of a layered scene, many of them pressing into the layers below. Samples are
 //! placed on the surface by picking through the grid, so the script replays anywhere.
 
@@ -24,9 +24,9 @@ pub enum BrushMix {
 pub struct ScriptSpec {
     pub strokes: usize,
     pub seed: u64,
-    /// Brush radius in mean edge lengths (BENCHMARK.md: 12).
+    /// Brush radius in mean edge lengths (docs/bench.md: 12).
     pub radius_edges: f32,
-    /// Sample spacing as a share of the radius (BENCHMARK.md: 1/4).
+    /// Sample spacing as a share of the radius (docs/bench.md: 1/4).
     pub spacing: f32,
     /// Samples per stroke.
     pub samples: usize,

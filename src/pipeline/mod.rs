@@ -10,6 +10,36 @@
 //!
 //! Strokes stream: [`Pipeline::begin_stroke`] → [`StrokeInProgress::add_samples`] as samples
 //! are drawn → [`StrokeInProgress::finish`]. [`Pipeline::apply_stroke`] is the three at once.
+//! `docs/strokes.md` has the stroke file and this example:
+//!
+//! ```
+//! use glam::Vec3;
+//! use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
+//! use slayer::pipeline::{Pipeline, PipelineSettings};
+//! use slayer::scene::{SceneKind, SceneSpec, generate};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let mut mesh = generate(&SceneSpec { kind: SceneKind::Plaster, triangles: 2_000, seed: 1 })?;
+//! let mut pipeline = Pipeline::new(PipelineSettings::default());
+//! let brush = Brush { kind: BrushKind::Draw, radius: 0.1, strength: 0.5,
+//!                     falloff: Falloff::default(), invert: true };
+//! let mut stroke = pipeline.begin_stroke(&mut mesh, StrokeSettings {
+//!     brush, paint: None, layers: vec![1], spacing: 0.25,
+//! })?;
+//! for x in [0.3f32, 0.35, 0.4, 0.45, 0.5] {
+//!     // One pointer event: the samples it completes run now.
+//!     let done = stroke.add_samples(&[Sample {
+//!         position: Vec3::new(x, 0.5, 0.15), pressure: 1.0, normal: None,
+//!     }])?;
+//!     // `done.changed`: the vertices to upload again; `done.topology_changed`: the faces too.
+//!     assert!(done.changed.windows(2).all(|w| w[0] < w[1]));
+//! }
+//! let report = stroke.finish()?; // runs the last sample, remeshes what the stroke touched
+//! assert!(report.moves > 0);
+//! println!("{} samples, {} moves, {} clamped", report.samples, report.moves, report.clamped);
+//! # Ok(())
+//! # }
+//! ```
 
 mod engine;
 mod kernels;

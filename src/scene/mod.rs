@@ -1,4 +1,4 @@
-//! Deterministic generated scenes (BENCHMARK.md): a flat `plane`, a closed `sphere`, and the
+//! Deterministic generated scenes (docs/bench.md): a flat `plane`, a closed `sphere`, and the
 //! layered materials of the sLayer paper — `plaster` (3 layers), `bark` (4) and `metal` (3).
 //!
 //! Sheets sit on a unit square; upper layers float a few mean edge lengths above the layer below

@@ -262,7 +262,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
             "scenes": scenes,
             "scaling": if options.scaling { Some(&scaling) } else { None },
             "gpu_scenes": if gpu_scenes.is_empty() { None } else { Some(&gpu_scenes) },
-            // BENCHMARK.md's `parity` is one object: the first scene's; every scene's is in
+            // docs/bench.md's `parity` is one object: the first scene's; every scene's is in
             // `parity_by_scene`.
             "parity": parities.first().map(|(_, p)| p),
             "parity_by_scene": if parities.is_empty() { None } else { Some(&parities) },

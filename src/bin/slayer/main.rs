@@ -123,7 +123,7 @@ enum Command {
         strokes: usize,
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Write the figures as JSON (BENCHMARK.md's field names).
+        /// Write the figures as JSON (the fields of docs/bench.md).
         #[arg(long)]
         json: Option<PathBuf>,
         /// Also run the same strokes on plaster from 250K to 4M faces.
