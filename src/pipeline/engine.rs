@@ -18,22 +18,15 @@ use crate::grid::SpatialHash;
 use crate::mesh::{Mesh, MeshVersion};
 use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
 
-/// How nearby elements are found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Search {
-    /// Through the spatial hash and a per-step face grid.
-    Grid,
-    /// By scanning every vertex and face: slow, obviously right, the reference.
-    Scan,
-}
-
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
 /// remeshing run here on the CPU; selection, deformation and (on a GPU) the proximity passes
 /// run in its [`StepKernels`].
 pub struct Pipeline {
     pub(super) settings: PipelineSettings,
-    pub(super) search: Search,
-    pub(super) parallel: bool,
+    /// The reference: nearby elements found by scanning every vertex and face, on one thread
+    /// (slow, obviously right); otherwise through the spatial hash and a per-step face grid, on
+    /// all cores.
+    pub(super) reference: bool,
     pub(super) edge_length: Option<f32>,
     /// Where selection and deformation run.
     pub(super) kernels: Box<dyn StepKernels>,
@@ -74,20 +67,19 @@ const EDGE_BOUND_SLACK: f32 = 2.0;
 impl Pipeline {
     /// The fast backend: grids and all cores.
     pub fn new(settings: PipelineSettings) -> Pipeline {
-        Pipeline::with_search(settings, Search::Grid, true)
+        Pipeline::with_reference(settings, false)
     }
 
     /// The reference: brute-force search on one thread.
     pub fn reference(settings: PipelineSettings) -> Pipeline {
-        Pipeline::with_search(settings, Search::Scan, false)
+        Pipeline::with_reference(settings, true)
     }
 
-    pub fn with_search(settings: PipelineSettings, search: Search, parallel: bool) -> Pipeline {
+    fn with_reference(settings: PipelineSettings, reference: bool) -> Pipeline {
         Pipeline {
             edge_length: settings.edge_length,
             settings,
-            search,
-            parallel,
+            reference,
             kernels: Box::new(CpuKernels),
             scratch: Scratch::default(),
             prepared: None,
@@ -143,11 +135,10 @@ impl Pipeline {
                 format!("gpu (select, deform on {kernels}; collide, remesh on the cpu)")
             };
         }
-        match (self.search, self.parallel) {
-            (Search::Grid, true) => "cpu".into(),
-            (Search::Scan, false) => "cpu-reference".into(),
-            (Search::Grid, false) => "cpu-1-thread".into(),
-            (Search::Scan, true) => "cpu-scan".into(),
+        if self.reference {
+            "cpu-reference".into()
+        } else {
+            "cpu".into()
         }
     }
 

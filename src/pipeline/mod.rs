@@ -46,7 +46,7 @@ mod kernels;
 pub mod step;
 mod stroke;
 
-pub use engine::{Pipeline, Search};
+pub use engine::Pipeline;
 pub use kernels::{
     BackstopFilter, CallAt, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels,
     Uploads,

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::engine::{Pipeline, Prepared, Scratch, Search, longest_edge, millis, remesh_touched};
+use super::engine::{Pipeline, Prepared, Scratch, longest_edge, millis, remesh_touched};
 use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
@@ -175,7 +175,8 @@ impl<'a> StrokeInProgress<'a> {
         };
         let pipeline = &mut *self.pipeline;
         let kernels = pipeline.kernels.as_mut();
-        let search = (pipeline.search == Search::Grid, pipeline.parallel);
+        // (use the grid, in parallel): both, or (the reference) neither, scanning on one thread.
+        let search = (!pipeline.reference, !pipeline.reference);
         if active.plans_ahead(pipeline.settings.remeshing) {
             let probes = active.probes(samples);
             kernels.given(self.mesh, active.samples_run, &probes);
