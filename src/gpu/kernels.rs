@@ -59,12 +59,10 @@ use crate::brush::{Dab, DabFrame};
 use crate::grid::{cell_coordinates, hash_cell};
 
 mod run_ahead;
+use crate::collide::{Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region};
 use crate::cpu::FRAME_SUM_WORDS;
 use crate::mesh::{Mesh, MeshVersion};
-use crate::pipeline::step::{
-    Backstop, MAX_PASSES, Region, StepMoves, StrokeState, clamp_in_region, frame_flags,
-    frame_of_sums, longest_move,
-};
+use crate::pipeline::step::{frame_flags, frame_of_sums, longest_move};
 use crate::pipeline::{
     BackstopFilter, CallAt, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels,
     Uploads,
