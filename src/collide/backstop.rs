@@ -123,8 +123,9 @@ fn undo_pairs(
     undo
 }
 
-/// Gathers the region of a step whose selection has moved already: with the selection put
-/// back at `before` meanwhile, so that it is the region [`clamp_in_region`](super::clamp_in_region) gathers.
+/// Gathers the region of a step whose selection has moved already: with the selection put back at
+/// `before` meanwhile, so that it is the region [`clamp_in_region`](super::clamp_in_region)
+/// gathers.
 fn gather_from_start(
     state: &StrokeState<'_>,
     region: &mut Region,

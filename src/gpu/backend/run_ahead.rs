@@ -37,15 +37,18 @@ use std::collections::VecDeque;
 
 use glam::Vec3;
 
-use super::{
-    AheadBounds, ClampedAhead, GpuKernels, Resident, SelectedVertex, StrokeState, TableUse,
-    cell_size, in_vertex_order, permuted, record_sample, selection_guess,
+use super::GpuKernels;
+use super::clamp::ClampedAhead;
+use super::hashed::{TableUse, cell_size};
+use super::resident::put_back_rows;
+use super::select_deform::{
+    AheadBounds, in_vertex_order, permuted, record_sample, selection_guess,
 };
 use crate::brush::Dab;
+use crate::collide::StrokeState;
 use crate::cpu::FRAME_SUM_WORDS;
-use crate::gpu::reusable::Patches;
 use crate::gpu::{
-    GateBuffers, GateStatus, GpuContext, GpuError, MovingVertex, record_gate_vacate,
+    GateBuffers, GateStatus, GpuError, MovingVertex, SelectedVertex, record_gate_vacate,
     record_moved_edges, record_moved_normals, ring_bytes,
 };
 use crate::mesh::Mesh;
@@ -603,29 +606,6 @@ impl GpuKernels {
             self.drop_queued_and(mesh, &vertices);
         }
     }
-}
-
-/// Puts the GPU's rows of `vertices` — positions, and the normals of every corner of the faces
-/// around them, which `moved_normals` may have rewritten — back to the mesh's, in one upload.
-pub(super) fn put_back_rows(
-    gpu: &GpuContext,
-    resident: Option<&Resident>,
-    mesh: &Mesh,
-    vertices: &[u32],
-) {
-    let Some(r) = resident else {
-        return;
-    };
-    let mut corners: Vec<u32> = vertices
-        .iter()
-        .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
-        .collect();
-    corners.sort_unstable();
-    corners.dedup();
-    let mut patches = Patches::default();
-    patches.rows(&r.vertices.positions, mesh.positions(), vertices);
-    patches.rows(&r.normals, mesh.normals(), &corners);
-    patches.submit(gpu);
 }
 
 /// The queue of samples recorded ahead, oldest first.
