@@ -6,9 +6,10 @@ use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
 use slayer::collide::neighbourhood::exclusion_ring;
+use slayer::collide::{Region, StrokeState, collide};
 use slayer::grid::SpatialHash;
 use slayer::mesh::INVALID;
-use slayer::pipeline::step::{Region, StrokeState, collide, deform, select};
+use slayer::pipeline::step::{deform, select};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 use std::hint::black_box;
 

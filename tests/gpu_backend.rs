@@ -397,8 +397,8 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
 #[test]
 fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
     use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
+    use slayer::collide::StrokeState;
     use slayer::grid::SpatialHash;
-    use slayer::pipeline::step::StrokeState;
     use slayer::pipeline::{CpuKernels, StepKernels};
 
     let (mut mesh, _) = plaster_and_strokes(0);
@@ -476,7 +476,7 @@ fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
     // turned into the frame by the same function), and the same targets within rounding.
     use glam::Vec3;
     use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
-    use slayer::pipeline::step::StrokeState;
+    use slayer::collide::StrokeState;
     use slayer::pipeline::{CpuKernels, FrameSource, StepKernels};
 
     // Vertices numbered in no spatial order, so that the GPU appends its selection out of

@@ -15,7 +15,7 @@ pub const FACE_WORDS: usize = 4;
 /// changes it by rounding only; without the slack, whether such a vertex is stopped would
 /// depend on the last bits of the arithmetic, which differ between the CPU and a GPU (fused
 /// multiply-adds), and the stop moves it by a whole step. `wgsl/proximity.wgsl` has the same,
-/// and `pipeline::step::pull_back` (the CPU backend) uses it too.
+/// and `collide::pull_back` (the CPU backend) uses it too.
 pub const CLAMP_SLACK: f32 = 1.0 / 1024.0;
 
 /// Bisection fractions of `wgsl/proximity.wgsl` are multiples of 1 / PULL_SCALE; pull-back

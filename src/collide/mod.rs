@@ -1,13 +1,27 @@
-//! Collision queries between layers and within a layer: the per-step broad phase (a dense face
-//! grid over the brush's region), the neighbourhood a vertex skips, and the exact whole-mesh
-//! intersection count that `slayer check`, the bench and the tests use to prove that nothing
-//! passed through anything.
+//! Collision queries between layers and within a layer, and the response to them: the per-step
+//! broad phase (a dense face grid over the brush's region), the neighbourhood a vertex skips,
+//! sLayer's collision response (the proximity clamp, then the exact backstop), and the exact
+//! whole-mesh intersection count that `slayer check`, the bench and the tests use to prove that
+//! nothing passed through anything.
+//!
+//! Floors: `state` ← `region` ← `backstop` ← `response`; nothing here imports the pipeline or
+//! the GPU, which both build on it.
 
+mod backstop;
 mod intersections;
 mod local_grid;
 pub mod neighbourhood;
+mod region;
+mod response;
 mod stamps;
+mod state;
 
+pub use backstop::Backstop;
 pub use intersections::{IntersectingPair, IntersectionReport, find_intersections};
 pub use local_grid::LocalFaceGrid;
+pub use region::{Region, Scratch, StepMoves};
+pub use response::{
+    CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, collide, collide_with, pull_back,
+};
 pub use stamps::Stamps;
+pub use state::StrokeState;

@@ -1,4 +1,4 @@
-//! Mirror of `wgsl/proximity.wgsl`: one Jacobi pass of `pipeline::step::pull_back` over the
+//! Mirror of `wgsl/proximity.wgsl`: one Jacobi pass of `collide::pull_back` over the
 //! moving list, with the shader's invocations (entry, cell of the box around its tentative
 //! position), loops (bucket entries, each entry's faces) and the same
 //! `closest_point_on_triangle`. Faces met twice are harmless: each entry keeps the largest

@@ -1,7 +1,7 @@
 //! Host side of `wgsl/backstop.wgsl`: the f32 filter in front of the exact backstop. After a
 //! step's proximity passes it lists the pairs of faces (a moved face and another, or a moved
 //! face and itself for "may have turned over") that it cannot clear; the CPU decides those
-//! with the exact predicates (`pipeline::step`'s `Backstop::Undecided`) instead of gathering
+//! with the exact predicates (`collide::Backstop::Undecided`) instead of gathering
 //! and searching the step's region.
 
 use glam::Vec3;

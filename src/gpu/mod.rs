@@ -2,6 +2,7 @@
 //! Each kernel in `wgsl/` has a CPU mirror of the same name in [`crate::cpu`].
 
 mod apply_moves;
+mod backend;
 mod backstop;
 mod brush_frame;
 mod cell_keys;
@@ -10,7 +11,6 @@ mod deform;
 mod dispatch_args;
 mod gate;
 mod hash_table;
-mod kernels;
 mod limits;
 mod moving_entries;
 mod options;
@@ -38,6 +38,7 @@ pub use crate::abi::{
 };
 
 pub use apply_moves::{AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves};
+pub use backend::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use backstop::{
     BackstopBuffers, BackstopQuery, PAIRS_GUESS, UndecidedPairs, backstop_inputs, backstop_params,
     backstop_query_params, check_backstop_invocations, moved_edge_bound, record_backstop,
@@ -58,7 +59,6 @@ pub use gate::{
 pub use hash_table::{
     GpuHashTable, read_table, run_cell_counts, run_hash_table, run_scatter, table_size_for,
 };
-pub use kernels::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
 pub use moving_entries::{
     BuiltEntries, BuiltEntryBuffers, EntryBuffers, RING_STRIDE, entry_params,
     record_moving_entries, ring_bytes, run_moving_entries,

@@ -1,5 +1,5 @@
 //! Host side of `wgsl/proximity.wgsl`: one Jacobi pass of vertex–triangle proximity and
-//! clamping over a step's selection, as `pipeline::step::pull_back` does it on the CPU. The
+//! clamping over a step's selection, as `collide::pull_back` does it on the CPU. The
 //! kernel leaves a pull-back amount per entry; [`verdicts`] turns amounts into positions as
 //! `apply_moves` does on the GPU.
 //!

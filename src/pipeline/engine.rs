@@ -7,12 +7,12 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::kernels::{CpuKernels, StepKernels};
-use super::step::Region;
 use super::stroke::StrokeInProgress;
 use super::{
     BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, StrokeReport, Uploads,
 };
 use crate::brush::{Stroke, StrokeSettings};
+use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
 use crate::mesh::{Mesh, MeshVersion};

@@ -9,10 +9,9 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::step::{
-    Backstop, Region, StepMoves, StrokeState, brush_frame, clamp_in_region, deform, select,
-};
+use super::step::{brush_frame, deform, select};
 use crate::brush::{Dab, DabFrame};
+use crate::collide::{Backstop, Region, StepMoves, StrokeState, clamp_in_region};
 use crate::mesh::{Mesh, MeshVersion};
 use serde::Serialize;
 
@@ -95,7 +94,7 @@ pub trait StepKernels: Send {
         selection: &[(u32, f32)],
         at: Option<CallAt>,
     ) -> Vec<Vec3>;
-    /// The collision response's first phase, [`super::step::clamp_moves`]: the selection
+    /// The collision response's first phase, [`crate::collide::clamp_moves`]: the selection
     /// moved to its targets, then pulled back where it comes too close to a face. `before`
     /// holds each selected vertex's start; `region` is the step's, gathered here if needed.
     /// Leaves the positions in `mesh`, and says what it leaves the exact backstop.

@@ -11,9 +11,10 @@ use glam::Vec3;
 
 use super::engine::{Pipeline, Prepared, Scratch, longest_edge, millis, remesh_touched};
 use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
-use super::step::{StrokeState, brush_frame, collide_with, longest_move, paint, steps_for};
+use super::step::{brush_frame, longest_move, paint, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
 use crate::brush::{BrushKind, Dab, DabFrame, Resampler, Sample, StrokeSettings};
+use crate::collide::{StrokeState, collide_with};
 use crate::geom::largest_move;
 use crate::mesh::{INVALID, Mesh};
 

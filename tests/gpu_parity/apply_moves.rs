@@ -125,7 +125,7 @@ fn apply_moves_matches_cpu_mirror_in_every_mode() {
 }
 
 /// The whole Jacobi loop of a step on the GPU (`GpuKernels::clamp`: targets placed, passes
-/// sized by indirect dispatch, finals gathered) against `pipeline::step::clamp_moves`.
+/// sized by indirect dispatch, finals gathered) against `collide::clamp_moves`.
 fn check_clamp_loop(scene: ProximityScene) {
     use slayer::pipeline::StepKernels;
     let mut kernels = slayer::gpu::GpuKernels::new(gpu());
@@ -154,7 +154,7 @@ fn check_clamp_loop(scene: ProximityScene) {
         for (&(v, _), q) in selection.iter().zip(&targets) {
             moved.positions_mut()[v as usize] = *q;
         }
-        let state = slayer::pipeline::step::StrokeState {
+        let state = slayer::collide::StrokeState {
             grid: Some(&grid),
             active: &active,
             parallel: true,
@@ -164,18 +164,11 @@ fn check_clamp_loop(scene: ProximityScene) {
         };
         let (region, target_of) = gathered_region(&state, mesh, &selection, &targets);
         let mut on_cpu = mesh.clone();
-        slayer::pipeline::step::clamp_moves(
-            &state,
-            &region,
-            &mut on_cpu,
-            &selection,
-            &targets,
-            &before,
-        );
+        slayer::collide::clamp_moves(&state, &region, &mut on_cpu, &selection, &targets, &before);
         let mut on_gpu = mesh.clone();
         let backstop = kernels.clamp(
             &state,
-            &mut slayer::pipeline::step::Region::default(),
+            &mut slayer::collide::Region::default(),
             &mut on_gpu,
             (&selection, &targets, &target_of),
             &before,
@@ -183,7 +176,7 @@ fn check_clamp_loop(scene: ProximityScene) {
         assert_eq!(kernels.failure(), None);
         // The GPU filtered the backstop's pairs too: no region needed.
         assert!(
-            matches!(backstop, slayer::pipeline::step::Backstop::Undecided(_)),
+            matches!(backstop, slayer::collide::Backstop::Undecided(_)),
             "{}: {backstop:?}",
             scene.name
         );

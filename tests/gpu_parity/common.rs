@@ -5,11 +5,11 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::brush::Falloff;
+use slayer::collide::{Region, StrokeState};
 use slayer::gpu::{
     AdapterChoice, CsrTable, GpuContext, MovingVertex, NormalParams, PackedTopology, SelectedVertex,
 };
 use slayer::mesh::{INVALID, Mesh, VertexFlags};
-use slayer::pipeline::step::{Region, StrokeState};
 
 pub fn gpu() -> GpuContext {
     let gpu = GpuContext::new(AdapterChoice {

@@ -41,7 +41,7 @@ fn check_deform(binding: Binding) {
     };
     let grid = SpatialHash::build(&mesh, 0.05).unwrap();
     let active = [true, false, true];
-    let state = slayer::pipeline::step::StrokeState {
+    let state = slayer::collide::StrokeState {
         grid: Some(&grid),
         active: &active,
         parallel: false,

@@ -43,7 +43,7 @@ fn cpu_proximity(
     slayer::gpu::verdicts(&moving, &flat, &pulls)
 }
 
-/// `pipeline::step::pull_back` (the CPU backend's first pass) for the same step.
+/// `collide::pull_back` (the CPU backend's first pass) for the same step.
 fn reference_pull_back(
     scene: &ProximityScene,
     selection: &[u32],
@@ -57,7 +57,7 @@ fn reference_pull_back(
         current.positions_mut()[v as usize] = scene.targets[v as usize];
     }
     let active = vec![true; mesh.layer_count()];
-    let state = slayer::pipeline::step::StrokeState {
+    let state = slayer::collide::StrokeState {
         grid: Some(&grid),
         active: &active,
         parallel: false,
@@ -71,7 +71,7 @@ fn reference_pull_back(
         .map(|&v| scene.targets[v as usize])
         .collect();
     let (region, _) = gathered_region(&state, mesh, &pairs, &targets);
-    let mut scratch = slayer::pipeline::step::Scratch::default();
+    let mut scratch = slayer::collide::Scratch::default();
     selection
         .iter()
         .map(|&v| {
@@ -79,15 +79,7 @@ fn reference_pull_back(
             if current.positions()[v as usize] == start {
                 return None;
             }
-            slayer::pipeline::step::pull_back(
-                &state,
-                &region,
-                &current,
-                v,
-                start,
-                None,
-                &mut scratch,
-            )
+            slayer::collide::pull_back(&state, &region, &current, v, start, None, &mut scratch)
         })
         .collect()
 }

@@ -315,7 +315,7 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
     }
     let grid = SpatialHash::build(&mesh, 0.1).unwrap();
     let active = [true, false, true];
-    let state = slayer::pipeline::step::StrokeState {
+    let state = slayer::collide::StrokeState {
         grid: Some(&grid),
         active: &active,
         parallel: false,

@@ -37,16 +37,22 @@ use std::collections::VecDeque;
 
 use glam::Vec3;
 
-use super::{
-    AheadBounds, ClampedAhead, GpuKernels, Resident, SelectedVertex, StrokeState, TableUse,
-    cell_size, in_vertex_order, permuted, record_sample, selection_guess,
+use super::GpuKernels;
+use super::clamp::ClampedAhead;
+use super::hashed::{TableUse, cell_size};
+use super::resident::{Resident, put_back_rows};
+use super::select_deform::{
+    AheadBounds, RecordedSample, SampleLayout, in_vertex_order, permuted, record_sample,
+    selection_guess,
 };
+use super::step_buffers::StepBuffers;
 use crate::brush::Dab;
+use crate::collide::StrokeState;
 use crate::cpu::FRAME_SUM_WORDS;
-use crate::gpu::reusable::Patches;
+use crate::gpu::reusable::ReusableBuffer;
 use crate::gpu::{
-    GateBuffers, GateStatus, GpuContext, GpuError, MovingVertex, record_gate_vacate,
-    record_moved_edges, record_moved_normals, ring_bytes,
+    GateBuffers, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
+    record_gate_vacate, record_moved_edges, record_moved_normals, ring_bytes,
 };
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
@@ -174,25 +180,7 @@ impl GpuKernels {
         self.check_injected_failure()?;
         self.check_gpu_filing(mesh);
         self.drop_all_ahead(mesh);
-        let mut calls: Vec<RunCall> = steps
-            .into_iter()
-            .flat_map(|(sample, dab, steps)| {
-                (0..steps).map(move |k| RunCall::Step {
-                    sample,
-                    dab,
-                    k,
-                    steps,
-                })
-            })
-            .collect();
-        let step_count = calls.len();
-        if let Some(from) = from {
-            let samples = (self.plan.len() - from).min(
-                self.run_length
-                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
-            );
-            calls.extend((from..from + samples).map(RunCall::Start));
-        }
+        let (calls, step_count) = self.run_calls(steps, from);
         let count = calls.len();
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
@@ -228,116 +216,70 @@ impl GpuKernels {
             unreachable!("prepare built the hash table");
         };
         hashed.start_gpu_filing(gpu, room)?;
-        let r = &*r;
-        let Some(topology) = &r.topology else {
-            unreachable!("reserve_sample made the topology resident");
+        let shape = RunShape {
+            count,
+            guess,
+            ahead: AheadBounds {
+                assumed_move,
+                drift,
+            },
+            filter,
         };
-        let list_bytes = (guess * std::mem::size_of::<SelectedVertex>()) as u64;
-        let mut encoder = gpu.encoder("samples ahead");
-        r.hashed().record_gpu_table(gpu, &mut encoder)?;
-        // The gate's edge bound starts at the pipeline's; each call but the last grows it by
-        // the faces it turned (`moved_edges`) for the next one's verdict.
-        step.start_gate(gpu, state.max_edge);
-        // The edges as the calls before call j may have lengthened them (checked by the gate,
-        // and by the host when the pipeline reaches it).
-        let edge_bound = |j: usize| state.max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move;
-        let mut layouts = Vec::with_capacity(count);
-        let mut stride = 0;
-        for (j, &call) in calls.iter().enumerate() {
-            let (dab, source) = call.dab_and_source(&self.plan);
-            let state = StrokeState {
-                max_edge: edge_bound(j),
-                ..*state
-            };
-            let recorded = record_sample(
-                gpu,
-                &mut encoder,
-                (r, step),
-                &state,
-                &dab,
-                (source, true),
-                guess,
-                Some(AheadBounds {
-                    assumed_move,
-                    drift,
-                }),
-                filter,
-            )?;
-            let normals_of = match call {
-                RunCall::Start(_) => Some((step.moving.buffer(), guess)),
-                // The pipeline recomputes normals after a sample's last step: every step
-                // deforms on the normals from before the sample. Each step's moving list is
-                // kept until then, and vacated if the run stopped at one of them: the steps
-                // taken before the stop leave their normals to the pipeline.
-                RunCall::Step { k, steps, .. } => {
-                    let held = step.held_moving.buffer();
-                    encoder.copy_buffer_to_buffer(
-                        step.moving.buffer(),
-                        0,
-                        held,
-                        k as u64 * moving_bytes,
-                        moving_bytes,
-                    );
-                    let last = k + 1 == steps;
-                    if last {
-                        record_gate_vacate(
-                            gpu,
-                            &mut encoder,
-                            &GateBuffers {
-                                moving: held,
-                                ..step.gate(r)
-                            },
-                            steps * guess,
-                        )?;
-                    }
-                    last.then_some((held, steps * guess))
-                }
-            };
-            if let Some(moving) = normals_of {
-                record_moved_normals(
-                    gpu,
-                    &mut encoder,
-                    (&r.vertices.positions, &topology.buffer),
-                    topology.layout.vertex_rows_base,
-                    moving,
-                    &r.normals,
-                )?;
-            }
-            if j + 1 < count {
-                record_moved_edges(
-                    gpu,
-                    &mut encoder,
-                    (&r.vertices.positions, &topology.buffer),
-                    topology.layout.vertex_rows_base,
-                    (step.moving.buffer(), guess),
-                    &step.gate_status,
-                )?;
-                r.hashed().record_gpu_filing(
-                    gpu,
-                    &mut encoder,
-                    &r.vertices.positions,
-                    (step.moving.buffer(), guess),
-                )?;
-            }
-            let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
-            parts.extend_from_slice(&recorded.parts);
-            if j == 0 {
-                // Every call leaves the same parts, but for the brush frame's sums a step
-                // (whose frame is its dab's) leaves out: room for the largest.
-                let frame_bytes = match recorded.layout.frame_from_selection {
-                    Some(_) => 0,
-                    None => (FRAME_SUM_WORDS * 4) as u64,
-                };
-                stride = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>() + frame_bytes;
-                readback.reserve(gpu, stride * count as u64)?;
-            }
-            layouts.push(recorded.layout);
-            readback.record_copies(&mut encoder, &parts, j as u64 * stride);
-        }
-        let data = readback.submit_and_map(gpu, encoder, stride * count as u64)?;
+        let run = (calls.as_slice(), self.plan.as_slice());
+        let (data, layouts, stride) = record_run(gpu, (&*r, step, readback), state, run, &shape)?;
         self.uploads.batches += 1;
         self.run_taken = 0;
+        let read = (data.as_slice(), layouts.as_slice(), stride);
+        self.queue_run(read, &calls, state.max_edge, &shape, (capacity, limit));
+        Ok(())
+    }
 
+    /// The calls of a run: the `steps` of a sample of several when given, then the planned
+    /// samples from `from`, as many as the run's length; and how many of them are steps.
+    fn run_calls(
+        &self,
+        steps: Option<(usize, Dab, usize)>,
+        from: Option<usize>,
+    ) -> (Vec<RunCall>, usize) {
+        let mut calls: Vec<RunCall> = steps
+            .into_iter()
+            .flat_map(|(sample, dab, steps)| {
+                (0..steps).map(move |k| RunCall::Step {
+                    sample,
+                    dab,
+                    k,
+                    steps,
+                })
+            })
+            .collect();
+        let step_count = calls.len();
+        if let Some(from) = from {
+            let samples = (self.plan.len() - from).min(
+                self.run_length
+                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
+            );
+            calls.extend((from..from + samples).map(RunCall::Start));
+        }
+        (calls, step_count)
+    }
+
+    /// Queues what each of a run's `calls` left for the pipeline — `data`, `stride` bytes a
+    /// call, split as `layouts` — up to the call where the gate stopped the run (that one too
+    /// when the pipeline's call for it is answered from here, [`GpuKernels::after_stop`]), and
+    /// notes what the GPU filed for the host's next filing. `max_edge`: the pipeline's bound
+    /// on the edges at the run's start; `capacity`: the selection list's; `limit`: the step
+    /// limit.
+    fn queue_run(
+        &mut self,
+        (data, layouts, stride): (&[u8], &[SampleLayout], u64),
+        calls: &[RunCall],
+        max_edge: f32,
+        shape: &RunShape,
+        (capacity, limit): (usize, f32),
+    ) {
+        let (count, guess) = (shape.count, shape.guess);
+        let assumed_move = shape.ahead.assumed_move;
+        let list_bytes = shape.list_bytes();
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
         for (j, bytes) in data.chunks_exact(stride as usize).enumerate() {
@@ -368,7 +310,7 @@ impl GpuKernels {
                 },
                 ahead: None,
                 assumed_move,
-                max_edge: edge_bound(j),
+                max_edge: edge_bound(max_edge, assumed_move, j),
                 filed: j + 1 < count,
             };
             if status.stopped != 0 {
@@ -396,7 +338,7 @@ impl GpuKernels {
             if !queued.deformed.selection.is_empty() {
                 let targets = targets(found);
                 let clamp = layout.clamp.expect("passes recorded");
-                let (finals, backstop) = step.parse_clamp(parts.clamp, guess, clamp);
+                let (finals, backstop) = self.step.parse_clamp(parts.clamp, guess, clamp);
                 queued.deformed.targets = Some(targets.clone());
                 queued.ahead = Some(ClampedAhead {
                     vertices: queued.deformed.selection.iter().map(|&(v, _)| v).collect(),
@@ -410,7 +352,6 @@ impl GpuKernels {
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
         }
-        Ok(())
     }
 
     /// The first step of the stroke's sample numbered `sample`, of `steps`, under `dab` (given
@@ -605,27 +546,171 @@ impl GpuKernels {
     }
 }
 
-/// Puts the GPU's rows of `vertices` — positions, and the normals of every corner of the faces
-/// around them, which `moved_normals` may have rewritten — back to the mesh's, in one upload.
-pub(super) fn put_back_rows(
+/// How a run is recorded: `count` calls, each over `guess` slots of the selection list, their
+/// passes sized by `ahead` (`filter`: with the backstop filter).
+struct RunShape {
+    count: usize,
+    guess: usize,
+    ahead: AheadBounds,
+    filter: bool,
+}
+
+impl RunShape {
+    /// The bytes of a call's head of the selection list.
+    fn list_bytes(&self) -> u64 {
+        (self.guess * std::mem::size_of::<SelectedVertex>()) as u64
+    }
+
+    /// The bytes of a call's moving list.
+    fn moving_bytes(&self) -> u64 {
+        (self.guess * std::mem::size_of::<MovingVertex>()) as u64
+    }
+}
+
+/// The edges as the calls of a run before call `j` may have lengthened them, from the
+/// pipeline's bound `max_edge` at its start and the `assumed_move` of each (checked by the
+/// gate, and by the host when the pipeline reaches it).
+fn edge_bound(max_edge: f32, assumed_move: f32, j: usize) -> f32 {
+    max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move
+}
+
+/// Records a run's `calls` (see [`GpuKernels::gpu_run_ahead`]) in one submission — the
+/// overlay table rebuilt from its slots first, the gate started, each call's results copied
+/// aside — submits it and maps them all. Returns the bytes, each call's layout, and the stride
+/// between calls.
+fn record_run(
     gpu: &GpuContext,
-    resident: Option<&Resident>,
-    mesh: &Mesh,
-    vertices: &[u32],
-) {
-    let Some(r) = resident else {
-        return;
+    (r, step, readback): (&Resident, &StepBuffers, &mut ReusableBuffer),
+    state: &StrokeState<'_>,
+    (calls, plan): (&[RunCall], &[SampleProbe]),
+    shape: &RunShape,
+) -> Result<(Vec<u8>, Vec<SampleLayout>, u64), GpuError> {
+    let count = shape.count;
+    let list_bytes = shape.list_bytes();
+    let mut encoder = gpu.encoder("samples ahead");
+    r.hashed().record_gpu_table(gpu, &mut encoder)?;
+    // The gate's edge bound starts at the pipeline's; each call but the last grows it by
+    // the faces it turned (`moved_edges`) for the next one's verdict.
+    step.start_gate(gpu, state.max_edge);
+    let mut layouts = Vec::with_capacity(count);
+    let mut stride = 0;
+    for (j, &call) in calls.iter().enumerate() {
+        let (dab, source) = call.dab_and_source(plan);
+        let state = StrokeState {
+            max_edge: edge_bound(state.max_edge, shape.ahead.assumed_move, j),
+            ..*state
+        };
+        let recorded = record_call(
+            gpu,
+            &mut encoder,
+            (r, step),
+            &state,
+            (j, call, &dab, source),
+            shape,
+        )?;
+        let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
+        parts.extend_from_slice(&recorded.parts);
+        if j == 0 {
+            // Every call leaves the same parts, but for the brush frame's sums a step
+            // (whose frame is its dab's) leaves out: room for the largest.
+            let frame_bytes = match recorded.layout.frame_from_selection {
+                Some(_) => 0,
+                None => (FRAME_SUM_WORDS * 4) as u64,
+            };
+            stride = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>() + frame_bytes;
+            readback.reserve(gpu, stride * count as u64)?;
+        }
+        layouts.push(recorded.layout);
+        readback.record_copies(&mut encoder, &parts, j as u64 * stride);
+    }
+    let data = readback.submit_and_map(gpu, encoder, stride * count as u64)?;
+    Ok((data, layouts, stride))
+}
+
+/// Records call `j` of a run under `dab`: its step ([`record_sample`]); the normals its moves
+/// turned (for a step of a sample of several, those of all its steps after the last); and, but
+/// for the run's last call, the edges it lengthened (`moved_edges`, for the next call's gate)
+/// and the filing of its moved vertices in the overlay.
+fn record_call<'b>(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    (r, step): (&'b Resident, &'b StepBuffers),
+    state: &StrokeState<'_>,
+    (j, call, dab, source): (usize, RunCall, &Dab, FrameSource),
+    shape: &RunShape,
+) -> Result<RecordedSample<'b>, GpuError> {
+    let Some(topology) = &r.topology else {
+        unreachable!("reserve_sample made the topology resident");
     };
-    let mut corners: Vec<u32> = vertices
-        .iter()
-        .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
-        .collect();
-    corners.sort_unstable();
-    corners.dedup();
-    let mut patches = Patches::default();
-    patches.rows(&r.vertices.positions, mesh.positions(), vertices);
-    patches.rows(&r.normals, mesh.normals(), &corners);
-    patches.submit(gpu);
+    let (guess, moving_bytes) = (shape.guess, shape.moving_bytes());
+    let recorded = record_sample(
+        gpu,
+        encoder,
+        (r, step),
+        state,
+        dab,
+        (source, true),
+        guess,
+        Some(shape.ahead),
+        shape.filter,
+    )?;
+    let normals_of = match call {
+        RunCall::Start(_) => Some((step.moving.buffer(), guess)),
+        // The pipeline recomputes normals after a sample's last step: every step
+        // deforms on the normals from before the sample. Each step's moving list is
+        // kept until then, and vacated if the run stopped at one of them: the steps
+        // taken before the stop leave their normals to the pipeline.
+        RunCall::Step { k, steps, .. } => {
+            let held = step.held_moving.buffer();
+            encoder.copy_buffer_to_buffer(
+                step.moving.buffer(),
+                0,
+                held,
+                k as u64 * moving_bytes,
+                moving_bytes,
+            );
+            let last = k + 1 == steps;
+            if last {
+                record_gate_vacate(
+                    gpu,
+                    encoder,
+                    &GateBuffers {
+                        moving: held,
+                        ..step.gate(r)
+                    },
+                    steps * guess,
+                )?;
+            }
+            last.then_some((held, steps * guess))
+        }
+    };
+    if let Some(moving) = normals_of {
+        record_moved_normals(
+            gpu,
+            encoder,
+            (&r.vertices.positions, &topology.buffer),
+            topology.layout.vertex_rows_base,
+            moving,
+            &r.normals,
+        )?;
+    }
+    if j + 1 < shape.count {
+        record_moved_edges(
+            gpu,
+            encoder,
+            (&r.vertices.positions, &topology.buffer),
+            topology.layout.vertex_rows_base,
+            (step.moving.buffer(), guess),
+            &step.gate_status,
+        )?;
+        r.hashed().record_gpu_filing(
+            gpu,
+            encoder,
+            &r.vertices.positions,
+            (step.moving.buffer(), guess),
+        )?;
+    }
+    Ok(recorded)
 }
 
 /// The queue of samples recorded ahead, oldest first.

@@ -1,0 +1,245 @@
+//! The exact backstop, the collision response's second phase: after the proximity clamp, moves
+//! are undone until no moved face crosses another, turned over, or folded onto a neighbour —
+//! the edge–edge cases a vertex–triangle test cannot see. The candidate pairs come from a
+//! search of the step's region, or from a filter that ran on the GPU ([`Backstop`]); the exact
+//! predicates (`crate::geom`) decide them.
+
+use glam::Vec3;
+
+use super::region::{Region, StepMoves, map_with_scratch, triangle};
+use super::state::StrokeState;
+use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
+use crate::mesh::{INVALID, Mesh};
+
+/// What the first phase of a step leaves the exact backstop.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Backstop {
+    /// The region was gathered (around the step's starts and targets): search it.
+    Search,
+    /// The region was not gathered: gather it, then search.
+    Gather,
+    /// The face pairs of the first round were filtered already (by the GPU): the exact
+    /// predicates decide these, the ones the filter could not clear; `(f, f)` asks whether
+    /// face f turned over. The region is gathered only if an undo calls for another round.
+    Undecided(Vec<[u32; 2]>),
+}
+
+/// The exact backstop, [`collide_with`](super::collide_with)'s phase B: undoes moves until no
+/// moved face crosses any face (edge–edge crossings and a still vertex poking through a moving
+/// face are invisible to phase A, the proximity clamp). `before` holds each selected vertex's
+/// start, `backstop` what phase A left to do. Returns how many moves were undone.
+pub(super) fn undo_crossings(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    moves: StepMoves<'_>,
+    before: &[Vec3],
+    backstop: Backstop,
+) -> usize {
+    let (selection, _, target_of) = moves;
+    let mut still_moved: Vec<bool> = selection
+        .iter()
+        .zip(before)
+        .map(|(&(v, _), p)| mesh.positions()[v as usize] != *p)
+        .collect();
+    let mut reverted = 0;
+    let (mut gathered, mut undecided) = match backstop {
+        Backstop::Search => (true, None),
+        Backstop::Gather => (false, None),
+        Backstop::Undecided(pairs) => (false, Some(pairs)),
+    };
+    // First every moved face; after an undo, only the faces around the vertices put back (the
+    // others have not moved since they were found clean).
+    let mut changed: Vec<u32> = selection
+        .iter()
+        .zip(&still_moved)
+        .filter(|(_, m)| **m)
+        .map(|(&(v, _), _)| v)
+        .collect();
+    loop {
+        let mut moving_faces: Vec<u32> =
+            changed.iter().flat_map(|&v| mesh.faces_around(v)).collect();
+        moving_faces.sort_unstable();
+        moving_faces.dedup();
+        if moving_faces.is_empty() {
+            break;
+        }
+        let mut pairs: Vec<(u32, u32)> = match undecided.take() {
+            // The filter tested exactly the pairs the search below would: the same crossings.
+            Some(candidates) => candidates
+                .into_iter()
+                .map(|[f, g]| (f.min(g), f.max(g)))
+                .filter(|&pair| pair_crosses(mesh, pair, target_of, before))
+                .collect(),
+            None => {
+                if !gathered {
+                    gather_from_start(state, region, mesh, moves, before);
+                    gathered = true;
+                }
+                crossings(state, region, mesh, &moving_faces, (target_of, before))
+            }
+        };
+        if pairs.is_empty() {
+            break;
+        }
+        pairs.sort_unstable();
+        let undo = undo_pairs(mesh, pairs, (target_of, before), &mut still_moved);
+        let undone = undo.len();
+        reverted += undone;
+        changed = undo;
+        if undone == 0 {
+            // Crossings that involve no moving vertex were there before the step.
+            break;
+        }
+    }
+    reverted
+}
+
+/// Puts every vertex of the faces of `pairs` (ascending) that is still moved back where it
+/// was `before` the step, through `target_of`; returns them in the order they went back.
+fn undo_pairs(
+    mesh: &mut Mesh,
+    pairs: Vec<(u32, u32)>,
+    (target_of, before): (&[u32], &[Vec3]),
+    still_moved: &mut [bool],
+) -> Vec<u32> {
+    let mut undo: Vec<u32> = Vec::new();
+    for (f, g) in pairs {
+        // (f, f) marks a face that turned over.
+        for face in [f, g] {
+            for v in mesh.faces()[face as usize] {
+                let slot = target_of[v as usize];
+                if slot != INVALID && still_moved[slot as usize] {
+                    still_moved[slot as usize] = false;
+                    undo.push(v);
+                }
+            }
+        }
+    }
+    let positions = mesh.positions_mut();
+    for &v in &undo {
+        positions[v as usize] = before[target_of[v as usize] as usize];
+    }
+    undo
+}
+
+/// Gathers the region of a step whose selection has moved already: with the selection put back at
+/// `before` meanwhile, so that it is the region [`clamp_in_region`](super::clamp_in_region)
+/// gathers.
+fn gather_from_start(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, target_of): StepMoves<'_>,
+    before: &[Vec3],
+) {
+    let now: Vec<Vec3> = selection
+        .iter()
+        .map(|&(v, _)| mesh.positions()[v as usize])
+        .collect();
+    let positions = mesh.positions_mut();
+    for (&(v, _), &p) in selection.iter().zip(before) {
+        positions[v as usize] = p;
+    }
+    region.gather(state, mesh, selection, targets, target_of);
+    let positions = mesh.positions_mut();
+    for (&(v, _), p) in selection.iter().zip(now) {
+        positions[v as usize] = p;
+    }
+}
+
+/// Whether face `f` turned over in the step: its normal before (vertices of the selection at
+/// `before`, through `target_of`) and now point apart. A face turned over onto its neighbours
+/// (a fold within a fan, which twist and pinch can make) shares vertices with everything it
+/// overlaps, so no pair test sees it; its normal reversing does.
+fn turned_over(mesh: &Mesh, f: u32, target_of: &[u32], before: &[Vec3]) -> bool {
+    let old = mesh.faces()[f as usize].map(|w| {
+        let slot = target_of[w as usize];
+        if slot == INVALID {
+            mesh.positions()[w as usize]
+        } else {
+            before[slot as usize]
+        }
+    });
+    let (n_old, n_new) = (face_normal(old), face_normal(triangle(mesh, f)));
+    n_old.dot(n_new) <= 0.0 && n_old != Vec3::ZERO
+}
+
+/// The exact verdict on a candidate pair of the backstop: `(f, f)` whether f turned over; faces
+/// sharing a vertex whether they overlap beyond it; others whether they cross.
+fn pair_crosses(mesh: &Mesh, (f, g): (u32, u32), target_of: &[u32], before: &[Vec3]) -> bool {
+    if f == g {
+        return turned_over(mesh, f, target_of, before);
+    }
+    let faces = mesh.faces();
+    let (tri_f, tri_g) = (triangle(mesh, f), triangle(mesh, g));
+    if share_a_vertex(mesh, f, g) {
+        return neighbours_overlap(tri_f, faces[f as usize], tri_g, faces[g as usize]);
+    }
+    apart_faces_cross(tri_f, &Aabb::of_points(&tri_f), tri_g)
+}
+
+fn share_a_vertex(mesh: &Mesh, f: u32, g: u32) -> bool {
+    let faces = mesh.faces();
+    faces[g as usize]
+        .iter()
+        .any(|v| faces[f as usize].contains(v))
+}
+
+/// Whether two faces sharing no vertex cross (`box_f` the box of `tri_f`): boxes first.
+fn apart_faces_cross(tri_f: [Vec3; 3], box_f: &Aabb, tri_g: [Vec3; 3]) -> bool {
+    box_f.overlaps(&Aabb::of_points(&tri_g)) && triangles_intersect(tri_f, tri_g)
+}
+
+fn face_normal(t: [Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0])
+}
+
+/// The crossing pairs of `moving_faces` (ascending), searched in the gathered region: each
+/// moving face against itself (turned over), the faces around its vertices (overlap beyond
+/// a shared vertex) and the region's faces whose boxes meet its box. A pair of two moving
+/// faces is tested from the lower one.
+fn crossings(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    moving_faces: &[u32],
+    (target_of, before): (&[u32], &[Vec3]),
+) -> Vec<(u32, u32)> {
+    let is_moving = |f: u32| moving_faces.binary_search(&f).is_ok();
+    let found: Vec<Vec<(u32, u32)>> =
+        map_with_scratch(state.parallel, moving_faces, |scratch, &f| {
+            let tri_f = triangle(mesh, f);
+            let box_f = Aabb::of_points(&tri_f);
+            let faces = mesh.faces();
+            let mut found = Vec::new();
+            if turned_over(mesh, f, target_of, before) {
+                found.push((f, f));
+            }
+            // Nor may the step fold two faces around a shared vertex onto each other: they
+            // overlap while sharing a vertex, which the pair test skips.
+            let ids_f = faces[f as usize];
+            for w in ids_f {
+                for g in mesh.faces_around(w) {
+                    if g == f || (g < f && is_moving(g)) {
+                        continue;
+                    }
+                    let tri_g = triangle(mesh, g);
+                    if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
+                        found.push((f.min(g), f.max(g)));
+                    }
+                }
+            }
+            region.candidates(&box_f, scratch, |local| {
+                let g = region.faces[local];
+                if g == f || (g < f && is_moving(g)) || share_a_vertex(mesh, f, g) {
+                    return;
+                }
+                if apart_faces_cross(tri_f, &box_f, triangle(mesh, g)) {
+                    found.push((f.min(g), f.max(g)));
+                }
+            });
+            found
+        });
+    found.into_iter().flatten().collect()
+}

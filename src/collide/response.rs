@@ -1,0 +1,248 @@
+//! sLayer's collision response on the CPU: every moving vertex tested at its target against
+//! the faces near its move and pulled back along it to the collision distance (the proximity
+//! clamp, [`clamp_moves`] over [`pull_back`]), then the exact backstop (`super::backstop`).
+//! [`collide_with`] runs the two with the first phase given, which is where a GPU backend
+//! plugs in its own proximity passes.
+//!
+//! Each function runs in parallel (rayon) or sequentially, through the grids or by scanning
+//! everything; all give bit-identical results, because every per-vertex result depends only on
+//! the state before the pass and reductions are taken in a fixed order.
+
+use glam::Vec3;
+
+use super::backstop::{Backstop, undo_crossings};
+use super::neighbourhood::ring_vertices;
+use super::region::{Region, Scratch, StepMoves, map_with_scratch, triangle};
+use super::state::StrokeState;
+// The slack a vertex already within the collision distance is allowed (see its doc): the GPU's
+// `wgsl/proximity.wgsl` has the same.
+use crate::abi::CLAMP_SLACK;
+use crate::geom::{Aabb, closest_point_on_triangle};
+use crate::mesh::Mesh;
+
+/// Bisection rounds when clamping a move: 2⁻¹⁶ of a step.
+const CLAMP_ROUNDS: u32 = 16;
+
+/// Tests one moving vertex, now at its tentative position, against the faces near its move
+/// (only those in `changed`, if given). Returns the position it must be pulled back to, if any.
+/// Public as the reference for the GPU kernel `proximity` (`tests/gpu_parity/proximity.rs`).
+pub fn pull_back(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    v: u32,
+    start: Vec3,
+    changed: Option<&[bool]>,
+    scratch: &mut Scratch,
+) -> Option<Vec3> {
+    let d = state.collision_distance;
+    let x = mesh.positions()[v as usize];
+    let query = Aabb::of_points(&[start, x]).expanded(d);
+    let own_layer = mesh.vertex_layers()[v as usize];
+    let layers = mesh.face_layers();
+    let mut ring_ready = false;
+    let mut ring = std::mem::take(&mut scratch.ring);
+    let mut nearby = std::mem::take(&mut scratch.nearby);
+    nearby.clear();
+    region.candidates(&query, scratch, |local| nearby.push(local as u32));
+    let mut t = 1.0f32;
+    for &local in &nearby {
+        if changed.is_some_and(|marks| !marks[local as usize]) {
+            continue;
+        }
+        let f = region.faces[local as usize];
+        let tri = mesh.faces()[f as usize];
+        if tri.contains(&v) || !region.boxes[local as usize].within(x, d) {
+            continue;
+        }
+        // The vertex's own neighbourhood is near by construction, not by collision.
+        if layers[f as usize] == own_layer {
+            if !ring_ready {
+                ring_vertices(mesh, v, state.ring, &mut ring);
+                ring_ready = true;
+            }
+            if tri.iter().any(|u| ring.contains(u)) {
+                continue;
+            }
+        }
+        let [a, b, c] = triangle(mesh, f);
+        let distance = |y: Vec3| closest_point_on_triangle(y, a, b, c).distance(y);
+        let here = distance(x);
+        if here >= d {
+            continue;
+        }
+        // Never closer than the collision distance, nor closer than it already was (give or
+        // take the slack).
+        let threshold = d.min(distance(start));
+        if here >= threshold - CLAMP_SLACK * d {
+            continue;
+        }
+        // Distance along the move is convex and safe at its start: bisect for the last safe
+        // fraction, always over the whole move so that the result does not depend on the
+        // order faces are met in.
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        for _ in 0..CLAMP_ROUNDS {
+            let mid = 0.5 * (lo + hi);
+            if distance(start + (x - start) * mid) >= threshold {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        t = t.min(lo);
+    }
+    scratch.ring = ring;
+    scratch.nearby = nearby;
+    (t < 1.0).then(|| start + (x - start) * t)
+}
+
+/// What the collision phase did.
+#[derive(Debug, Default)]
+pub struct CollisionOutcome {
+    /// Final positions, one per selected vertex.
+    pub positions: Vec<Vec3>,
+    pub clamped: usize,
+    pub reverted: usize,
+}
+
+/// Passes of the proximity test before giving up on converging (each pass only re-tests against
+/// faces that the previous one changed; two passes are the rule).
+pub const MAX_PASSES: usize = 8;
+
+/// Proximity test and clamping (sLayer's narrow phase and response), then the exact backstop.
+/// Leaves the final positions in `mesh`.
+///
+/// Every moving vertex is tested at its target against the faces at *their* targets — the state
+/// the step is heading for — not against where they were: a patch carried by grab or turned by
+/// twist then never collides with its own old position, and two active layers moving together
+/// keep their gap instead of colliding with each other's past. A vertex closer than the
+/// collision distance `d` to a face outside its neighbourhood is pulled back along its own move
+/// to the last point at distance `min(d, distance from its start)`. Pulling some vertices back
+/// moves their faces, so the test repeats against the faces that changed, all vertices of a
+/// pass deciding from the same state (Jacobi), which keeps the result independent of thread
+/// count and search order.
+pub fn collide(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    selection: &[(u32, f32)],
+    targets: &[Vec3],
+    target_of: &[u32],
+) -> CollisionOutcome {
+    let moves = (selection, targets, target_of);
+    collide_with(state, region, mesh, moves, |region, mesh, before| {
+        clamp_in_region(state, region, mesh, moves, before)
+    })
+}
+
+/// [`collide`] with its first phase — targets written in, proximity passes — done by `clamp`
+/// (given the region, the mesh and each selected vertex's start), which must leave the
+/// positions [`clamp_moves`] would, and say what it leaves the backstop: a GPU backend runs
+/// it there, and filters the backstop's first round too.
+pub fn collide_with(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    moves: StepMoves<'_>,
+    clamp: impl FnOnce(&mut Region, &mut Mesh, &[Vec3]) -> Backstop,
+) -> CollisionOutcome {
+    let (selection, targets, _) = moves;
+    let before: Vec<Vec3> = selection
+        .iter()
+        .map(|&(v, _)| mesh.positions()[v as usize])
+        .collect();
+    let backstop = clamp(region, mesh, &before);
+    let clamped_count = selection
+        .iter()
+        .zip(targets)
+        .filter(|((v, _), q)| mesh.positions()[*v as usize] != **q)
+        .count();
+
+    let reverted = undo_crossings(state, region, mesh, moves, &before, backstop);
+    let positions = selection
+        .iter()
+        .map(|&(v, _)| mesh.positions()[v as usize])
+        .collect();
+    CollisionOutcome {
+        positions,
+        clamped: clamped_count,
+        reverted,
+    }
+}
+
+/// The CPU's first phase: the region gathered, then [`clamp_moves`].
+pub fn clamp_in_region(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, target_of): StepMoves<'_>,
+    before: &[Vec3],
+) -> Backstop {
+    region.gather(state, mesh, selection, targets, target_of);
+    clamp_moves(state, region, mesh, selection, targets, before);
+    Backstop::Search
+}
+
+/// The first phase of [`collide`] (sLayer's narrow phase and response): the selection moved to
+/// its targets, then Jacobi passes of [`pull_back`] until none pulls a vertex back. `before`
+/// holds each selected vertex's start; the positions are left in `mesh`.
+pub fn clamp_moves(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &mut Mesh,
+    selection: &[(u32, f32)],
+    targets: &[Vec3],
+    before: &[Vec3],
+) {
+    {
+        let positions = mesh.positions_mut();
+        for (&(v, _), &q) in selection.iter().zip(targets) {
+            positions[v as usize] = q;
+        }
+    }
+
+    // Per local face: changed by the last pass (the first pass tests every face).
+    let mut changed: Option<Vec<bool>> = None;
+    for pass in 0..MAX_PASSES {
+        let moving: Vec<usize> = (0..selection.len())
+            .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
+            .collect();
+        let mesh_view: &Mesh = mesh;
+        let changed_view = changed.as_deref();
+        let pulled: Vec<Option<Vec3>> = map_with_scratch(state.parallel, &moving, |scratch, &i| {
+            pull_back(
+                state,
+                region,
+                mesh_view,
+                selection[i].0,
+                before[i],
+                changed_view,
+                scratch,
+            )
+        });
+        let last_pass = pass + 1 == MAX_PASSES;
+        let mut moved_back = Vec::new();
+        {
+            let positions = mesh.positions_mut();
+            for (&i, x) in moving.iter().zip(pulled) {
+                let Some(x) = x else { continue };
+                let v = selection[i].0;
+                // Out of passes: what still collides goes back to where it was.
+                positions[v as usize] = if last_pass { before[i] } else { x };
+                moved_back.push(v);
+            }
+        }
+        if moved_back.is_empty() {
+            break;
+        }
+        let mut marks = vec![false; region.faces.len()];
+        for &v in &moved_back {
+            for f in mesh.faces_around(v) {
+                if let Some(local) = region.local(f) {
+                    marks[local] = true;
+                }
+            }
+        }
+        changed = Some(marks);
+    }
+}

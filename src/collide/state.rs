@@ -1,0 +1,19 @@
+//! What one stroke's steps read and never change: the grid, the active layers, the collision
+//! set-up and a bound on the edges. It lives here, in the lowest module that reads all of it,
+//! so that the collision response, the brush's selection and deformation (`pipeline::step`)
+//! and the GPU kernels share it without `collide` reaching up into the pipeline.
+
+use crate::grid::SpatialHash;
+
+/// Everything a step reads that lasts for the whole stroke.
+pub struct StrokeState<'a> {
+    pub grid: Option<&'a SpatialHash>,
+    pub active: &'a [bool],
+    pub parallel: bool,
+    /// Collision distance (world units).
+    pub collision_distance: f32,
+    /// Graph distance of the neighbourhood a vertex skips in its own layer.
+    pub ring: u32,
+    /// An upper bound on every edge length right now.
+    pub max_edge: f32,
+}
