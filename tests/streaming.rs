@@ -212,9 +212,15 @@ fn check_gpu_chunks(
             "{per_call:?} samples per call: deviation from the cpu {:.2e} L, {uploads:?}",
             deviation / edge
         );
-        assert!(deviation <= 1e-4 * edge, "{per_call:?}: {deviation} > 1e-4 L");
+        assert!(
+            deviation <= 1e-4 * edge,
+            "{per_call:?}: {deviation} > 1e-4 L"
+        );
         let from_first = first.as_ref().map_or(0.0, |f| largest_deviation(f, &mesh));
-        assert!(from_first <= 1e-4 * edge, "{per_call:?}: {from_first} from the first");
+        assert!(
+            from_first <= 1e-4 * edge,
+            "{per_call:?}: {from_first} from the first"
+        );
         assert_eq!(find_intersections(&mesh).total(), 0);
         read_backs.push(uploads.read_backs);
         first.get_or_insert(mesh);

@@ -177,7 +177,7 @@ const PARITY_TESTS: &[(&str, &[&str])] = &[
         ],
     ),
     (
-        "backstop",
+        "backstop_filter",
         &["backstop_filter_matches_cpu_mirror_and_keeps_every_crossing"],
     ),
     (
@@ -239,7 +239,7 @@ fn parity_sources(folder: &Path) -> Vec<String> {
 
 #[test]
 fn every_kernel_has_a_cpu_mirror_and_a_parity_test() {
-    // DESIGN §6: every kernel in `wgsl/` has a mirror of the same name in `src/cpu/` (a module
+    // docs/gpu.md: every kernel in `wgsl/` has a mirror of the same name in `src/cpu/` (a module
     // of `slayer::cpu`: declared, so the crate would not build without the file) and at least
     // one parity test, and every test named here is a test.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -501,7 +501,7 @@ fn wgsl_constants_match_the_host() {
         slayer::abi::CLAMP_SLACK
     );
     assert_eq!(
-        naga_f32_constant("backstop", "MARGIN"),
+        naga_f32_constant("backstop_filter", "MARGIN"),
         slayer::abi::BACKSTOP_MARGIN
     );
     for kernel in ["proximity", "apply_moves"] {
@@ -520,7 +520,7 @@ fn wgsl_constants_match_the_host() {
         ("brush_frame", slayer::abi::FRAME_WORKGROUP_SIZE),
         ("apply_moves", slayer::abi::APPLY_WORKGROUP_SIZE),
         ("proximity", slayer::abi::PROXIMITY_WORKGROUP_SIZE),
-        ("backstop", slayer::abi::BACKSTOP_WORKGROUP_SIZE),
+        ("backstop_filter", slayer::abi::BACKSTOP_WORKGROUP_SIZE),
         ("moving_entries", slayer::abi::ENTRIES_WORKGROUP_SIZE),
         ("longest_move", slayer::abi::GATE_WORKGROUP_SIZE),
         ("sample_gate", slayer::abi::GATE_WORKGROUP_SIZE),
@@ -606,7 +606,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
         "proximity",
         "apply_moves",
         "moving_entries",
-        "backstop",
+        "backstop_filter",
         "moved_normals",
         "overlay_members",
         "sample_gate",
@@ -646,7 +646,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
     assert_layout!("moving_entries", SelectedVertex { vertex, weight });
 
     assert_layout!(
-        "backstop",
+        "backstop_filter",
         BackstopParams {
             cell_reach,
             vertex_reach,
@@ -734,7 +734,7 @@ fn paged_kernels_declare_the_pages_and_the_shift_the_host_binds() {
     // sets when it compiles the kernel.
     let expected_groups = [
         ("proximity", 2),
-        ("backstop", 1),
+        ("backstop_filter", 1),
         ("vertex_normals", 1),
         ("moved_normals", 1),
         ("moved_edges", 1),

@@ -1,4 +1,4 @@
-// Writes a step's moves into the positions, around the proximity passes (DESIGN §3
+// Writes a step's moves into the positions, around the proximity passes (docs/design.md, "A stroke"
 // "collide"), so that a whole Jacobi loop runs on the GPU with one read-back at its end.
 // One invocation per entry of the moving list; `mode` says which write:
 //

@@ -1,4 +1,4 @@
-// Second pass of the spatial-hash build (DESIGN §2): how many vertices each bucket holds, and
+// Second pass of the spatial-hash build (docs/design.md, "Data"): how many vertices each bucket holds, and
 // each vertex's rank among them. The rank comes from the atomic, so `scatter` needs no atomics
 // and no cursor buffer; the order within a bucket is whatever order the atomics ran in.
 // Dead vertices are left out, as `SpatialHash::build` leaves them out.

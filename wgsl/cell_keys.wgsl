@@ -1,4 +1,4 @@
-// First pass of the spatial-hash build (DESIGN §2): the hash-table slot of every vertex's cell.
+// First pass of the spatial-hash build (docs/design.md, "Data"): the hash-table slot of every vertex's cell.
 // CPU mirror: src/cpu/cell_keys.rs.
 
 #import shared/grid

@@ -1,4 +1,4 @@
-// Brush deformation (sLayer Algorithm 2 "deform"; DESIGN §3): the target position of every
+// Brush deformation (sLayer Algorithm 2 "deform"; docs/design.md, "A stroke"): the target position of every
 // selected vertex under the dab's field, as `src/brush/field.rs::displacement` computes it.
 // One invocation per selection entry; `targets[i]` belongs to `selected[i]`. Non-finite
 // targets (absurd input) leave the vertex where it is, as on the CPU.

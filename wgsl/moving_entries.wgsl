@@ -1,6 +1,6 @@
 // The moving entries of a step (shared/moves) built from the selection list on the GPU, each
 // with its vertex's exclusion ring, so that the proximity passes follow `select` and `deform`
-// in the same submission (DESIGN §3 "collide"; on the host, `moving_vertices` in
+// in the same submission (docs/design.md, "A stroke"; on the host, `moving_vertices` in
 // src/gpu/proximity.rs builds the same entries). One invocation per slot of the list up to
 // `capacity`, the room the passes after it were sized for: slots past the selection's count
 // become vacant entries.

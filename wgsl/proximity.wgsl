@@ -1,5 +1,5 @@
 // Vertex–triangle proximity and the collision response of one Jacobi pass (sLayer Algorithm 2
-// "collide"; DESIGN §3): `pull_back` of src/pipeline/step.rs for every entry of the step's
+// "collide"; docs/design.md, "A stroke"): `pull_back` of src/collide/response.rs for every entry of the step's
 // selection. An entry whose vertex sits at its start has nothing to test. Otherwise the vertex,
 // at its tentative position x, is tested against every face near x outside its own
 // neighbourhood, and where a face is closer than min(d, its distance from the start) the move
@@ -59,7 +59,7 @@ struct ProximityParams {
 
 // Bisection rounds when clamping a move: 2^-16 of a step (CLAMP_ROUNDS of the CPU).
 const CLAMP_ROUNDS: u32 = 16u;
-// CLAMP_SLACK of src/pipeline/step.rs: 1/1024.
+// CLAMP_SLACK of src/abi/moves.rs: 1/1024.
 const CLAMP_SLACK: f32 = 0.0009765625;
 const WORKGROUP_SIZE: u32 = 64u;
 

@@ -1,4 +1,4 @@
-// Brush selection through the GPU hash table (sLayer Algorithm 2 "select"; DESIGN §3): the
+// Brush selection through the GPU hash table (sLayer Algorithm 2 "select"; docs/design.md, "A stroke"): the
 // vertices of active layers, neither masked nor dead, within the brush sphere and with a
 // positive falloff weight, appended to a compact list by an atomic counter.
 //

@@ -23,7 +23,7 @@ pub const CLAMP_SLACK: f32 = 1.0 / 1024.0;
 pub const PULL_SCALE: f32 = 65536.0;
 
 /// Share of a pair's size below which a separation is not trusted (`MARGIN` of
-/// `wgsl/backstop.wgsl`).
+/// `wgsl/backstop_filter.wgsl`).
 pub const BACKSTOP_MARGIN: f32 = 1.0 / 4096.0;
 
 /// `MovingVertex` in `wgsl/shared/moves.wgsl`: one entry of a step's selection.
@@ -137,7 +137,7 @@ impl ApplyParams {
     }
 }
 
-/// `BackstopParams` in `wgsl/backstop.wgsl`.
+/// `BackstopParams` in `wgsl/backstop_filter.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct BackstopParams {

@@ -1,4 +1,4 @@
-//! Brushes as deformation fields with a falloff (DESIGN §3), and strokes: polylines of samples
+//! Brushes as deformation fields with a falloff (docs/design.md, "A stroke"), and strokes: polylines of samples
 //! resampled at a spacing relative to the radius.
 
 mod falloff;

@@ -8,7 +8,7 @@
 //! the GPU path or the pipeline, so either can change without the reference moving.
 
 mod apply_moves;
-mod backstop;
+mod backstop_filter;
 mod brush_frame;
 mod cell_counts;
 mod cell_keys;
@@ -39,7 +39,7 @@ pub use crate::abi::{
 };
 
 pub use apply_moves::{ApplyBuffers, apply_moves};
-pub use backstop::{BackstopInputs, backstop};
+pub use backstop_filter::{BackstopInputs, backstop_filter};
 pub use brush_frame::{FrameInputs, brush_frame, frame_from_sums, from_fixed, to_fixed};
 pub use cell_counts::cell_counts;
 pub use cell_keys::cell_keys;

@@ -1,4 +1,4 @@
-//! The spatial hash on the GPU (DESIGN §2): a counting sort of vertex ids by bucket into a CSR
+//! The spatial hash on the GPU (docs/design.md, "Data"): a counting sort of vertex ids by bucket into a CSR
 //! table, rebuilt from scratch by four kernels — `cell_keys` → `cell_counts` → exclusive scan
 //! (`scan`, `scan_add`) → `scatter`.
 //!

@@ -1,9 +1,9 @@
-//! The GPU path: adapter choice, shader loading and the compute kernels' host side (DESIGN §6).
+//! The GPU path: adapter choice, shader loading and the compute kernels' host side (docs/gpu.md).
 //! Each kernel in `wgsl/` has a CPU mirror of the same name in [`crate::cpu`].
 
 mod apply_moves;
 mod backend;
-mod backstop;
+mod backstop_filter;
 mod brush_frame;
 mod cell_keys;
 mod context;
@@ -39,10 +39,10 @@ pub use crate::abi::{
 
 pub use apply_moves::{AppliedMoves, ApplyMovesBuffers, record_apply_moves, run_apply_moves};
 pub use backend::{GpuKernels, face_capacity, resident_bytes, vertex_capacity};
-pub use backstop::{
+pub use backstop_filter::{
     BackstopBuffers, BackstopQuery, PAIRS_GUESS, UndecidedPairs, backstop_inputs, backstop_params,
-    backstop_query_params, check_backstop_invocations, moved_edge_bound, record_backstop,
-    run_backstop,
+    backstop_query_params, check_backstop_invocations, moved_edge_bound, record_backstop_filter,
+    run_backstop_filter,
 };
 pub use brush_frame::{frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame};
 pub use cell_keys::{record_cell_keys, run_cell_keys};

@@ -54,7 +54,10 @@ pub const KERNELS: &[(&str, &str)] = &[
         "moving_entries",
         include_str!("../../wgsl/moving_entries.wgsl"),
     ),
-    ("backstop", include_str!("../../wgsl/backstop.wgsl")),
+    (
+        "backstop_filter",
+        include_str!("../../wgsl/backstop_filter.wgsl"),
+    ),
     (
         "vertex_normals",
         include_str!("../../wgsl/vertex_normals.wgsl"),

@@ -1,5 +1,5 @@
 //! The uniform grid stored as a hash table (sLayer §3 "Grid-Based Broad Phase", after Teschner
-//! et al. 2003; DESIGN §2). Cell side = target edge length `L`; vertices, not triangles, are
+//! et al. 2003; docs/design.md, "Data"). Cell side = target edge length `L`; vertices, not triangles, are
 //! inserted. Because edges stay near `L`, every face within distance `r` of a point has a vertex
 //! within `r + longest edge`, so one vertex grid answers brush selection, the collision broad
 //! phase, picking and the remesher's proximity checks.

@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Index of a layer. Layers are labels on faces and vertices (DESIGN §1), not separate meshes.
+/// Index of a layer. Layers are labels on faces and vertices (docs/design.md, "Data"), not separate meshes.
 pub type LayerId = u32;
 
 /// A per-vertex BRDF in a linear parametrization: diffuse albedo, specular albedo and a linearized

@@ -1,4 +1,4 @@
-//! One multi-layer triangle mesh (DESIGN §1).
+//! One multi-layer triangle mesh (docs/design.md, "Data").
 //!
 //! Layers are labels on faces and vertices, not separate meshes: the sLayer paper applies every
 //! operation "to individual vertices and triangles, with no special handling between different

@@ -74,7 +74,7 @@ pub struct PipelineSettings {
     pub remeshing: Remeshing,
 }
 
-/// When the pipeline remeshes what the brush touched (sLayer discusses both; DESIGN §3–4).
+/// When the pipeline remeshes what the brush touched (sLayer discusses both; docs/design.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Remeshing {
     /// Never: edges stretch and shrink with the brush.

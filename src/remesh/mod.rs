@@ -1,5 +1,5 @@
 //! Local adaptive isotropic remeshing after each stroke (Dunyach et al. 2013, in the loop of
-//! Botsch & Kobbelt 2004; DESIGN §4): within the faces around every vertex the stroke touched,
+//! Botsch & Kobbelt 2004; docs/design.md, "Remeshing"): within the faces around every vertex the stroke touched,
 //! plus a ring, split edges longer than 4/3·L, collapse edges shorter than 4/5·L, flip edges
 //! toward valence 6 (4 on boundaries), and relax vertices tangentially with projection back onto
 //! the surface as it was before remeshing. L stays constant: sLayer's edge length assumption.

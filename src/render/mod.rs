@@ -1,4 +1,4 @@
-//! Reflectance and the preview renderer (DESIGN §7, sLayer's "Reflectance Editing").
+//! Reflectance and the preview renderer (docs/design.md, "Materials and rendering", sLayer's "Reflectance Editing").
 //!
 //! [`brdf`] is the microfacet model over the linear BRDF parametrization, on the CPU: the
 //! reference the WGSL preview shader mirrors and the tests check. [`preview`] renders a mesh

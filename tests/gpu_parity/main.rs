@@ -6,7 +6,7 @@
 //! each kernel names its parity tests here); `common` holds what they share.
 
 mod apply_moves;
-mod backstop;
+mod backstop_filter;
 mod brush_frame;
 mod common;
 mod deform;

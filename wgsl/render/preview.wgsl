@@ -1,4 +1,4 @@
-// The preview renderer (DESIGN §7): per-vertex BRDFs shaded with the microfacet model of
+// The preview renderer (docs/design.md, "Materials and rendering"): per-vertex BRDFs shaded with the microfacet model of
 // `shared/brdf`, a key and a fill light, an optional wireframe and per-layer false colours.
 // Host side: src/render/preview.rs.
 //

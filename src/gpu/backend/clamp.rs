@@ -15,7 +15,8 @@ use crate::gpu::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyMovesBuffers, ApplyParams, BackstopBuffers,
     BackstopParams, GpuContext, GpuError, PROXIMITY_WORKGROUP_SIZE, ProximityBuffers,
     ProximityParams, backstop_params, check_invocations, moved_edge_bound, moving_vertices,
-    pass_params, record_apply_moves, record_backstop, record_dispatch_args, record_proximity,
+    pass_params, record_apply_moves, record_backstop_filter, record_dispatch_args,
+    record_proximity,
 };
 use crate::mesh::Mesh;
 use crate::pipeline::{BackstopFilter, Uploads};
@@ -169,7 +170,7 @@ pub(super) fn tally(stats: &mut BackstopFilter, backstop: &Backstop, filter: boo
 /// else in `step.rings`) and targets in `step.targets`: targets placed, a first pass against every
 /// face, then passes against the faces pulled-back vertices moved until one pulls nothing (the GPU
 /// sizes each pass from the last), the last sending what still collides back to its start; final
-/// positions gathered; then, with `filter`, the backstop filter (`wgsl/backstop.wgsl`) over the
+/// positions gathered; then, with `filter`, the backstop filter (`wgsl/backstop_filter.wgsl`) over the
 /// faces that moved. Buffers reserved beforehand (`StepBuffers::reserve_clamp`); the topology
 /// resident.
 pub(super) fn record_clamp(
@@ -332,7 +333,7 @@ fn record_passes(
     Ok(())
 }
 
-/// [`record_clamp`]'s backstop filter (`wgsl/backstop.wgsl`) over the faces that moved, after
+/// [`record_clamp`]'s backstop filter (`wgsl/backstop_filter.wgsl`) over the faces that moved, after
 /// the passes: the pairs it cannot clear go to `step.pairs`, within room for
 /// `step.pair_capacity` of them. Returns the bytes of that room.
 fn record_filter(
@@ -375,7 +376,7 @@ fn record_filter(
         None,
     )?;
     encoder.clear_buffer(&step.pair_count, 0, None);
-    record_backstop(
+    record_backstop_filter(
         gpu,
         encoder,
         &BackstopBuffers {

@@ -103,10 +103,6 @@ pub struct GpuKernels {
     plan: Vec<SampleProbe>,
     plan_first: usize,
     plan_next: usize,
-    /// How many samples the next run ahead records, and how many of the last run the pipeline
-    /// took (`run_ahead`).
-    run_length: usize,
-    run_taken: usize,
     /// Samples run ahead in such a submission, waiting for the pipeline (`run_ahead`).
     queued: run_ahead::Queue,
     /// The vertices and final positions of the last step taken from passes run ahead, to see
@@ -167,8 +163,6 @@ impl GpuKernels {
             plan: Vec::new(),
             plan_first: 0,
             plan_next: 0,
-            run_length: 0,
-            run_taken: 0,
             queued: run_ahead::Queue::new(),
             taken: None,
             taken_filed: false,

@@ -60,16 +60,13 @@ use crate::pipeline::{CallAt, Deformed, FrameSource, SampleProbe};
 
 /// At most this many samples in one submission: the read-back grows with each, and each later
 /// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
-/// their reach grows with the run. A run starts at two samples and doubles after every run
-/// taken whole; a run cut short makes the next one as long as what was taken of it (at least
-/// two). A run the gate stops still has the GPU go through the recorded passes of every sample
-/// after the stop, emptied but dispatched: starting every run at the rest of the stroke read
-/// the run-ahead test back twice instead of 4 times, but in 19–26 s of lavapipe against 15–21
-/// s, and on a hardware GPU, where each dispatch has a fixed cost, a 32-sample run stopped early
-/// would waste hundreds of them (in the 100K-face plaster bench 1 sample in 7 takes several
-/// steps or has a move undone by the exact backstop, and either stops a run).
+/// their reach grows with the run. A run records every sample given from where it starts, up
+/// to this many: a stroke given whole costs one blocking read-back per run, one more per gate
+/// stop. A run the gate stops still has the GPU go through the recorded passes of every sample
+/// after the stop, emptied but dispatched (a fixed cost per dispatch on a hardware GPU); runs
+/// that started at two samples and doubled spent fewer such dispatches but read back 4 times
+/// where this reads back once or twice (`docs/gpu.md`).
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
-const FIRST_SAMPLES_AHEAD: usize = 2;
 
 /// A sample of at most this many steps has them recorded in a run (each step's moving list
 /// is kept until the sample's last, for the normals): the bench strokes took at most 3.
@@ -165,8 +162,7 @@ impl GpuKernels {
     }
 
     /// Records in one submission the `steps` of a sample of several (all under its dab) when
-    /// given, then the planned samples from `from` (as many as the run's length, at most
-    /// [`MAX_SAMPLES_AHEAD`]), and queues what each left for the pipeline; nothing when that
+    /// given, then the given samples from `from` (at most [`MAX_SAMPLES_AHEAD`]), and queues what each left for the pipeline; nothing when that
     /// is fewer than two. The passes are sized as a single step's would be (`assumed_move`:
     /// twice the last move, within `limit`), each later call's from edges grown by
     /// [`EDGE_GROWTH_AHEAD`] of that move per call before it.
@@ -228,14 +224,13 @@ impl GpuKernels {
         let run = (calls.as_slice(), self.plan.as_slice());
         let (data, layouts, stride) = record_run(gpu, (&*r, step, readback), state, run, &shape)?;
         self.uploads.batches += 1;
-        self.run_taken = 0;
         let read = (data.as_slice(), layouts.as_slice(), stride);
         self.queue_run(read, &calls, state.max_edge, &shape, (capacity, limit));
         Ok(())
     }
 
-    /// The calls of a run: the `steps` of a sample of several when given, then the planned
-    /// samples from `from`, as many as the run's length; and how many of them are steps.
+    /// The calls of a run: the `steps` of a sample of several when given, then the given
+    /// samples from `from` (at most [`MAX_SAMPLES_AHEAD`]); and how many of them are steps.
     fn run_calls(
         &self,
         steps: Option<(usize, Dab, usize)>,
@@ -254,10 +249,7 @@ impl GpuKernels {
             .collect();
         let step_count = calls.len();
         if let Some(from) = from {
-            let samples = (self.plan.len() - from).min(
-                self.run_length
-                    .clamp(FIRST_SAMPLES_AHEAD, MAX_SAMPLES_AHEAD),
-            );
+            let samples = (self.plan.len() - from).min(MAX_SAMPLES_AHEAD);
             calls.extend((from..from + samples).map(RunCall::Start));
         }
         (calls, step_count)
@@ -316,7 +308,6 @@ impl GpuKernels {
             if status.stopped != 0 {
                 // The gate stopped the run here, before this call moved anything, and the
                 // calls after it selected nothing: there is nothing to put back.
-                self.run_length = j.max(FIRST_SAMPLES_AHEAD);
                 self.uploads.gated_ahead += 1;
                 if let RunCall::Start(index) = call
                     && self.after_stop(index, status, limit)
@@ -475,11 +466,6 @@ impl GpuKernels {
             }
         }
         let queued = self.queued.pop_front()?;
-        self.run_taken += 1;
-        if self.queued.is_empty() {
-            // The whole run was taken as predicted.
-            self.run_length = (2 * self.run_taken).min(MAX_SAMPLES_AHEAD);
-        }
         match queued.call {
             RunCall::Start(_) => self.uploads.samples_ahead += 1,
             RunCall::Step { .. } => {
@@ -502,9 +488,6 @@ impl GpuKernels {
     /// [`GpuKernels::drop_queued`], putting back the rows of `also` too.
     fn drop_queued_and(&mut self, mesh: &Mesh, also: &[u32]) {
         let queued = std::mem::take(&mut self.queued);
-        if !queued.is_empty() {
-            self.run_length = self.run_taken.max(FIRST_SAMPLES_AHEAD);
-        }
         let mut vertices: Vec<u32> = queued.iter().flat_map(moved_by).copied().collect();
         vertices.extend_from_slice(also);
         if queued

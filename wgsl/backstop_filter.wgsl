@@ -1,4 +1,4 @@
-// The exact backstop's filter (DESIGN §3; phase B of `collide_with` in src/pipeline/step.rs).
+// The exact backstop's filter (docs/design.md, "A stroke"; phase B of `collide_with` in src/collide/response.rs).
 // After the proximity passes, no face a step moved may cross another face, nor turn over, nor
 // fold onto a face it shares a vertex with. Deciding that exactly takes the CPU's predicates;
 // this kernel settles the many pairs that are plainly apart in f32, with margins far above

@@ -99,7 +99,7 @@ fn backstop_filter_matches_cpu_mirror_and_keeps_every_crossing() {
                 cell_size: scene.edge,
                 capacity: 1 << 16,
             };
-            let actual = slayer::gpu::run_backstop(&gpu, &query).expect("GPU run");
+            let actual = slayer::gpu::run_backstop_filter(&gpu, &query).expect("GPU run");
 
             let mesh = &scene.mesh;
             let (moving, moved) = slayer::gpu::backstop_inputs(&query);
@@ -112,7 +112,7 @@ fn backstop_filter_matches_cpu_mirror_and_keeps_every_crossing() {
             );
             let table = mesh_table(mesh, params.inv_cell_size, table_size);
             let flat = packed(&current);
-            let mut mirror = slayer::cpu::backstop(
+            let mut mirror = slayer::cpu::backstop_filter(
                 &params,
                 &slayer::cpu::BackstopInputs {
                     positions: &flat,

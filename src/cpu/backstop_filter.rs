@@ -1,4 +1,4 @@
-//! Mirror of `wgsl/backstop.wgsl`: the f32 filter in front of the exact backstop, with the
+//! Mirror of `wgsl/backstop_filter.wgsl`: the f32 filter in front of the exact backstop, with the
 //! shader's invocations (entry, row of cells of the box around its moved vertex), loops (the
 //! first row's neighbour tests, the row's cells near the entry's faces, bucket entries, their
 //! faces, the entry's faces) and tests. Pairs come
@@ -256,7 +256,7 @@ impl Filter<'_, '_> {
 
 /// The pairs every invocation (entry, row of cells of the box around its moved vertex) appends, in
 /// invocation order; the kernel keeps the first `params.capacity` and counts them all.
-pub fn backstop(params: &BackstopParams, inputs: &BackstopInputs<'_>) -> Vec<[u32; 2]> {
+pub fn backstop_filter(params: &BackstopParams, inputs: &BackstopInputs<'_>) -> Vec<[u32; 2]> {
     let mut pairs = Vec::new();
     let mut filter = Filter {
         params,

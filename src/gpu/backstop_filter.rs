@@ -1,4 +1,4 @@
-//! Host side of `wgsl/backstop.wgsl`: the f32 filter in front of the exact backstop. After a
+//! Host side of `wgsl/backstop_filter.wgsl`: the f32 filter in front of the exact backstop. After a
 //! step's proximity passes it lists the pairs of faces (a moved face and another, or a moved
 //! face and itself for "may have turned over") that it cannot clear; the CPU decides those
 //! with the exact predicates (`collide::Backstop::Undecided`) instead of gathering
@@ -119,7 +119,7 @@ pub struct BackstopBuffers<'a> {
 
 /// Records the filter: undecided pairs into `pairs` (two words each, up to `params.capacity`),
 /// all of them counted in `pair_count` (zero beforehand).
-pub fn record_backstop(
+pub fn record_backstop_filter(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     inputs: &BackstopBuffers<'_>,
@@ -127,7 +127,7 @@ pub fn record_backstop(
     (pairs, pair_count): (&wgpu::Buffer, &wgpu::Buffer),
 ) -> Result<(), GpuError> {
     check_backstop_invocations(params)?;
-    let pipeline = gpu.compute_pipeline("backstop")?;
+    let pipeline = gpu.compute_pipeline("backstop_filter")?;
     let uniform = gpu.uniform_buffer("backstop params", params);
     let resources = [
         &uniform,
@@ -145,7 +145,7 @@ pub fn record_backstop(
     gpu.record_paged_dispatch(
         encoder,
         &pipeline,
-        "backstop",
+        "backstop_filter",
         &resources,
         &[inputs.topology],
         Workgroups::Cover {
@@ -227,7 +227,7 @@ pub fn backstop_query_params(
 }
 
 /// Builds the hash table of the step's start positions and runs the filter on the GPU.
-pub fn run_backstop(
+pub fn run_backstop_filter(
     gpu: &GpuContext,
     query: &BackstopQuery<'_>,
 ) -> Result<UndecidedPairs, GpuError> {
@@ -253,7 +253,7 @@ pub fn run_backstop(
     let moved = gpu.storage_buffer("moved", &moved, false);
     let pairs = gpu.output_buffer::<[u32; 2]>("pairs", query.capacity);
     let pair_count = gpu.output_buffer::<u32>("pair count", 1);
-    let mut encoder = gpu.encoder("backstop");
+    let mut encoder = gpu.encoder("backstop filter");
     let table = super::GpuHashTable::record(
         gpu,
         &mut encoder,
@@ -264,7 +264,7 @@ pub fn run_backstop(
         table_size,
     )?;
     encoder.clear_buffer(&pair_count, 0, None);
-    record_backstop(
+    record_backstop_filter(
         gpu,
         &mut encoder,
         &BackstopBuffers {
