@@ -11,6 +11,7 @@
 //! the surface. The grid is kept up to date through every edit.
 
 mod reference;
+mod safety;
 
 use std::time::Instant;
 
@@ -18,8 +19,8 @@ use glam::Vec3;
 use serde::Serialize;
 
 use crate::collide::Stamps;
-use crate::collide::neighbourhood::ring_vertices;
-use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
+
+use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh, next, prev};
 use reference::ReferenceSurface;
@@ -688,166 +689,6 @@ impl<'a> Remesher<'a> {
                 .dot(normal(new).normalize_or_zero())
                 > MIN_NORMAL_COSINE
         })
-    }
-
-    /// A vertex (with `merged`, when a collapse takes it along) may move to `target` only if no
-    /// face outside its neighbourhood gets closer than the collision distance (or than it
-    /// already was), and its faces at the new position cross no other layer.
-    fn move_is_safe(&mut self, v: u32, target: Vec3, merged: Option<u32>) -> bool {
-        let d = self.settings.collision_distance;
-        let from = self.mesh.positions()[v as usize];
-        let mut ring = std::mem::take(&mut self.scratch);
-        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
-        if let Some(m) = merged {
-            let mut more = Vec::new();
-            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
-            ring.extend(more);
-        }
-        let layer = self.mesh.vertex_layers()[v as usize];
-        let positions = self.mesh.positions();
-        let faces = self.mesh.faces();
-        // The faces that will carry the vertex, at their new positions.
-        let moved: Vec<([u32; 3], [Vec3; 3])> = [Some(v), merged]
-            .into_iter()
-            .flatten()
-            .flat_map(|w| self.mesh.faces_around(w).collect::<Vec<_>>())
-            .filter_map(|f| {
-                let tri = faces[f as usize];
-                if merged.is_some_and(|m| tri.contains(&m) && tri.contains(&v)) {
-                    return None;
-                }
-                let ids = tri.map(|w| if Some(w) == merged { v } else { w });
-                let at = ids.map(|w| {
-                    if w == v {
-                        target
-                    } else {
-                        positions[w as usize]
-                    }
-                });
-                Some((ids, at))
-            })
-            .collect();
-        // One gathering serves both tests: faces near the move (for the distance test) and near
-        // the moved faces (for the crossing test).
-        let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = moved.iter().fold(reach, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
-        let near = self.gather_near(&around);
-        let mut safe = true;
-        for candidate in &near {
-            let (face, tri) = (candidate.face, candidate.ids);
-            // The neighbourhood skipped is the vertex's own, in its own layer.
-            if self.mesh.face_layers()[face as usize] == layer
-                && tri.iter().any(|w| ring.contains(w))
-            {
-                continue;
-            }
-            // Faces beyond the collision distance do not matter.
-            if !candidate.bounds.within(target, d) {
-                continue;
-            }
-            let [a, b, c] = candidate.at;
-            let now = closest_point_on_triangle(target, a, b, c).distance(target);
-            if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
-                safe = false;
-                break;
-            }
-        }
-        self.scratch = ring;
-        let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
-        let clear = safe && self.faces_clear_among(&moved, &involved, &[], &near);
-        self.near = near;
-        clear
-    }
-
-    /// The faces filed near `query` (live ones, at their current positions), in the reusable
-    /// list.
-    fn gather_near(&mut self, query: &Aabb) -> Vec<NearFace> {
-        let mut near = std::mem::take(&mut self.near);
-        near.clear();
-        let positions = self.mesh.positions();
-        let faces = self.mesh.faces();
-        self.surface.for_each_near(query, |face| {
-            let ids = faces[face as usize];
-            if ids[0] == INVALID {
-                return;
-            }
-            let at = ids.map(|w| positions[w as usize]);
-            let bounds = Aabb::of_points(&at);
-            if bounds.overlaps(query) {
-                near.push(NearFace {
-                    face,
-                    ids,
-                    at,
-                    bounds,
-                });
-            }
-        });
-        near
-    }
-
-    /// [`faces_clear_among`](Self::faces_clear_among) the faces near the triangles.
-    fn faces_clear(
-        &mut self,
-        triangles: &[([u32; 3], [Vec3; 3])],
-        moving: &[u32],
-        replaced: &[u32],
-    ) -> bool {
-        let bounds = triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
-        let near = self.gather_near(&bounds);
-        let clear = self.faces_clear_among(triangles, moving, replaced, &near);
-        self.near = near;
-        clear
-    }
-
-    /// No triangle in `triangles` (vertex ids and the positions they will have) crosses a nearby
-    /// face, of any layer, nor overlaps a neighbour beyond the vertices they share (a fold, which
-    /// pair tests skip and a later split would turn into a crossing). Faces around a `moving`
-    /// vertex are being tested themselves, among each other; `replaced` faces are on their way
-    /// out.
-    fn faces_clear_among(
-        &self,
-        triangles: &[([u32; 3], [Vec3; 3])],
-        moving: &[u32],
-        replaced: &[u32],
-        near: &[NearFace],
-    ) -> bool {
-        for (i, (ids, tri)) in triangles.iter().enumerate() {
-            for (other_ids, other) in &triangles[i + 1..] {
-                let shared = ids.iter().filter(|w| other_ids.contains(w)).count();
-                if shared == 3
-                    || (shared > 0 && neighbours_overlap(*tri, *ids, *other, *other_ids))
-                    || (shared == 0 && triangles_intersect(*tri, *other))
-                {
-                    return false;
-                }
-            }
-        }
-        for (ids, tri) in triangles {
-            let bounds = Aabb::of_points(tri);
-            for candidate in near {
-                let (face, other_ids, other) = (candidate.face, candidate.ids, candidate.at);
-                if !candidate.bounds.overlaps(&bounds)
-                    || replaced.contains(&face)
-                    || other_ids.iter().any(|w| moving.contains(w))
-                {
-                    continue;
-                }
-                let shared = other_ids.iter().filter(|w| ids.contains(w)).count();
-                let crossing = match shared {
-                    3 => false,
-                    0 => triangles_intersect(*tri, other),
-                    _ => neighbours_overlap(*tri, *ids, other, other_ids),
-                };
-                if crossing {
-                    return false;
-                }
-            }
-        }
-        true
     }
 }
 
