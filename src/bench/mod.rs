@@ -165,22 +165,23 @@ impl GpuCalls {
 }
 
 /// Runs `stroke` on `mesh` as an app would feed it: `samples_per_call` samples per
-/// `add_samples` call (`None`: all of them in one call). Returns the stroke's report and the
-/// calls it took, `finish` included.
+/// `add_samples` call, then `finish` (`None`: all of them and the end in one call,
+/// [`Pipeline::apply_stroke`]). Returns the stroke's report and the calls it took.
 pub fn feed_stroke(
     pipeline: &mut Pipeline,
     mesh: &mut Mesh,
     stroke: &Stroke,
     samples_per_call: Option<usize>,
 ) -> Result<(StrokeReport, usize), PipelineError> {
+    let Some(chunk) = samples_per_call else {
+        return Ok((pipeline.apply_stroke(mesh, stroke)?, 1));
+    };
     let mut in_progress = pipeline.begin_stroke(mesh, stroke.settings())?;
-    let chunk = samples_per_call.unwrap_or(stroke.samples.len()).max(1);
-    // `finish` runs the last sample: a call too.
-    let mut calls = 1;
-    for samples in stroke.samples.chunks(chunk) {
+    for samples in stroke.samples.chunks(chunk.max(1)) {
         in_progress.add_samples(samples)?;
-        calls += 1;
     }
+    // `finish` runs the last sample: a call too.
+    let calls = stroke.samples.len().div_ceil(chunk.max(1)) + 1;
     Ok((in_progress.finish()?, calls))
 }
 

@@ -111,16 +111,15 @@ impl Pipeline {
         StrokeInProgress::begin(self, mesh, stroke)
     }
 
-    /// A whole stroke: [`Pipeline::begin_stroke`], its samples in one
-    /// [`StrokeInProgress::add_samples`], and [`StrokeInProgress::finish`].
+    /// A whole stroke: [`Pipeline::begin_stroke`], then its samples and its end in one
+    /// [`StrokeInProgress::finish_with`] (the same mesh as `add_samples` then `finish`).
     pub fn apply_stroke(
         &mut self,
         mesh: &mut Mesh,
         stroke: &Stroke,
     ) -> Result<StrokeReport, PipelineError> {
-        let mut in_progress = self.begin_stroke(mesh, stroke.settings())?;
-        in_progress.add_samples(&stroke.samples)?;
-        in_progress.finish()
+        self.begin_stroke(mesh, stroke.settings())?
+            .finish_with(&stroke.samples)
     }
 
     /// Name for reports: "cpu", "cpu-reference", or what runs where on the GPU.

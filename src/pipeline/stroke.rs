@@ -154,9 +154,20 @@ impl<'a> StrokeInProgress<'a> {
 
     /// Ends the stroke: runs the last sample given, remeshes what the stroke touched (as the
     /// pipeline's settings say), and reports the whole stroke.
-    pub fn finish(mut self) -> Result<StrokeReport, PipelineError> {
+    pub fn finish(self) -> Result<StrokeReport, PipelineError> {
+        self.finish_with(&[])
+    }
+
+    /// [`StrokeInProgress::add_samples`] of the stroke's last `samples` and
+    /// [`StrokeInProgress::finish`] in one call: every sample left runs in one call, the last
+    /// one included (a pointer release that brings samples; the batch, which knows them all),
+    /// so the GPU may record them together. The mesh is the same as with the two calls.
+    pub fn finish_with(mut self, samples: &[Sample]) -> Result<StrokeReport, PipelineError> {
         let mut last = Vec::new();
         if let Some(active) = self.active.as_mut() {
+            for &sample in samples {
+                active.resampler.push(sample, &mut last);
+            }
             active.resampler.finish(&mut last);
         }
         self.run_samples(&last);
