@@ -119,3 +119,16 @@ pub const FRAME_SUM_WORDS: usize = 24;
 
 /// `brush_frame`'s output.
 pub type FrameSums = [u32; FRAME_SUM_WORDS];
+
+/// The parameters of `brush_frame` for a brush at `center` of `radius` over a selection list
+/// of `capacity` entries (the CPU mirror and the GPU host both build them here).
+pub fn frame_params(center: Vec3, radius: f32, capacity: usize) -> FrameParams {
+    FrameParams {
+        center: center.to_array(),
+        inv_radius: 1.0 / radius,
+        capacity: capacity as u32,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
+    }
+}

@@ -15,7 +15,7 @@ mod moves;
 
 pub use brush::{
     BrushSphere, DeformParams, FRAME_NORMAL_FROM_SUMS, FRAME_PLANE_FROM_SUMS, FRAME_SUM_WORDS,
-    FrameParams, FrameSums, SelectParams, SelectedVertex, brush_code, falloff_code,
+    FrameParams, FrameSums, SelectParams, SelectedVertex, brush_code, falloff_code, frame_params,
 };
 pub use dispatch::{
     APPLY_WORKGROUP_SIZE, BACKSTOP_WORKGROUP_SIZE, DispatchParams, ENTRIES_WORKGROUP_SIZE,

@@ -5,18 +5,9 @@
 use glam::Vec3;
 
 use super::{GpuContext, GpuError, SelectionBuffers, Workgroups};
-use crate::abi::{FRAME_SUM_WORDS, FRAME_WORKGROUP_SIZE, FrameParams, FrameSums, SelectedVertex};
-
-pub fn frame_params(center: Vec3, radius: f32, capacity: usize) -> FrameParams {
-    FrameParams {
-        center: center.to_array(),
-        inv_radius: 1.0 / radius,
-        capacity: capacity as u32,
-        _pad0: 0,
-        _pad1: 0,
-        _pad2: 0,
-    }
-}
+use crate::abi::{
+    FRAME_SUM_WORDS, FRAME_WORKGROUP_SIZE, FrameParams, FrameSums, SelectedVertex, frame_params,
+};
 
 /// The buffer of the sums: `FRAME_SUM_WORDS` words, `COPY_SRC` for the read-back.
 pub fn frame_sums_buffer(gpu: &GpuContext) -> wgpu::Buffer {

@@ -2,10 +2,11 @@
 
 use glam::Vec3;
 
-use super::brush_frame::{frame_params, frame_sums_buffer, record_brush_frame};
+use super::brush_frame::{frame_sums_buffer, record_brush_frame};
 use super::reusable::Patches;
 use super::rows::SlottedRows;
 use super::{GpuContext, GpuError, SelectionBuffers, Workgroups};
+use crate::abi::frame_params;
 use crate::abi::{
     DeformParams, FRAME_SUM_WORDS, FRAME_WORKGROUP_SIZE, FrameSums, SelectedVertex, WORKGROUP_SIZE,
     brush_code,

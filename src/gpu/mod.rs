@@ -44,7 +44,7 @@ pub use backstop_filter::{
     backstop_query_params, check_backstop_invocations, moved_edge_bound, record_backstop_filter,
     run_backstop_filter,
 };
-pub use brush_frame::{frame_params, frame_sums_buffer, record_brush_frame, run_brush_frame};
+pub use brush_frame::{frame_sums_buffer, record_brush_frame, run_brush_frame};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, Workgroups, list_adapters};
 pub use deform::{

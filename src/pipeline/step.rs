@@ -8,10 +8,10 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::abi::{SelectedVertex, frame_params};
 use crate::brush::{Dab, DabFrame, Paint, displacement, paint_share};
 use crate::collide::StrokeState;
 use crate::cpu;
-use crate::gpu::{SelectedVertex, frame_params};
 use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags};
 
 /// The brush frame of `probe` (its centre, radius and motion) over `selection`: the falloff-

@@ -25,7 +25,7 @@ fn brush_frame_sums_match_the_cpu_mirror_bit_for_bit_in_any_order() {
         }
         let selection = &mut full[..size];
         let mut mirror = [0u32; slayer::cpu::FRAME_SUM_WORDS];
-        let params = slayer::gpu::frame_params(center, radius, size);
+        let params = slayer::abi::frame_params(center, radius, size);
         fn inputs<'a>(
             mesh: &'a slayer::mesh::Mesh,
             selected: &'a [SelectedVertex],

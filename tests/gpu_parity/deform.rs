@@ -169,7 +169,7 @@ fn deform_takes_the_frame_from_the_sums_as_the_mirror_does() {
                         .expect("GPU run");
                 let mut mirror_sums = [0u32; slayer::cpu::FRAME_SUM_WORDS];
                 slayer::cpu::brush_frame(
-                    &slayer::gpu::frame_params(center, dab.brush.radius, size),
+                    &slayer::abi::frame_params(center, dab.brush.radius, size),
                     &slayer::cpu::FrameInputs {
                         positions: mesh.positions(),
                         normals: mesh.normals(),

@@ -12,16 +12,16 @@ use super::clamp::{ClampedAhead, PassBounds, put_back, record_clamp};
 use super::hashed::{TableUse, cell_size};
 use super::resident::Resident;
 use super::step_buffers::{ClampRead, StepBuffers};
-use crate::abi::DeformParams;
+use crate::abi::{DeformParams, frame_params};
 use crate::brush::{Dab, DabFrame};
 use crate::collide::StrokeState;
 use crate::cpu::FRAME_SUM_WORDS;
 use crate::gpu::{
     BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FRAME_WORKGROUP_SIZE, GateStatus,
     GpuContext, GpuError, HashedVertices, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    SelectionRead, Workgroups, deform_params, entry_params, frame_params, record_brush_frame,
-    record_deform, record_dispatch_args, record_gate_check, record_gate_open,
-    record_moving_entries, record_select, ring_bytes,
+    SelectionRead, Workgroups, deform_params, entry_params, record_brush_frame, record_deform,
+    record_dispatch_args, record_gate_check, record_gate_open, record_moving_entries,
+    record_select, ring_bytes,
 };
 use crate::mesh::Mesh;
 use crate::pipeline::step::{frame_flags, frame_of_sums, longest_move};
