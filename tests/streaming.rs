@@ -148,6 +148,38 @@ fn each_call_reports_the_vertices_it_changed() {
     assert!(moved_any, "the strokes move something");
 }
 
+/// `finish` reports what its last sample and the remeshing after the stroke changed: every
+/// vertex whose position, normal or faces differ from before `finish` is listed, new ones too.
+#[test]
+fn finish_reports_what_remeshing_changed() {
+    let (start, strokes) = plaster_and_strokes(2_000, 3, 5);
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let mut mesh = start.clone();
+    let mut remeshed_any = false;
+    for stroke in &strokes {
+        let mut in_progress = pipeline.begin_stroke(&mut mesh, stroke.settings()).unwrap();
+        in_progress.add_samples(&stroke.samples).unwrap();
+        let before = in_progress.mesh().clone();
+        let report = in_progress.finish().unwrap();
+        remeshed_any |= report.remesh.splits + report.remesh.collapses + report.remesh.flips > 0;
+        assert!(report.changed.windows(2).all(|w| w[0] < w[1]));
+        for v in 0..mesh.vertex_count() as u32 {
+            let i = v as usize;
+            let differs = i >= before.vertex_count()
+                || before.positions()[i] != mesh.positions()[i]
+                || before.normals()[i] != mesh.normals()[i]
+                || before.is_vertex_dead(v) != mesh.is_vertex_dead(v);
+            if differs {
+                assert!(
+                    report.changed.binary_search(&v).is_ok(),
+                    "vertex {v} unreported"
+                );
+            }
+        }
+    }
+    assert!(remeshed_any, "the strokes are remeshed");
+}
+
 /// A stroke dropped before `finish` leaves the pipeline ready: the next stroke runs, and the
 /// mesh stays sound.
 #[test]

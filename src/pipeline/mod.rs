@@ -165,6 +165,11 @@ pub struct StrokeReport {
     /// What remeshing did, summed over the stroke's remeshing passes.
     pub remesh: RemeshReport,
     pub phases: PhaseTimes,
+    /// Vertices the last call (`finish`: its last samples and the remeshing after the stroke)
+    /// changed, ascending, vertices remeshing added or removed among them: what a viewer
+    /// uploads again after the stroke, with the faces when `remesh` edited any.
+    #[serde(skip)]
+    pub changed: Vec<u32>,
 }
 
 #[derive(Debug, Error)]

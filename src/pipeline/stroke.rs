@@ -170,12 +170,17 @@ impl<'a> StrokeInProgress<'a> {
             }
             active.resampler.finish(&mut last);
         }
-        self.run_samples(&last);
+        let last_call = self.run_samples(&last);
         let mut active = self.active.take().ok_or(PipelineError::StrokeEnded)?;
         let kernels = self.pipeline.kernels.as_mut();
         kernels.given(self.mesh, active.samples_run, &[]);
-        active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
-        let report = std::mem::take(&mut active.report);
+        let remeshed =
+            active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
+        let mut report = std::mem::take(&mut active.report);
+        report.changed = last_call.changed;
+        report.changed.extend(remeshed);
+        report.changed.sort_unstable();
+        report.changed.dedup();
         self.pipeline.end_stroke(self.mesh, active);
         Ok(report)
     }
@@ -549,13 +554,14 @@ impl Active {
         call.phases.remesh += millis(started);
     }
 
-    /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved.
+    /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved, and
+    /// returns the vertices remeshing changed.
     fn remesh_after_stroke(
         &mut self,
         kernels: &mut dyn StepKernels,
         mesh: &mut Mesh,
         remeshing: Remeshing,
-    ) {
+    ) -> Vec<u32> {
         self.touched_list.sort_unstable();
         self.report.touched = self.touched_list.len();
         let remesh_now = match remeshing {
@@ -564,7 +570,7 @@ impl Active {
             Remeshing::AfterSample => self.stroke.brush.kind == BrushKind::Grab,
         };
         if !remesh_now {
-            return;
+            return Vec::new();
         }
         let started = Instant::now();
         let lengths = (
@@ -573,10 +579,12 @@ impl Active {
             self.prepared.ring,
         );
         let seeds = &self.touched_list;
-        let (pass, _) = remesh_touched(mesh, (&mut self.prepared.grid, kernels), seeds, lengths);
+        let (pass, changed) =
+            remesh_touched(mesh, (&mut self.prepared.grid, kernels), seeds, lengths);
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.report.remesh.add(&pass);
         self.report.phases.remesh += millis(started);
+        changed
     }
 }
 
