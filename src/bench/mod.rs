@@ -145,14 +145,15 @@ impl GpuCalls {
         (samples, strokes, calls): (usize, usize, usize),
     ) -> GpuCalls {
         let per = |count: usize, over: usize| count as f64 / over.max(1) as f64;
+        let submissions = after.submissions - before.submissions;
         let read_backs = after.read_backs - before.read_backs;
         let gate_stops = after.gated_ahead - before.gated_ahead;
         GpuCalls {
             samples_per_call: None,
             calls,
-            submissions: after.submissions - before.submissions,
+            submissions,
             read_backs,
-            submissions_per_sample: per(after.submissions - before.submissions, samples),
+            submissions_per_sample: per(submissions, samples),
             read_backs_per_sample: per(read_backs, samples),
             read_backs_per_stroke: per(read_backs, strokes),
             read_backs_per_call: per(read_backs, calls),

@@ -172,6 +172,18 @@ pub struct StrokeReport {
     pub changed: Vec<u32>,
 }
 
+impl StrokeReport {
+    /// Counts and phase times of one [`StrokeInProgress::add_samples`] call, added in.
+    pub(crate) fn add_call(&mut self, call: &SamplesReport) {
+        self.samples += call.samples;
+        self.steps += call.steps;
+        self.moves += call.moves;
+        self.clamped += call.clamped;
+        self.reverted += call.reverted;
+        self.phases.add(&call.phases);
+    }
+}
+
 #[derive(Debug, Error)]
 pub enum PipelineError {
     #[error("the mesh has no edges to take a length from")]

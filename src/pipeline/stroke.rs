@@ -54,6 +54,8 @@ struct Active {
     scratch: Scratch,
     /// Per layer: whether the stroke moves it.
     active: Vec<bool>,
+    /// Search through the grid on all cores; the reference pipeline scans on one thread.
+    fast: bool,
     lengths: Lengths,
     /// Where the last sample was: the next one's motion starts there.
     previous: Option<Vec3>,
@@ -108,7 +110,7 @@ impl<'a> StrokeInProgress<'a> {
         }
         // A new stroke: nothing given to the kernels yet.
         pipeline.kernels.given(mesh, 0, &[]);
-        let settings = pipeline.settings;
+        let (settings, fast) = (pipeline.settings, !pipeline.reference);
         Ok(StrokeInProgress {
             pipeline,
             mesh,
@@ -118,6 +120,7 @@ impl<'a> StrokeInProgress<'a> {
                 prepared,
                 scratch,
                 active,
+                fast,
                 lengths: Lengths {
                     edge,
                     collision_distance: settings.collision_distance * edge,
@@ -192,8 +195,6 @@ impl<'a> StrokeInProgress<'a> {
         };
         let pipeline = &mut *self.pipeline;
         let kernels = pipeline.kernels.as_mut();
-        // (use the grid, in parallel): both, or (the reference) neither, scanning on one thread.
-        let search = (!pipeline.reference, !pipeline.reference);
         if active.plans_ahead(pipeline.settings.remeshing) {
             let probes = active.probes(samples);
             kernels.given(self.mesh, active.samples_run, &probes);
@@ -202,14 +203,14 @@ impl<'a> StrokeInProgress<'a> {
         let remesh_each = pipeline.settings.remeshing == Remeshing::AfterSample
             && active.stroke.brush.kind != BrushKind::Grab;
         for sample in samples {
-            let moved = active.run_sample(kernels, self.mesh, sample, search, &mut call);
+            let moved = active.run_sample(kernels, self.mesh, sample, &mut call);
             if let Some(moved) = moved.filter(|_| remesh_each) {
                 active.remesh_after_sample(kernels, self.mesh, &moved, &mut call);
             }
         }
         call.changed.sort_unstable();
         call.changed.dedup();
-        active.report.phases.add(&call.phases);
+        active.report.add_call(&call);
         call
     }
 }
@@ -283,8 +284,8 @@ impl Active {
     }
 
     /// What a step reads that lasts for the stroke.
-    fn state(&self, search: (bool, bool)) -> StrokeState<'_> {
-        stroke_state(&self.prepared, &self.active, self.lengths, search)
+    fn state(&self) -> StrokeState<'_> {
+        stroke_state(&self.prepared, &self.active, self.lengths, self.fast)
     }
 
     /// One sample of Algorithm 2: select, paint, deform in steps, collide, update the grid,
@@ -295,14 +296,12 @@ impl Active {
         kernels: &mut dyn StepKernels,
         mesh: &mut Mesh,
         sample: &Sample,
-        search: (bool, bool),
         call: &mut SamplesReport,
     ) -> Option<Vec<u32>> {
         let number = self.samples_run;
         self.samples_run += 1;
         call.samples += 1;
-        self.report.samples += 1;
-        let opened = self.open_sample(kernels, mesh, sample, number, search, &mut call.phases);
+        let opened = self.open_sample(kernels, mesh, sample, number, &mut call.phases);
         if opened.selection.is_empty() {
             return None;
         }
@@ -314,7 +313,7 @@ impl Active {
                 frame: opened.frame,
                 ..opened.probe
             };
-            let painted = paint(&self.state(search), mesh, &dab, &opened.selection, spec);
+            let painted = paint(&self.state(), mesh, &dab, &opened.selection, spec);
             let brdfs = mesh.brdfs_mut();
             for (&(v, _), brdf) in opened.selection.iter().zip(painted) {
                 brdfs[v as usize] = brdf;
@@ -326,7 +325,7 @@ impl Active {
         if !self.stroke.brush.kind.deforms() {
             return None;
         }
-        let moved = self.deform_in_steps(kernels, mesh, opened, (number, search), call);
+        let moved = self.deform_in_steps(kernels, mesh, (opened, number), call);
 
         // Normals of the moved vertices and of their neighbours, whose faces also turned.
         let started = Instant::now();
@@ -353,7 +352,6 @@ impl Active {
         mesh: &Mesh,
         sample: &Sample,
         number: usize,
-        search: (bool, bool),
         phases: &mut PhaseTimes,
     ) -> Opened {
         let started = Instant::now();
@@ -368,7 +366,7 @@ impl Active {
                 deform_millis: 0.0,
             },
             _ => {
-                let state = self.state(search);
+                let state = self.state();
                 let source = FrameSource::Selection {
                     normal: sample.normal,
                 };
@@ -400,8 +398,7 @@ impl Active {
         &mut self,
         kernels: &mut dyn StepKernels,
         mesh: &mut Mesh,
-        opened: Opened,
-        (number, search): (usize, (bool, bool)),
+        (opened, number): (Opened, usize),
         call: &mut SamplesReport,
     ) -> Vec<u32> {
         let started = Instant::now();
@@ -413,7 +410,7 @@ impl Active {
         let first_selection = opened.selection;
         let mut full = match opened.targets {
             Some(targets) => targets,
-            None => kernels.deform(&self.state(search), mesh, &whole, &first_selection, None),
+            None => kernels.deform(&self.state(), mesh, &whole, &first_selection, None),
         };
         let limit = self.lengths.step_limit;
         let steps = steps_for(longest_move(mesh, &first_selection, &full), limit);
@@ -434,7 +431,7 @@ impl Active {
             // under the dab and deform in the same call (one submission on the GPU, booked
             // under selection there).
             let started = Instant::now();
-            let state = self.state(search);
+            let state = self.state();
             let (selection, targets) = if k == 0 || is_grab {
                 let targets = if steps == 1 {
                     std::mem::take(&mut full)
@@ -450,7 +447,7 @@ impl Active {
                 call.phases.deformation += pass.deform_millis;
                 (pass.selection, pass.targets.unwrap_or_default())
             };
-            let moved = self.take_step(kernels, mesh, (&selection, &targets), search, call);
+            let moved = self.take_step(kernels, mesh, (&selection, &targets), call);
             moved_in_sample.extend(moved);
         }
         moved_in_sample
@@ -463,7 +460,6 @@ impl Active {
         kernels: &mut dyn StepKernels,
         mesh: &mut Mesh,
         (selection, targets): (&[(u32, f32)], &[Vec3]),
-        search: (bool, bool),
         call: &mut SamplesReport,
     ) -> Vec<u32> {
         let started = Instant::now();
@@ -475,7 +471,7 @@ impl Active {
             .iter()
             .map(|&(v, _)| mesh.positions()[v as usize])
             .collect();
-        let state = stroke_state(&self.prepared, &self.active, self.lengths, search);
+        let state = stroke_state(&self.prepared, &self.active, self.lengths, self.fast);
         let moves = (selection, targets, target_of.as_slice());
         let outcome = collide_with(
             &state,
@@ -511,10 +507,6 @@ impl Active {
         }
         call.phases.grid_update += millis(started);
 
-        self.report.steps += 1;
-        self.report.moves += moved.len();
-        self.report.clamped += outcome.clamped;
-        self.report.reverted += outcome.reverted;
         call.steps += 1;
         call.moves += moved.len();
         call.clamped += outcome.clamped;
@@ -594,12 +586,12 @@ fn stroke_state<'s>(
     prepared: &'s Prepared,
     active: &'s [bool],
     lengths: Lengths,
-    (use_grid, parallel): (bool, bool),
+    fast: bool,
 ) -> StrokeState<'s> {
     StrokeState {
-        grid: use_grid.then_some(&prepared.grid),
+        grid: fast.then_some(&prepared.grid),
         active,
-        parallel,
+        parallel: fast,
         collision_distance: lengths.collision_distance,
         ring: prepared.ring,
         max_edge: prepared.max_edge,
