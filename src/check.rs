@@ -33,6 +33,8 @@ pub struct CheckReport {
     pub grid: Option<GridFigures>,
     /// One line per defect; empty when the mesh is clean.
     pub defects: Vec<String>,
+    /// The content digest ([`Mesh::digest`]): equal for the same mesh however it was stored.
+    pub digest: String,
 }
 
 impl CheckReport {
@@ -141,6 +143,7 @@ pub fn check_mesh(
             .collect(),
         grid,
         defects,
+        digest: mesh.digest(),
     }
 }
 
@@ -185,6 +188,7 @@ impl std::fmt::Display for CheckReport {
                 g.build_ms
             )?;
         }
+        writeln!(f, "  digest            {}", self.digest)?;
         if self.defects.is_empty() {
             write!(f, "  ok: no defects")
         } else {

@@ -11,7 +11,9 @@ pub enum IoError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}: unsupported file type (expected .obj or .ply)")]
+    #[error(
+        "{path}: unsupported file type (expected .obj, .ply or, where a session fits, .slayer)"
+    )]
     UnsupportedFormat { path: String },
     #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Parse {

@@ -8,17 +8,22 @@
 mod attributes;
 mod components;
 mod corner_table;
+mod delta;
+mod digest;
 mod edit;
 mod error;
 mod measure;
+mod raw;
 mod validate;
 mod vertex_faces;
 
 pub use attributes::{Brdf, LayerId, MIN_SLOPE, VertexFlags, blinn_exponent};
 pub use components::Components;
 pub use corner_table::{CornerTable, FanIter, INVALID, face_of, next, prev};
+pub use delta::{MeshDelta, RowsDelta};
 pub use error::MeshError;
 pub use measure::EdgeLengthStats;
+pub use raw::RawMeshError;
 pub use vertex_faces::VertexFaces;
 
 use glam::Vec3;
@@ -250,6 +255,14 @@ impl Mesh {
             if l == layer {
                 *b = brdf;
             }
+        }
+    }
+
+    /// Renames a layer; a `layer` past the last is ignored.
+    pub fn set_layer_name(&mut self, layer: LayerId, name: &str) {
+        if let Some(slot) = self.layer_names.get_mut(layer as usize) {
+            *slot = name.to_string();
+            self.version.attributes += 1;
         }
     }
 

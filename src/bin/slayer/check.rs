@@ -9,7 +9,12 @@ use crate::progress::Steps;
 pub fn report(file: &Path) -> anyhow::Result<CheckReport> {
     let steps = Steps::new("check");
     steps.step("reading");
-    let (mesh, notes) = slayer::io::load_mesh(file)?;
+    let (mesh, notes) = if slayer::session::is_session_path(file) {
+        let session = slayer::session::open(file)?;
+        (session.into_mesh(), slayer::io::LoadNotes::default())
+    } else {
+        slayer::io::load_mesh(file)?
+    };
     let report = check_mesh(&mesh, &notes, &file.display().to_string(), |s| {
         steps.step(s)
     });

@@ -4,6 +4,7 @@ mod backend;
 mod bench;
 mod check;
 mod demo;
+mod history;
 mod progress;
 mod remesh;
 mod render;
@@ -56,7 +57,7 @@ enum Command {
         /// 0.4): a deliberately irregular mesh, e.g. to try `slayer remesh` on.
         #[arg(long, default_value_t = 0.0)]
         jitter: f32,
-        /// Output file (.obj or .ply).
+        /// Output file: a mesh (.obj, .ply) or a session (.slayer).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -67,13 +68,16 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Apply a stroke file to a mesh and write the result (the input is never modified).
+    /// Apply a stroke file to a mesh or session and write the result (the input is never
+    /// modified). A `.slayer` output keeps every stroke as an undoable history entry.
     Sculpt {
+        /// Mesh (.obj, .ply) or session (.slayer).
         #[arg(long)]
         input: PathBuf,
         /// Stroke file (JSON; see `slayer::brush` docs or README).
         #[arg(long)]
         strokes: PathBuf,
+        /// Mesh (.obj, .ply) or session (.slayer, with the history).
         #[arg(long)]
         output: PathBuf,
         /// Write per-stroke phase timings and counts as JSON.
@@ -86,6 +90,24 @@ enum Command {
         /// lavapipe included).
         #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
         backend: backend::Backend,
+    },
+    /// Undo the last entries of a session file's history and write the result.
+    Undo {
+        /// Session file (.slayer).
+        session: PathBuf,
+        /// How many entries to undo.
+        #[arg(long, default_value_t = 1)]
+        steps: usize,
+        /// Output: a session (.slayer, the undone entries kept for redo) or a mesh.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// List a session file's history: each entry and the bytes it holds.
+    History {
+        /// Session file (.slayer).
+        session: PathBuf,
+        #[arg(long)]
+        json: bool,
     },
     /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax).
     Remesh {
@@ -155,7 +177,7 @@ enum Command {
     /// shadowing) under a key and a fill light. The camera orbits the mesh's bounding box with
     /// +z up and frames it whole.
     Render {
-        /// Mesh file (.ply keeps painted BRDFs; .obj renders in clay).
+        /// Mesh or session file (.ply and .slayer keep painted BRDFs; .obj renders in clay).
         file: PathBuf,
         /// Output PNG.
         #[arg(short, long)]
@@ -215,6 +237,12 @@ fn main() -> ExitCode {
             backend,
         } => sculpt::run(&input, &strokes, &output, stats.as_deref(), remesh, backend),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
+        Command::Undo {
+            session,
+            steps,
+            output,
+        } => history::undo(&session, steps, &output),
+        Command::History { session, json } => history::list(&session, json),
         Command::Render {
             file,
             output,

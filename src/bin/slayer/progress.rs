@@ -58,6 +58,15 @@ impl Bar {
         self.bar.inc(1);
     }
 
+    /// A line on stderr above the bar (always printed, terminal or not).
+    pub fn println(&self, line: &str) {
+        if self.bar.is_hidden() {
+            eprintln!("{line}");
+        } else {
+            self.bar.println(line);
+        }
+    }
+
     pub fn finish(self) {
         self.bar.finish_and_clear();
     }

@@ -96,7 +96,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         bail!("{}: the output must be a .png file", args.output.display());
     }
     let started = Instant::now();
-    let mesh = slayer::io::read_mesh(args.file)?;
+    let mesh = slayer::session::open(args.file)?.into_mesh();
     let load_ms = started.elapsed().as_secs_f64() * 1e3;
     let layers = if args.layers.is_empty() {
         None

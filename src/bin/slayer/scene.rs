@@ -19,7 +19,7 @@ pub fn run(
         triangles: triangles.unwrap_or(kind.default_triangles()),
         seed,
     };
-    slayer::io::Format::of_path(output)?;
+    slayer::session::check_save_path(output)?;
     if !(0.0..=slayer::scene::MAX_JITTER).contains(&jitter) {
         anyhow::bail!(
             "--jitter {jitter} is out of range (0 to {} edge lengths)",
@@ -34,7 +34,9 @@ pub fn run(
         slayer::scene::jitter(&mut mesh, jitter, seed).map_err(anyhow::Error::msg)?;
     }
     steps.step(&format!("writing {}", output.display()));
-    slayer::io::write_mesh(&mesh, output).context("writing the scene")?;
+    let session = slayer::session::Session::new(mesh);
+    slayer::session::save(&session, output, true).context("writing the scene")?;
+    let mesh = session.mesh();
     let seconds = steps.finish();
     println!(
         "{}: {} layers, {} vertices, {} faces, mean edge {:.6} -> {} ({seconds:.1} s)",

@@ -1,0 +1,119 @@
+//! `slayer history` and `slayer undo`: a session file's history, headless.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use slayer::session::{Session, is_session_path};
+
+fn open_session(path: &Path) -> anyhow::Result<Session> {
+    if !is_session_path(path) {
+        anyhow::bail!(
+            "{}: only a session file (.slayer) keeps a history",
+            path.display()
+        );
+    }
+    Ok(slayer::session::open(path)?)
+}
+
+/// Lists a session's history entries, oldest first, with the bytes each holds.
+pub fn list(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
+    let session = open_session(path)?;
+    let history = session.history();
+    let mesh_bytes = mesh_bytes(&session);
+    if json {
+        let entries: Vec<_> = history
+            .entries()
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                serde_json::json!({
+                    "index": i + 1,
+                    "label": e.label,
+                    "bytes": e.bytes(),
+                    "done": i < history.done(),
+                })
+            })
+            .collect();
+        let json = serde_json::json!({
+            "file": path.display().to_string(),
+            "entries": entries,
+            "done": history.done(),
+            "bytes": history.bytes(),
+            "cap_bytes": history.cap_bytes(),
+            "mesh_bytes": mesh_bytes,
+        });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!(
+        "{}: {} entries ({} done), {:.2} MiB of history for a mesh of {:.2} MiB (cap {} MiB)",
+        path.display(),
+        history.entries().len(),
+        history.done(),
+        history.bytes() as f64 / 1048576.0,
+        mesh_bytes as f64 / 1048576.0,
+        history.cap_bytes() >> 20
+    );
+    for (i, entry) in history.entries().iter().enumerate() {
+        let state = if i < history.done() { "" } else { "  (undone)" };
+        println!(
+            "  {:>4}  {:<28} {:>10} bytes{state}",
+            i + 1,
+            entry.label,
+            entry.bytes()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Undoes `steps` entries of a session file's history and writes the result.
+pub fn undo(path: &Path, steps: usize, output: &Path) -> anyhow::Result<ExitCode> {
+    slayer::session::check_save_path(output)?;
+    let mut session = open_session(path)?;
+    let done = session.history().done();
+    if steps > done {
+        anyhow::bail!(
+            "{}: --steps {steps} is more than the {done} entries there are to undo",
+            path.display()
+        );
+    }
+    let started = std::time::Instant::now();
+    for _ in 0..steps {
+        session.undo();
+    }
+    let millis = started.elapsed().as_secs_f64() * 1e3;
+    session
+        .mesh()
+        .validate()
+        .context("the mesh after undoing failed validation (not written)")?;
+    slayer::session::save(&session, output, true)?;
+    println!(
+        "undid {steps} of {done} entries in {millis:.1} ms -> {} ({} left to undo, {} to redo)",
+        output.display(),
+        session.history().done(),
+        session.history().entries().len() - session.history().done()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The mesh's bytes in memory, every array (what a history entry is compared with).
+fn mesh_bytes(session: &Session) -> usize {
+    let [
+        positions,
+        normals,
+        brdfs,
+        vertex_layers,
+        flags,
+        faces,
+        face_layers,
+        opposite,
+        corner,
+    ] = session.mesh().array_lengths();
+    (positions + normals) * 12
+        + brdfs * 28
+        + (vertex_layers + flags + corner) * 4
+        + faces * 12
+        + face_layers * 4
+        + opposite * 4
+}

@@ -1,0 +1,359 @@
+//! The editing session (the document): the mesh, each layer's settings, the brush, and the
+//! history that undoes and redoes every change a user makes.
+//!
+//! The mesh can only be changed through an [`Edit`], which records what changed as one
+//! history entry when it ends — a stroke, a paint stroke, a mask edit, a layer tool — so
+//! nothing a user does escapes undo. An entry keeps only the rows that changed
+//! ([`MeshDelta`]), found by comparing the mesh with the copy the session keeps of it as the
+//! last entry left it (`recorded`): one copy of the mesh, however long the history.
+//!
+//! ```
+//! use slayer::pipeline::{Pipeline, PipelineSettings};
+//! use slayer::scene::{SceneKind, SceneSpec, generate};
+//! use slayer::session::Session;
+//!
+//! let mesh = generate(&SceneSpec { kind: SceneKind::Plaster, triangles: 2_000, seed: 1 })?;
+//! let before = mesh.digest();
+//! let mut session = Session::new(mesh);
+//! let mut pipeline = Pipeline::new(PipelineSettings::default());
+//! let script = slayer::bench::generate_script(session.mesh(), &Default::default());
+//! let stroke = &script.resolve(session.mesh(), "script")?[0];
+//! session.apply_stroke(&mut pipeline, stroke)?;
+//! session.undo();
+//! assert_eq!(session.mesh().digest(), before);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod file;
+mod history;
+
+pub use file::{
+    SessionFileError, VERSION, check_save_path, is_session_path, open, read_session, save,
+    write_session,
+};
+pub use history::{DEFAULT_HISTORY_CAP_BYTES, Entry, History};
+
+use serde::{Deserialize, Serialize};
+
+use crate::brush::{BrushKind, Falloff, Stroke};
+use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta, VertexFlags};
+use crate::pipeline::{Pipeline, PipelineError, StrokeReport};
+
+/// How a layer meets what comes within the collision distance of it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProximityPolicy {
+    /// Contact stops motion (sLayer): the layer never crosses anything.
+    #[default]
+    Collide,
+}
+
+/// A layer's settings; its name lives in the mesh (files keep it there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayerSettings {
+    pub visible: bool,
+    /// Brushed by strokes that do not name their layers.
+    pub active: bool,
+    pub policy: ProximityPolicy,
+    /// What painting with the layer's own material lays down.
+    pub material: Brdf,
+}
+
+/// The brush a user has picked (the app's brush panel; a stroke file names its own).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BrushSettings {
+    pub kind: BrushKind,
+    pub radius: f32,
+    pub strength: f32,
+    pub falloff: Falloff,
+    pub invert: bool,
+    /// Resampling step as a share of the radius.
+    pub spacing: f32,
+}
+
+impl BrushSettings {
+    /// A draw brush twelve edge lengths wide (the bench's size), for a mesh of edge `edge`.
+    pub fn for_edge(edge: f32) -> BrushSettings {
+        BrushSettings {
+            kind: BrushKind::Draw,
+            radius: 12.0 * edge,
+            strength: 0.5,
+            falloff: Falloff::default(),
+            invert: false,
+            spacing: 0.25,
+        }
+    }
+}
+
+/// What recording an edit did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Recorded {
+    /// The entry changed the mesh or the layers (one that changed nothing is recorded too:
+    /// every action is one entry, so undoing as many steps as strokes were made undoes them).
+    pub changed: bool,
+    /// Bytes the entry holds.
+    pub bytes: usize,
+    /// The oldest entries dropped to stay under the memory cap.
+    pub dropped: usize,
+}
+
+/// An entry undone or redone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stepped {
+    pub label: String,
+    /// The vertices whose rows changed: what a viewer re-uploads.
+    pub touched_vertices: Vec<u32>,
+}
+
+/// The document a user edits.
+#[derive(Debug, Clone)]
+pub struct Session {
+    mesh: Mesh,
+    layers: Vec<LayerSettings>,
+    /// The brush the user has picked.
+    pub brush: BrushSettings,
+    history: History,
+    /// The mesh as the history's last done entry left it: the next edit is compared with it.
+    recorded: Mesh,
+}
+
+/// Why a session operation was refused; the session is unchanged.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SessionError {
+    #[error("layer {layer} does not exist (the mesh has {layer_count})")]
+    NoSuchLayer { layer: LayerId, layer_count: usize },
+    #[error("a layer name must be one line of at most 255 bytes, not {0:?}")]
+    BadLayerName(String),
+}
+
+impl Session {
+    /// A new session on `mesh`: every layer visible, active and colliding, its material the
+    /// BRDF of its first vertex; an empty history with the default cap.
+    pub fn new(mesh: Mesh) -> Session {
+        let layers = default_layers(&mesh);
+        let brush = BrushSettings::for_edge(mesh.mean_edge_length());
+        Session::from_parts(mesh, layers, brush, History::default())
+    }
+
+    /// A session from its parts (a session file); `history`'s done entries end at `mesh`.
+    pub(crate) fn from_parts(
+        mesh: Mesh,
+        layers: Vec<LayerSettings>,
+        brush: BrushSettings,
+        history: History,
+    ) -> Session {
+        Session {
+            recorded: mesh.clone(),
+            mesh,
+            layers,
+            brush,
+            history,
+        }
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// The mesh, leaving the session.
+    pub fn into_mesh(self) -> Mesh {
+        self.mesh
+    }
+
+    pub fn layers(&self) -> &[LayerSettings] {
+        &self.layers
+    }
+
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Sets the history's memory cap; returns how many of the oldest entries it dropped.
+    pub fn set_history_cap(&mut self, bytes: usize) -> usize {
+        self.history.set_cap(bytes)
+    }
+
+    /// The active layers, ascending (what a stroke that names none brushes).
+    pub fn active_layers(&self) -> Vec<LayerId> {
+        (0..self.layers.len() as LayerId)
+            .filter(|&l| self.layers[l as usize].active)
+            .collect()
+    }
+
+    /// Starts a change of the mesh, recorded as one history entry labelled `label` when the
+    /// returned [`Edit`] is committed or dropped (even one that changed nothing: every action
+    /// is one entry).
+    pub fn edit(&mut self, label: &str) -> Edit<'_> {
+        Edit {
+            label: label.to_string(),
+            session: self,
+            done: false,
+        }
+    }
+
+    /// A whole stroke through `pipeline`, as one history entry named after its brush.
+    pub fn apply_stroke(
+        &mut self,
+        pipeline: &mut Pipeline,
+        stroke: &Stroke,
+    ) -> Result<(StrokeReport, Recorded), PipelineError> {
+        let mut edit = self.edit(&stroke_label(stroke));
+        let report = pipeline.apply_stroke(edit.mesh(), stroke);
+        // A failed stroke leaves the mesh intact but may have moved some of it: recorded too.
+        let recorded = edit.commit();
+        Ok((report?, recorded))
+    }
+
+    /// Changes a layer's settings, as one history entry.
+    pub fn set_layer(
+        &mut self,
+        layer: LayerId,
+        settings: LayerSettings,
+    ) -> Result<Recorded, SessionError> {
+        self.check_layer(layer)?;
+        let before = self.layers.clone();
+        self.layers[layer as usize] = settings;
+        let changed = before != self.layers;
+        let after = self.layers.clone();
+        let entry = Entry::new(
+            "layer settings",
+            MeshDelta::default(),
+            Some((before, after)),
+        );
+        Ok(self.push(entry, changed))
+    }
+
+    /// Renames a layer, as one history entry.
+    pub fn rename_layer(&mut self, layer: LayerId, name: &str) -> Result<Recorded, SessionError> {
+        self.check_layer(layer)?;
+        if name.is_empty() || name.len() > 255 || name.chars().any(char::is_control) {
+            return Err(SessionError::BadLayerName(name.to_string()));
+        }
+        let mut edit = self.edit("rename layer");
+        edit.mesh().set_layer_name(layer, name);
+        Ok(edit.commit())
+    }
+
+    /// Clears the mask of every vertex, as one history entry.
+    pub fn clear_mask(&mut self) -> Recorded {
+        let mut edit = self.edit("clear mask");
+        for flags in edit.mesh().flags_mut() {
+            flags.remove(VertexFlags::MASKED);
+        }
+        edit.commit()
+    }
+
+    /// Undoes the last done entry; `None` when there is none.
+    pub fn undo(&mut self) -> Option<Stepped> {
+        let entry = self.history.step_back()?;
+        entry.undo(&mut self.mesh, &mut self.layers);
+        entry.mesh.undo(&mut self.recorded);
+        Some(Stepped {
+            label: entry.label.clone(),
+            touched_vertices: entry.touched_vertices(),
+        })
+    }
+
+    /// Redoes the first undone entry; `None` when there is none.
+    pub fn redo(&mut self) -> Option<Stepped> {
+        let entry = self.history.step_forward()?;
+        entry.redo(&mut self.mesh, &mut self.layers);
+        entry.mesh.redo(&mut self.recorded);
+        Some(Stepped {
+            label: entry.label.clone(),
+            touched_vertices: entry.touched_vertices(),
+        })
+    }
+
+    fn check_layer(&self, layer: LayerId) -> Result<(), SessionError> {
+        if (layer as usize) < self.layers.len() {
+            Ok(())
+        } else {
+            Err(SessionError::NoSuchLayer {
+                layer,
+                layer_count: self.layers.len(),
+            })
+        }
+    }
+
+    /// Records what changed since the last entry as one entry labelled `label`.
+    fn record(&mut self, label: &str) -> Recorded {
+        let delta = MeshDelta::between(&self.recorded, &self.mesh);
+        let changed = !delta.is_empty();
+        delta.redo(&mut self.recorded);
+        self.push(Entry::new(label, delta, None), changed)
+    }
+
+    fn push(&mut self, entry: Entry, changed: bool) -> Recorded {
+        let bytes = entry.bytes();
+        let dropped = self.history.push(entry);
+        Recorded {
+            changed,
+            bytes,
+            dropped,
+        }
+    }
+}
+
+/// A change of a session's mesh in progress; recorded as one history entry by
+/// [`Edit::commit`], or when dropped (an error or a panic half-way does not escape undo).
+pub struct Edit<'a> {
+    session: &'a mut Session,
+    label: String,
+    done: bool,
+}
+
+impl Edit<'_> {
+    /// The mesh to change (give it to `Pipeline::begin_stroke`, a paint or mask tool, ...).
+    pub fn mesh(&mut self) -> &mut Mesh {
+        &mut self.session.mesh
+    }
+
+    /// Records the change as one history entry.
+    pub fn commit(mut self) -> Recorded {
+        self.done = true;
+        self.session.record(&self.label)
+    }
+}
+
+impl Drop for Edit<'_> {
+    fn drop(&mut self) {
+        if !self.done {
+            self.session.record(&self.label);
+        }
+    }
+}
+
+/// Every layer visible, active, colliding, in the material of its first live vertex.
+fn default_layers(mesh: &Mesh) -> Vec<LayerSettings> {
+    let mut materials = vec![None; mesh.layer_count()];
+    for v in 0..mesh.vertex_count() {
+        let layer = mesh.vertex_layers()[v] as usize;
+        if !mesh.is_vertex_dead(v as u32) && layer < materials.len() && materials[layer].is_none() {
+            materials[layer] = Some(mesh.brdfs()[v]);
+        }
+    }
+    materials
+        .into_iter()
+        .map(|material| LayerSettings {
+            visible: true,
+            active: true,
+            policy: ProximityPolicy::Collide,
+            material: material.unwrap_or(Brdf::CLAY),
+        })
+        .collect()
+}
+
+/// "draw stroke", "paint stroke", "grab stroke (painting)".
+fn stroke_label(stroke: &Stroke) -> String {
+    let kind = serde_json::to_value(stroke.brush.kind)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| "brush".into());
+    let painting = if stroke.paint.is_some() && stroke.brush.kind != BrushKind::Paint {
+        " (painting)"
+    } else {
+        ""
+    };
+    format!("{kind} stroke{painting}")
+}
