@@ -12,6 +12,7 @@ pub mod brush;
 pub mod check;
 pub mod collide;
 pub mod cpu;
+pub mod files;
 pub mod geom;
 pub mod gpu;
 pub mod grid;

@@ -1,19 +1,22 @@
 //! Brushes as deformation fields with a falloff (docs/design.md, "A stroke"), and strokes: polylines of samples
 //! resampled at a spacing relative to the radius.
 
+mod decode;
 mod falloff;
 mod field;
 mod paint;
 mod stencil;
 mod stroke;
 
+pub use decode::{MAX_SAMPLES_PER_FILE, MAX_SAMPLES_PER_STROKE, MAX_STROKES};
 pub use falloff::Falloff;
 pub use field::{Dab, DabFrame, displacement};
 pub use paint::{Paint, paint_share};
 pub use stencil::{Pattern, Stencil};
 pub use stroke::{
-    LayerRef, MAX_RADIUS_OVER_EXTENT, PaintSpec, Resampler, Sample, SampleSpec, StencilSpec,
-    Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec, resample,
+    DabLimit, LayerRef, MAX_DABS_PER_STROKE, MAX_RADIUS_OVER_EXTENT, PaintSpec, Resampler, Sample,
+    SampleSpec, StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec,
+    dabs_for, resample,
 };
 
 use serde::{Deserialize, Serialize};

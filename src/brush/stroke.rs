@@ -47,15 +47,18 @@ use thiserror::Error;
 
 use std::sync::Arc;
 
+use super::decode::MAX_SAMPLES_PER_STROKE;
 use super::{Brush, BrushKind, Falloff, Paint, Pattern, Stencil};
+use crate::files::escape;
 use crate::material;
 use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
 
 /// A radius beyond this many times the mesh's bounding-box diagonal is rejected as absurd.
 pub const MAX_RADIUS_OVER_EXTENT: f32 = 10.0;
+/// The largest stencil PNG read (256 MiB): a texture, not a photograph archive.
+pub const MAX_STENCIL_BYTES: u64 = 256 << 20;
 /// A radius below this share of the mean edge length touches nothing and is rejected.
 const MIN_RADIUS_OVER_EDGE: f32 = 0.05;
-const MAX_SAMPLES: usize = 1_000_000;
 
 #[derive(Debug, Error)]
 pub enum StrokeError {
@@ -86,7 +89,7 @@ fn one() -> f32 {
     1.0
 }
 
-fn default_spacing() -> f32 {
+pub(super) fn default_spacing() -> f32 {
     0.25
 }
 
@@ -232,23 +235,33 @@ impl Stroke {
 impl StrokeFile {
     /// Parses JSON; `source_name` names the file in messages.
     pub fn parse(text: &str, source_name: &str) -> Result<StrokeFile, StrokeError> {
-        let file: StrokeFile = serde_json::from_str(text).map_err(|e| StrokeError::Json {
-            source_name: source_name.to_string(),
-            line: e.line(),
-            column: e.column(),
-            message: e
-                .to_string()
-                .split(" at line ")
-                .next()
-                .unwrap_or_default()
-                .to_string(),
-        })?;
-        if file.version != 1 {
-            return Err(StrokeError::Invalid {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| StrokeError::Json {
                 source_name: source_name.to_string(),
-                location: "version".into(),
-                message: format!("version {} is not supported (expected 1)", file.version),
-            });
+                line: e.line(),
+                column: e.column(),
+                message: if e.is_eof() {
+                    "the file ends before its JSON is complete".into()
+                } else {
+                    "not valid JSON here (a stroke file is one JSON object; docs/strokes.md)"
+                        .into()
+                },
+            })?;
+        let invalid = |(location, message): (String, String)| StrokeError::Invalid {
+            source_name: source_name.to_string(),
+            location: if location.is_empty() {
+                "the file".into()
+            } else {
+                location
+            },
+            message,
+        };
+        let file = super::decode::file(&value).map_err(invalid)?;
+        if file.version != 1 {
+            return Err(invalid((
+                "version".into(),
+                format!("version {} is not supported (expected 1)", file.version),
+            )));
         }
         Ok(file)
     }
@@ -335,10 +348,13 @@ fn resolve_stroke(
     if spec.samples.is_empty() {
         return fail(".samples", "a stroke needs at least one sample".into());
     }
-    if spec.samples.len() > MAX_SAMPLES {
+    if spec.samples.len() > MAX_SAMPLES_PER_STROKE {
         return fail(
             ".samples",
-            format!("{} samples is more than {MAX_SAMPLES}", spec.samples.len()),
+            format!(
+                "{} samples is more than a stroke may have ({MAX_SAMPLES_PER_STROKE})",
+                spec.samples.len()
+            ),
         );
     }
     if spec.layers.is_empty() {
@@ -363,8 +379,9 @@ fn resolve_stroke(
                     return fail(
                         &format!(".layers[{k}]"),
                         format!(
-                            "no layer is named `{name}` (the mesh has: {})",
-                            mesh.layer_names().join(", ")
+                            "no layer is named `{}` (the mesh has: {})",
+                            escape(name),
+                            escape(&mesh.layer_names().join(", "))
                         ),
                     );
                 }
@@ -435,7 +452,11 @@ fn resolve_stroke(
 fn preset(name: &str) -> Result<Brdf, String> {
     material::preset(name).map(|m| m.brdf).ok_or_else(|| {
         let names: Vec<&str> = material::PRESETS.iter().map(|m| m.name).collect();
-        format!("no material named `{name}` (presets: {})", names.join(", "))
+        format!(
+            "no material named `{}` (presets: {})",
+            escape(name),
+            names.join(", ")
+        )
     })
 }
 
@@ -508,7 +529,11 @@ fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, S
                 let names: Vec<&str> = Pattern::ALL.iter().map(|p| p.name()).collect();
                 return fail(
                     ".pattern",
-                    format!("no pattern named `{name}` (patterns: {})", names.join(", ")),
+                    format!(
+                        "no pattern named `{}` (patterns: {})",
+                        escape(name),
+                        names.join(", ")
+                    ),
                 );
             };
             let second = match &spec.with {
@@ -521,33 +546,71 @@ fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, S
             if spec.with.is_some() {
                 return fail(".with", "only patterns mix two materials".into());
             }
-            let bytes = std::fs::read(path)
-                .map_err(|e| (".png".to_string(), format!("cannot read `{path}`: {e}")))?;
+            let shown = escape(path);
+            let bytes = crate::files::read_input(std::path::Path::new(path), MAX_STENCIL_BYTES)
+                .map_err(|e| (".png".to_string(), format!("cannot read `{shown}`: {e}")))?;
             Stencil::from_png(&bytes, brdf.specular, spec.tile)
-                .map_err(|e| (".png".to_string(), format!("`{path}`: {e}")))
+                .map_err(|e| (".png".to_string(), format!("`{shown}`: {e}")))
         }
         (Some(_), Some(_)) => fail("", "give either `pattern` or `png`, not both".into()),
         (None, None) => fail("", "give a `pattern` or a `png`".into()),
     }
 }
 
+/// The most dabs (samples after resampling) one stroke may make. Two samples far apart would
+/// otherwise resample into dabs without end; the bound is checked before a segment emits any.
+/// Raise it with [`PipelineSettings::max_dabs_per_stroke`](crate::pipeline::PipelineSettings)
+/// (`slayer sculpt --max-dabs`).
+pub const MAX_DABS_PER_STROKE: usize = 100_000;
+
+/// A stroke would make more dabs than its bound allows.
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[error(
+    "the stroke would make about {wanted:.0} dabs (its samples span {length} world units at a \
+     step of {step}), more than the {limit} allowed; raise the dab bound (`--max-dabs`, \
+     PipelineSettings::max_dabs_per_stroke) or split the stroke"
+)]
+pub struct DabLimit {
+    /// Dabs the stroke would make with the refused samples.
+    pub wanted: f64,
+    /// The stroke's length with them.
+    pub length: f64,
+    pub step: f32,
+    pub limit: usize,
+}
+
 /// Resamples a polyline of samples every `step` of arc length, interpolating pressure and
-/// normal; the first and last samples are kept. The whole of [`Resampler`] in one call.
-pub fn resample(samples: &[Sample], step: f32) -> Vec<Sample> {
+/// normal; the first and last samples are kept. The whole of [`Resampler`] in one call, bound
+/// by [`MAX_DABS_PER_STROKE`].
+pub fn resample(samples: &[Sample], step: f32) -> Result<Vec<Sample>, DabLimit> {
     let mut resampler = Resampler::new(step);
     let mut out = Vec::new();
     for &sample in samples {
-        resampler.push(sample, &mut out);
+        resampler.push(sample, &mut out)?;
     }
     resampler.finish(&mut out);
-    out
+    Ok(out)
+}
+
+/// How many dabs `samples` make at `step` (at most; the exact count the resampler emits is this
+/// or one less): for checking a stroke against a bound before it runs.
+pub fn dabs_for(samples: &[Sample], step: f32) -> f64 {
+    if step.is_nan() || step <= 0.0 {
+        return samples.len() as f64;
+    }
+    let length: f64 = samples
+        .windows(2)
+        .map(|w| w[0].position.as_dvec3().distance(w[1].position.as_dvec3()))
+        .sum();
+    (length / step as f64).floor() + 2.0
 }
 
 /// Resamples a stroke while it is drawn: samples are pushed as they arrive, and each push
 /// emits the samples every `step` of arc length that the new segment completes. The last
 /// input sample is emitted by [`Resampler::finish`] (only then is it known to be the last),
 /// unless an emission already lies on it. Pushing samples one at a time or all at once
-/// emits the same samples, bit for bit: the arithmetic is per segment.
+/// emits the same samples, bit for bit: the arithmetic is per segment. A push that would take
+/// the stroke past its dab bound emits nothing and changes nothing.
 #[derive(Debug, Clone)]
 pub struct Resampler {
     step: f32,
@@ -556,16 +619,29 @@ pub struct Resampler {
     last_emitted: Option<Vec3>,
     /// Arc length since the last emission.
     carried: f32,
+    /// Samples emitted so far, the bound on them, and the arc length pushed (for messages).
+    emitted: usize,
+    limit: usize,
+    length: f64,
 }
 
 impl Resampler {
-    /// A step that is not a positive number passes every sample through as it is.
+    /// A resampler bound by [`MAX_DABS_PER_STROKE`]. A step that is not a positive number
+    /// passes every sample through as it is.
     pub fn new(step: f32) -> Resampler {
+        Resampler::with_limit(step, MAX_DABS_PER_STROKE)
+    }
+
+    /// A resampler that emits at most `limit` samples, the last one included.
+    pub fn with_limit(step: f32, limit: usize) -> Resampler {
         Resampler {
             step,
             last_input: None,
             last_emitted: None,
             carried: 0.0,
+            emitted: 0,
+            limit,
+            length: 0.0,
         }
     }
 
@@ -573,8 +649,46 @@ impl Resampler {
         self.step.is_nan() || self.step <= 0.0
     }
 
-    /// Emits into `out` the samples the segment up to `sample` completes.
-    pub fn push(&mut self, sample: Sample, out: &mut Vec<Sample>) {
+    /// Emits into `out` the samples the segment up to `sample` completes, or refuses the
+    /// sample (and emits nothing) when they would take the stroke past its bound.
+    pub fn push(&mut self, sample: Sample, out: &mut Vec<Sample>) -> Result<(), DabLimit> {
+        let previous = self.last_input;
+        // The f32 length the segment is walked with, so that the count matches the walk.
+        let segment = previous.map_or(0.0, |a| a.position.distance(sample.position));
+        let emissions = self.emissions(segment, previous.is_none());
+        // One place is kept for the sample `finish` may add.
+        let wanted = self.emitted as f64 + emissions + 1.0;
+        if wanted > self.limit as f64 {
+            return Err(DabLimit {
+                wanted,
+                length: self.length + segment as f64,
+                step: self.step,
+                limit: self.limit,
+            });
+        }
+        let before = out.len();
+        self.emit(sample, out, emissions as usize);
+        self.emitted += out.len() - before;
+        self.length += segment as f64;
+        Ok(())
+    }
+
+    /// How many samples a segment of `length` emits at most (one more than the exact count
+    /// allows for the walk's rounding), in f64 so that an absurd length is counted, not walked.
+    fn emissions(&self, length: f32, first: bool) -> f64 {
+        if first || self.passes_through() {
+            return 1.0;
+        }
+        let (length, step) = (length as f64, self.step as f64);
+        let at = step - self.carried as f64;
+        if length <= 0.0 || at > length + step {
+            return 0.0;
+        }
+        ((length - at) / step).floor().max(0.0) + 2.0
+    }
+
+    /// Emits at most `cap` samples: f32 rounding may not add one the f64 count missed.
+    fn emit(&mut self, sample: Sample, out: &mut Vec<Sample>, cap: usize) {
         let previous = self.last_input.replace(sample);
         let Some(a) = previous.filter(|_| !self.passes_through()) else {
             out.push(sample);
@@ -585,7 +699,9 @@ impl Resampler {
         let step = self.step;
         let length = a.position.distance(b.position);
         let mut at = step - self.carried; // distance along this segment of the next emission
-        while at <= length && length > 0.0 {
+        let mut count = 0;
+        while at <= length && length > 0.0 && count < cap {
+            count += 1;
             let t = at / length;
             let emitted = Sample {
                 position: a.position.lerp(b.position, t),
@@ -599,7 +715,8 @@ impl Resampler {
             out.push(emitted);
             at += step;
         }
-        self.carried = length - (at - step);
+        // Below `step` unless the cap cut the walk short: then the next segment starts afresh.
+        self.carried = (length - (at - step)).min(step);
     }
 
     /// Emits the last sample pushed, unless the last emission lies on it. Pushing after this
@@ -611,6 +728,7 @@ impl Resampler {
         if !self.passes_through() && emitted.distance(last.position) > 1e-3 * self.step {
             out.push(last);
             self.last_emitted = Some(last.position);
+            self.emitted += 1;
         }
     }
 }
