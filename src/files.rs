@@ -38,7 +38,10 @@ pub fn read_input_text(path: &Path, limit: u64) -> io::Result<String> {
     String::from_utf8(read_input(path, limit)?).map_err(|e| {
         io::Error::new(
             io::ErrorKind::InvalidData,
-            format!("not a text file (invalid UTF-8 at byte {})", e.utf8_error().valid_up_to()),
+            format!(
+                "not a text file (invalid UTF-8 at byte {})",
+                e.utf8_error().valid_up_to()
+            ),
         )
     })
 }

@@ -27,7 +27,12 @@ const STROKE_FIELDS: &[&str] = &[
 ];
 const SAMPLE_FIELDS: &[&str] = &["position", "pressure", "normal"];
 const PAINT_FIELDS: &[&str] = &[
-    "material", "diffuse", "specular", "roughness", "opacity", "stencil",
+    "material",
+    "diffuse",
+    "specular",
+    "roughness",
+    "opacity",
+    "stencil",
 ];
 const STENCIL_FIELDS: &[&str] = &["pattern", "png", "with", "tile"];
 const CURVES: &[&str] = &["blend", "smooth", "sphere", "linear"];
@@ -117,10 +122,12 @@ fn describe(value: &Value) -> String {
 }
 
 fn number(value: &Value, at: &str) -> Result<f32, Mistake> {
-    value
-        .as_f64()
-        .map(|n| n as f32)
-        .ok_or_else(|| (at.to_string(), format!("{} is not a number", describe(value))))
+    value.as_f64().map(|n| n as f32).ok_or_else(|| {
+        (
+            at.to_string(),
+            format!("{} is not a number", describe(value)),
+        )
+    })
 }
 
 fn string(value: &Value, at: &str, what: &str) -> Result<String, Mistake> {
@@ -161,12 +168,15 @@ pub(super) fn file(value: &Value) -> Result<StrokeFile, Mistake> {
     let object = Object::new(value, "", FILE_FIELDS)?;
     let version = match object.get("version") {
         None => 1,
-        Some(v) => v.as_u64().filter(|&n| n <= u32::MAX as u64).ok_or_else(|| {
-            (
-                "version".to_string(),
-                format!("{} is not a version number (1)", describe(v)),
-            )
-        })? as u32,
+        Some(v) => v
+            .as_u64()
+            .filter(|&n| n <= u32::MAX as u64)
+            .ok_or_else(|| {
+                (
+                    "version".to_string(),
+                    format!("{} is not a version number (1)", describe(v)),
+                )
+            })? as u32,
     };
     let items = list(
         object.required("strokes", "a list of strokes")?,
@@ -213,7 +223,10 @@ fn stroke(value: &Value, at: &str) -> Result<StrokeSpec, Mistake> {
         })?,
     };
     Ok(StrokeSpec {
-        brush: brush(object.required("brush", "a brush name")?, &object.at("brush"))?,
+        brush: brush(
+            object.required("brush", "a brush name")?,
+            &object.at("brush"),
+        )?,
         radius: object.required_number("radius", "a length in world units")?,
         strength: object.required_number("strength", "a number from 0 to 1")?,
         falloff: match object.get("falloff") {
@@ -261,9 +274,12 @@ fn brush(value: &Value, at: &str) -> Result<BrushKind, Mistake> {
 
 fn falloff(value: &Value, at: &str) -> Result<Falloff, Mistake> {
     let object = Object::new(value, at, &["curve", "n"])?;
-    let curve = object
-        .string("curve", "a curve name")?
-        .ok_or_else(|| (object.at("curve"), format!("missing (give one of {})", CURVES.join(", "))))?;
+    let curve = object.string("curve", "a curve name")?.ok_or_else(|| {
+        (
+            object.at("curve"),
+            format!("missing (give one of {})", CURVES.join(", ")),
+        )
+    })?;
     let n = object.get("n");
     if n.is_some() && curve != "blend" {
         return Err((object.at("n"), "only the blend curve takes an `n`".into()));
@@ -272,12 +288,15 @@ fn falloff(value: &Value, at: &str) -> Result<Falloff, Mistake> {
         "blend" => {
             let n = match n {
                 None => 3,
-                Some(v) => v.as_u64().filter(|&n| n <= u32::MAX as u64).ok_or_else(|| {
-                    (
-                        object.at("n"),
-                        format!("{} is not a whole number (3 to 16)", describe(v)),
-                    )
-                })? as u32,
+                Some(v) => v
+                    .as_u64()
+                    .filter(|&n| n <= u32::MAX as u64)
+                    .ok_or_else(|| {
+                        (
+                            object.at("n"),
+                            format!("{} is not a whole number (3 to 16)", describe(v)),
+                        )
+                    })? as u32,
             };
             Ok(Falloff::Blend { n })
         }

@@ -15,8 +15,8 @@ pub use paint::{Paint, paint_share};
 pub use stencil::{Pattern, Stencil};
 pub use stroke::{
     DabLimit, LayerRef, MAX_DABS_PER_STROKE, MAX_RADIUS_OVER_EXTENT, PaintSpec, Resampler, Sample,
-    SampleSpec, StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec,
-    dabs_for, resample,
+    SampleSpec, StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec, dabs_for,
+    resample,
 };
 
 use serde::{Deserialize, Serialize};

@@ -243,8 +243,7 @@ impl StrokeFile {
                 message: if e.is_eof() {
                     "the file ends before its JSON is complete".into()
                 } else {
-                    "not valid JSON here (a stroke file is one JSON object; docs/strokes.md)"
-                        .into()
+                    "not valid JSON here (a stroke file is one JSON object; docs/strokes.md)".into()
                 },
             })?;
         let invalid = |(location, message): (String, String)| StrokeError::Invalid {
