@@ -154,6 +154,8 @@ impl std::fmt::Display for CheckReport {
         writeln!(f, "  faces             {}", self.faces)?;
         writeln!(f, "  layers            {}", self.layers)?;
         for (i, name) in self.layer_names.iter().enumerate() {
+            // Names come from the file: escaped, so that they cannot drive the terminal.
+            let name = crate::files::escape(name);
             writeln!(
                 f,
                 "    {i}: {name:<14} {:>9} faces  {:>5} components",

@@ -13,6 +13,7 @@ pub mod check;
 pub mod codec;
 pub mod collide;
 pub mod cpu;
+pub mod files;
 pub mod geom;
 pub mod gpu;
 pub mod grid;

@@ -56,7 +56,7 @@ fn resampling_spaces_samples_evenly_and_keeps_the_ends() {
             normal: None,
         },
     ];
-    let out = resample(&samples, 1.0);
+    let out = resample(&samples, 1.0).unwrap();
     assert_eq!(out.first().unwrap().position, Vec3::ZERO);
     assert_eq!(out.last().unwrap().position, Vec3::new(10.0, 5.0, 0.0));
     assert_eq!(out.len(), 16);
@@ -65,8 +65,8 @@ fn resampling_spaces_samples_evenly_and_keeps_the_ends() {
         // Arc-length steps of 1 (a chord across the corner is shorter).
         assert!(pair[0].position.distance(pair[1].position) <= 1.0 + 1e-5);
     }
-    assert_eq!(resample(&samples[..1], 1.0).len(), 1);
-    assert!(resample(&[], 1.0).is_empty());
+    assert_eq!(resample(&samples[..1], 1.0).unwrap().len(), 1);
+    assert!(resample(&[], 1.0).unwrap().is_empty());
 }
 
 fn sheet() -> Mesh {
@@ -248,7 +248,7 @@ fn bad_stroke_files_name_the_problem_and_where() {
             one(&format!(
                 r#""brush": "smudge", "radius": 1, "strength": 0.5, "layers": [0], {ok_sample}"#
             )),
-            "unknown variant `smudge`",
+            "strokes[0].brush: the text \"smudge\" is not a brush (brushes: draw,",
         ),
         (
             one(&format!(
@@ -266,7 +266,7 @@ fn bad_stroke_files_name_the_problem_and_where() {
             one(&format!(
                 r#""brush": "draw", "strength": 0.5, "layers": [0], {ok_sample}"#
             )),
-            "missing field `radius`",
+            "strokes[0].radius: missing",
         ),
         (
             one(&format!(

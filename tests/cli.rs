@@ -279,7 +279,7 @@ fn sculpt_with_a_bad_stroke_file_fails_cleanly_and_touches_nothing() {
     let cases = [
         (
             r#"{"strokes": [{"brush": "smudge", "radius": 0.1, "strength": 0.5, "layers": [0], "samples": [{"position": [0.5, 0.5, 0]}]}]}"#,
-            "unknown variant `smudge`",
+            "strokes[0].brush: the text \"smudge\" is not a brush",
         ),
         (
             r#"{"strokes": [{"brush": "draw", "radius": -0.1, "strength": 0.5, "layers": [0], "samples": [{"position": [0.5, 0.5, 0]}]}]}"#,
@@ -291,7 +291,7 @@ fn sculpt_with_a_bad_stroke_file_fails_cleanly_and_touches_nothing() {
         ),
         (
             r#"{"strokes": [{"brush": "draw", "radius": 0.1, "layers": [0], "samples": []}]}"#,
-            "missing field `strength`",
+            "strokes[0].strength: missing",
         ),
         ("not json", "s.json:1:"),
     ];

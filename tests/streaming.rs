@@ -96,13 +96,13 @@ fn resampling_across_calls_matches_resampling_the_whole() {
     let (_, strokes) = plaster_and_strokes(2_000, 6, 11);
     for stroke in &strokes {
         let step = stroke.settings().resampling_step();
-        let whole = resample(&stroke.samples, step);
+        let whole = resample(&stroke.samples, step).unwrap();
         for per_call in [1, 2, 5] {
             let mut resampler = Resampler::new(step);
             let mut out: Vec<Sample> = Vec::new();
             for chunk in stroke.samples.chunks(per_call) {
                 for &s in chunk {
-                    resampler.push(s, &mut out);
+                    resampler.push(s, &mut out).unwrap();
                 }
             }
             resampler.finish(&mut out);

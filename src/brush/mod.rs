@@ -1,19 +1,23 @@
 //! Brushes as deformation fields with a falloff (docs/design.md, "A stroke"), and strokes: polylines of samples
 //! resampled at a spacing relative to the radius.
 
+mod decode;
 mod falloff;
 mod field;
 mod paint;
+mod resample;
 mod stencil;
 mod stroke;
 
+pub use decode::{MAX_SAMPLES_PER_FILE, MAX_SAMPLES_PER_STROKE, MAX_STROKES};
 pub use falloff::Falloff;
 pub use field::{Dab, DabFrame, displacement};
 pub use paint::{Paint, paint_share};
+pub use resample::{DabLimit, MAX_DABS_PER_STROKE, Resampler, dabs_for, resample};
 pub use stencil::{Pattern, Stencil};
 pub use stroke::{
-    LayerRef, MAX_RADIUS_OVER_EXTENT, PaintSpec, Resampler, Sample, SampleSpec, StencilSpec,
-    Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec, resample,
+    LayerRef, MAX_RADIUS_OVER_EXTENT, MAX_STENCIL_BYTES, PaintSpec, Sample, SampleSpec,
+    StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec,
 };
 
 use serde::{Deserialize, Serialize};

@@ -47,15 +47,18 @@ use thiserror::Error;
 
 use std::sync::Arc;
 
+use super::decode::MAX_SAMPLES_PER_STROKE;
 use super::{Brush, BrushKind, Falloff, Paint, Pattern, Stencil};
+use crate::files::escape;
 use crate::material;
 use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
 
 /// A radius beyond this many times the mesh's bounding-box diagonal is rejected as absurd.
 pub const MAX_RADIUS_OVER_EXTENT: f32 = 10.0;
+/// The largest stencil PNG read (256 MiB): a texture, not a photograph archive.
+pub const MAX_STENCIL_BYTES: u64 = 256 << 20;
 /// A radius below this share of the mean edge length touches nothing and is rejected.
 const MIN_RADIUS_OVER_EDGE: f32 = 0.05;
-const MAX_SAMPLES: usize = 1_000_000;
 
 #[derive(Debug, Error)]
 pub enum StrokeError {
@@ -86,7 +89,7 @@ fn one() -> f32 {
     1.0
 }
 
-fn default_spacing() -> f32 {
+pub(super) fn default_spacing() -> f32 {
     0.25
 }
 
@@ -232,23 +235,32 @@ impl Stroke {
 impl StrokeFile {
     /// Parses JSON; `source_name` names the file in messages.
     pub fn parse(text: &str, source_name: &str) -> Result<StrokeFile, StrokeError> {
-        let file: StrokeFile = serde_json::from_str(text).map_err(|e| StrokeError::Json {
-            source_name: source_name.to_string(),
-            line: e.line(),
-            column: e.column(),
-            message: e
-                .to_string()
-                .split(" at line ")
-                .next()
-                .unwrap_or_default()
-                .to_string(),
-        })?;
-        if file.version != 1 {
-            return Err(StrokeError::Invalid {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| StrokeError::Json {
                 source_name: source_name.to_string(),
-                location: "version".into(),
-                message: format!("version {} is not supported (expected 1)", file.version),
-            });
+                line: e.line(),
+                column: e.column(),
+                message: if e.is_eof() {
+                    "the file ends before its JSON is complete".into()
+                } else {
+                    "not valid JSON here (a stroke file is one JSON object; docs/strokes.md)".into()
+                },
+            })?;
+        let invalid = |(location, message): (String, String)| StrokeError::Invalid {
+            source_name: source_name.to_string(),
+            location: if location.is_empty() {
+                "the file".into()
+            } else {
+                location
+            },
+            message,
+        };
+        let file = super::decode::file(&value).map_err(invalid)?;
+        if file.version != 1 {
+            return Err(invalid((
+                "version".into(),
+                format!("version {} is not supported (expected 1)", file.version),
+            )));
         }
         Ok(file)
     }
@@ -335,10 +347,13 @@ fn resolve_stroke(
     if spec.samples.is_empty() {
         return fail(".samples", "a stroke needs at least one sample".into());
     }
-    if spec.samples.len() > MAX_SAMPLES {
+    if spec.samples.len() > MAX_SAMPLES_PER_STROKE {
         return fail(
             ".samples",
-            format!("{} samples is more than {MAX_SAMPLES}", spec.samples.len()),
+            format!(
+                "{} samples is more than a stroke may have ({MAX_SAMPLES_PER_STROKE})",
+                spec.samples.len()
+            ),
         );
     }
     if spec.layers.is_empty() {
@@ -363,8 +378,9 @@ fn resolve_stroke(
                     return fail(
                         &format!(".layers[{k}]"),
                         format!(
-                            "no layer is named `{name}` (the mesh has: {})",
-                            mesh.layer_names().join(", ")
+                            "no layer is named `{}` (the mesh has: {})",
+                            escape(name),
+                            escape(&mesh.layer_names().join(", "))
                         ),
                     );
                 }
@@ -435,7 +451,11 @@ fn resolve_stroke(
 fn preset(name: &str) -> Result<Brdf, String> {
     material::preset(name).map(|m| m.brdf).ok_or_else(|| {
         let names: Vec<&str> = material::PRESETS.iter().map(|m| m.name).collect();
-        format!("no material named `{name}` (presets: {})", names.join(", "))
+        format!(
+            "no material named `{}` (presets: {})",
+            escape(name),
+            names.join(", ")
+        )
     })
 }
 
@@ -508,7 +528,11 @@ fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, S
                 let names: Vec<&str> = Pattern::ALL.iter().map(|p| p.name()).collect();
                 return fail(
                     ".pattern",
-                    format!("no pattern named `{name}` (patterns: {})", names.join(", ")),
+                    format!(
+                        "no pattern named `{}` (patterns: {})",
+                        escape(name),
+                        names.join(", ")
+                    ),
                 );
             };
             let second = match &spec.with {
@@ -521,96 +545,13 @@ fn resolve_stencil(spec: &StencilSpec, brdf: Brdf) -> Result<Stencil, (String, S
             if spec.with.is_some() {
                 return fail(".with", "only patterns mix two materials".into());
             }
-            let bytes = std::fs::read(path)
-                .map_err(|e| (".png".to_string(), format!("cannot read `{path}`: {e}")))?;
+            let shown = escape(path);
+            let bytes = crate::files::read_input(std::path::Path::new(path), MAX_STENCIL_BYTES)
+                .map_err(|e| (".png".to_string(), format!("cannot read `{shown}`: {e}")))?;
             Stencil::from_png(&bytes, brdf.specular, spec.tile)
-                .map_err(|e| (".png".to_string(), format!("`{path}`: {e}")))
+                .map_err(|e| (".png".to_string(), format!("`{shown}`: {e}")))
         }
         (Some(_), Some(_)) => fail("", "give either `pattern` or `png`, not both".into()),
         (None, None) => fail("", "give a `pattern` or a `png`".into()),
-    }
-}
-
-/// Resamples a polyline of samples every `step` of arc length, interpolating pressure and
-/// normal; the first and last samples are kept. The whole of [`Resampler`] in one call.
-pub fn resample(samples: &[Sample], step: f32) -> Vec<Sample> {
-    let mut resampler = Resampler::new(step);
-    let mut out = Vec::new();
-    for &sample in samples {
-        resampler.push(sample, &mut out);
-    }
-    resampler.finish(&mut out);
-    out
-}
-
-/// Resamples a stroke while it is drawn: samples are pushed as they arrive, and each push
-/// emits the samples every `step` of arc length that the new segment completes. The last
-/// input sample is emitted by [`Resampler::finish`] (only then is it known to be the last),
-/// unless an emission already lies on it. Pushing samples one at a time or all at once
-/// emits the same samples, bit for bit: the arithmetic is per segment.
-#[derive(Debug, Clone)]
-pub struct Resampler {
-    step: f32,
-    /// The last sample pushed, and where the last emitted one lies.
-    last_input: Option<Sample>,
-    last_emitted: Option<Vec3>,
-    /// Arc length since the last emission.
-    carried: f32,
-}
-
-impl Resampler {
-    /// A step that is not a positive number passes every sample through as it is.
-    pub fn new(step: f32) -> Resampler {
-        Resampler {
-            step,
-            last_input: None,
-            last_emitted: None,
-            carried: 0.0,
-        }
-    }
-
-    fn passes_through(&self) -> bool {
-        self.step.is_nan() || self.step <= 0.0
-    }
-
-    /// Emits into `out` the samples the segment up to `sample` completes.
-    pub fn push(&mut self, sample: Sample, out: &mut Vec<Sample>) {
-        let previous = self.last_input.replace(sample);
-        let Some(a) = previous.filter(|_| !self.passes_through()) else {
-            out.push(sample);
-            self.last_emitted = Some(sample.position);
-            return;
-        };
-        let b = sample;
-        let step = self.step;
-        let length = a.position.distance(b.position);
-        let mut at = step - self.carried; // distance along this segment of the next emission
-        while at <= length && length > 0.0 {
-            let t = at / length;
-            let emitted = Sample {
-                position: a.position.lerp(b.position, t),
-                pressure: a.pressure + (b.pressure - a.pressure) * t,
-                normal: match (a.normal, b.normal) {
-                    (Some(na), Some(nb)) => na.lerp(nb, t).try_normalize().or(Some(na)),
-                    (n, None) | (None, n) => n,
-                },
-            };
-            self.last_emitted = Some(emitted.position);
-            out.push(emitted);
-            at += step;
-        }
-        self.carried = length - (at - step);
-    }
-
-    /// Emits the last sample pushed, unless the last emission lies on it. Pushing after this
-    /// starts a new segment from that sample.
-    pub fn finish(&mut self, out: &mut Vec<Sample>) {
-        let (Some(last), Some(emitted)) = (self.last_input, self.last_emitted) else {
-            return;
-        };
-        if !self.passes_through() && emitted.distance(last.position) > 1e-3 * self.step {
-            out.push(last);
-            self.last_emitted = Some(last.position);
-        }
     }
 }

@@ -32,11 +32,12 @@ pub enum IoError {
 }
 
 impl IoError {
+    /// A parse error; control characters in `message` (which may quote the file) are escaped.
     pub fn parse(path: &str, line: Option<usize>, message: impl Into<String>) -> IoError {
         IoError::Parse {
             path: path.to_string(),
             line,
-            message: message.into(),
+            message: crate::files::escape(&message.into()).into_owned(),
         }
     }
 

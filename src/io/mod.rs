@@ -1,20 +1,22 @@
 //! Mesh files: OBJ (tobj underneath, one layer per `o`/`g`) and PLY (per-vertex BRDF and layer
 //! ids). Readers never panic on malformed input: every problem becomes an [`IoError`] naming the
-//! file and, where it applies, the line. Writers go through a temporary file and a rename, so a
-//! failed write never leaves half a mesh where a good one was.
+//! file and, where it applies, the line. Only regular files are read, at most
+//! [`MAX_INPUT_BYTES`](crate::files::MAX_INPUT_BYTES) of them. Writers go through temporary files
+//! and renames ([`AtomicBatch`]), so a failed write never leaves half a mesh where a good one
+//! was, nor an OBJ without its `.mtl`.
 
+mod atomic;
 mod error;
 mod obj;
 mod ply;
 
+pub use atomic::{AtomicBatch, sweep_stale_temporaries, write_atomically};
 pub use error::IoError;
 pub use obj::{
     ObjReport, layer_materials, parse_obj, write_mtl, write_obj, write_obj_with_materials,
 };
 pub use ply::{parse_ply, write_ply};
 
-use std::fs;
-use std::io::Write;
 use std::path::Path;
 
 use crate::mesh::Mesh;
@@ -116,7 +118,7 @@ pub fn load_mesh_bytes(
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
-    fs::read(path).map_err(|source| IoError::Io {
+    crate::files::read_input(path, crate::files::MAX_INPUT_BYTES).map_err(|source| IoError::Io {
         path: path.display().to_string(),
         source,
     })
@@ -134,10 +136,19 @@ pub fn encode_mesh(mesh: &Mesh, format: Format) -> Vec<u8> {
 }
 
 /// Writes a mesh in the format its extension names, atomically. An OBJ gets a material library
-/// beside it (`NAME.mtl`, one material per layer) that it names with `mtllib`.
+/// beside it (`NAME.mtl`, one material per layer) that it names with `mtllib`; the two are
+/// written as one ([`AtomicBatch`]).
 pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
+    let mut batch = AtomicBatch::new();
+    stage_mesh(&mut batch, mesh, path)?;
+    batch.commit()
+}
+
+/// Stages a mesh's file (and an OBJ's `.mtl`) in `batch`, to be written with other files as
+/// one unit.
+pub fn stage_mesh(batch: &mut AtomicBatch, mesh: &Mesh, path: &Path) -> Result<(), IoError> {
     match Format::of_path(path)? {
-        Format::Ply => write_atomically(path, &encode_mesh(mesh, Format::Ply)),
+        Format::Ply => batch.stage(path, &encode_mesh(mesh, Format::Ply)),
         Format::Obj => {
             let library = path.with_extension("mtl");
             let library_name = library
@@ -149,31 +160,8 @@ pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
             // Writing into a Vec cannot fail.
             let _ = write_obj_with_materials(mesh, &mut obj, Some(&library_name));
             let _ = write_mtl(mesh, &mut mtl);
-            write_atomically(path, &obj)?;
-            write_atomically(&library, &mtl)
+            batch.stage(path, &obj)?;
+            batch.stage(&library, &mtl)
         }
     }
-}
-
-/// Writes `bytes` to a temporary file beside `path`, syncs it, and renames it over `path`.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
-    let io_error = |source| IoError::Io {
-        path: path.display().to_string(),
-        source,
-    };
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "mesh".into());
-    let temporary = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut file = fs::File::create(&temporary)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        fs::rename(&temporary, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&temporary);
-    }
-    result.map_err(io_error)
 }

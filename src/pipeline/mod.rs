@@ -72,6 +72,9 @@ pub struct PipelineSettings {
     pub edge_length: Option<f32>,
     /// When the touched region is remeshed back to edge length `L`.
     pub remeshing: Remeshing,
+    /// The most dabs (samples after resampling) one stroke may make; samples that would take a
+    /// stroke past it are refused with [`PipelineError::TooManyDabs`] before they run.
+    pub max_dabs_per_stroke: usize,
 }
 
 /// When the pipeline remeshes what the brush touched (sLayer discusses both; docs/design.md).
@@ -108,6 +111,7 @@ impl Default for PipelineSettings {
             max_step: 1.0,
             edge_length: None,
             remeshing: Remeshing::AfterStroke,
+            max_dabs_per_stroke: crate::brush::MAX_DABS_PER_STROKE,
         }
     }
 }
@@ -194,4 +198,8 @@ pub enum PipelineError {
     Grid(#[from] GridError),
     #[error("the stroke has ended")]
     StrokeEnded,
+    /// Samples were refused: they would make the stroke more dabs than its bound. The mesh and
+    /// the stroke are as they were before the call.
+    #[error(transparent)]
+    TooManyDabs(#[from] crate::brush::DabLimit),
 }

@@ -115,7 +115,10 @@ impl<'a> StrokeInProgress<'a> {
             pipeline,
             mesh,
             active: Some(Active {
-                resampler: Resampler::new(stroke.resampling_step()),
+                resampler: Resampler::with_limit(
+                    stroke.resampling_step(),
+                    settings.max_dabs_per_stroke,
+                ),
                 stroke,
                 prepared,
                 scratch,
@@ -146,12 +149,12 @@ impl<'a> StrokeInProgress<'a> {
     /// Runs every sample `samples` completes at the stroke's spacing (the last one given is
     /// held until the next call or [`StrokeInProgress::finish`] shows where the stroke goes).
     /// Returns when their moves are in the mesh: nothing is left running for later calls.
+    /// Samples that would take the stroke past `PipelineSettings::max_dabs_per_stroke` are
+    /// refused, all of the call's, before any runs ([`PipelineError::TooManyDabs`]): the mesh
+    /// and the stroke stay as they were, and the stroke may go on.
     pub fn add_samples(&mut self, samples: &[Sample]) -> Result<SamplesReport, PipelineError> {
         let active = self.active.as_mut().ok_or(PipelineError::StrokeEnded)?;
-        let mut resampled = Vec::new();
-        for &sample in samples {
-            active.resampler.push(sample, &mut resampled);
-        }
+        let resampled = active.resample(samples)?;
         Ok(self.run_samples(&resampled))
     }
 
@@ -168,9 +171,7 @@ impl<'a> StrokeInProgress<'a> {
     pub fn finish_with(mut self, samples: &[Sample]) -> Result<StrokeReport, PipelineError> {
         let mut last = Vec::new();
         if let Some(active) = self.active.as_mut() {
-            for &sample in samples {
-                active.resampler.push(sample, &mut last);
-            }
+            last = active.resample(samples)?;
             active.resampler.finish(&mut last);
         }
         let last_call = self.run_samples(&last);
@@ -246,6 +247,18 @@ impl Pipeline {
 }
 
 impl Active {
+    /// The dabs `samples` complete, or an error (and the resampler as it was) when they would
+    /// take the stroke past its dab bound: all of a call's samples are judged before any runs.
+    fn resample(&mut self, samples: &[Sample]) -> Result<Vec<Sample>, PipelineError> {
+        let mut trial = self.resampler.clone();
+        let mut resampled = Vec::new();
+        for &sample in samples {
+            trial.push(sample, &mut resampled)?;
+        }
+        self.resampler = trial;
+        Ok(resampled)
+    }
+
     /// Whether the kernels may run the samples of a call ahead: each is one step that nothing
     /// else touches between — not a grab (it moves what its first sample caught), not with
     /// remeshing between samples.

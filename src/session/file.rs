@@ -16,7 +16,7 @@ use thiserror::Error;
 use super::history::Entry;
 use super::{BrushSettings, History, LayerSettings, ProximityPolicy, Session};
 use crate::codec::{DecodeError, Reader, Writer};
-use crate::io::IoError;
+use crate::io::{AtomicBatch, IoError};
 use crate::mesh::{Brdf, Mesh, MeshDelta, RawMeshError};
 
 /// The first bytes of every session file: a high byte and a CR-LF/LF pair catch transfers
@@ -307,19 +307,34 @@ pub fn open(path: &Path) -> Result<Session, SessionFileError> {
     if !is_session_path(path) {
         return Ok(Session::new(crate::io::read_mesh(path)?));
     }
-    let bytes = std::fs::read(path).map_err(|source| IoError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let bytes =
+        crate::files::read_input(path, crate::files::MAX_INPUT_BYTES).map_err(|source| {
+            IoError::Io {
+                path: path.display().to_string(),
+                source,
+            }
+        })?;
     read_session(&bytes, &path.display().to_string())
 }
 
 /// Saves a session atomically: a `.slayer` path gets the session file (with its history when
 /// `with_history`), a mesh path (OBJ, PLY) the mesh alone.
 pub fn save(session: &Session, path: &Path, with_history: bool) -> Result<(), IoError> {
+    let mut batch = AtomicBatch::new();
+    stage(&mut batch, session, path, with_history)?;
+    batch.commit()
+}
+
+/// [`save`] staged in `batch`, to be written with other files as one unit.
+pub fn stage(
+    batch: &mut AtomicBatch,
+    session: &Session,
+    path: &Path,
+    with_history: bool,
+) -> Result<(), IoError> {
     if is_session_path(path) {
-        crate::io::write_atomically(path, &write_session(session, with_history))
+        batch.stage(path, &write_session(session, with_history))
     } else {
-        crate::io::write_mesh(&session.mesh, path)
+        crate::io::stage_mesh(batch, &session.mesh, path)
     }
 }

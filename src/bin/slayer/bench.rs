@@ -156,6 +156,7 @@ pub fn sculpt_with_progress(
 }
 
 pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
+    crate::strokes::check_stroke_count("--strokes", options.strokes)?;
     // Open the backend once up front: a missing GPU is an error before any work, and `auto`
     // says what it chose once; the scenes then use that choice without asking again.
     let (pipeline_name, adapter, resolved) = match options.backend {

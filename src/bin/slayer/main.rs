@@ -69,7 +69,8 @@ enum Command {
         json: bool,
     },
     /// Apply a stroke file to a mesh or session and write the result (the input is never
-    /// modified). A `.slayer` output keeps every stroke as an undoable history entry.
+    /// modified unless `--in-place` is given). A `.slayer` output keeps every stroke as an
+    /// undoable history entry.
     Sculpt {
         /// Mesh (.obj, .ply) or session (.slayer).
         #[arg(long)]
@@ -80,6 +81,13 @@ enum Command {
         /// Mesh (.obj, .ply) or session (.slayer, with the history).
         #[arg(long)]
         output: PathBuf,
+        /// Allow the output to be the input file itself (it is replaced only once the whole
+        /// result is written).
+        #[arg(long)]
+        in_place: bool,
+        /// The most dabs (samples after resampling at the stroke's spacing) one stroke may make.
+        #[arg(long, default_value_t = slayer::brush::MAX_DABS_PER_STROKE, value_name = "N")]
+        max_dabs: usize,
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
@@ -212,7 +220,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
+    // Where the user asked for JSON, a failure is JSON too.
+    let json_errors = matches!(
+        cli.command,
+        Command::Check { json: true, .. } | Command::Adapters { json: true }
+    );
     let result = match cli.command {
         Command::Demo {
             out,
@@ -232,10 +246,21 @@ fn main() -> ExitCode {
             input,
             strokes,
             output,
+            in_place,
+            max_dabs,
             stats,
             remesh,
             backend,
-        } => sculpt::run(&input, &strokes, &output, stats.as_deref(), remesh, backend),
+        } => sculpt::run(&sculpt::Args {
+            input: &input,
+            strokes: &strokes,
+            output: &output,
+            in_place,
+            max_dabs,
+            stats: stats.as_deref(),
+            remeshing: remesh,
+            backend,
+        }),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
         Command::Undo {
             session,
@@ -306,9 +331,24 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(error) => {
-            eprintln!("error: {}", one_line(&error));
+            let line = one_line(&error);
+            eprintln!("error: {line}");
+            if json_errors {
+                println!("{}", serde_json::json!({ "error": line }));
+            }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A closed stdout (`slayer check FILE | head -1`) ends the program quietly, as it does any
+/// Unix tool, instead of a panic in the next `println!`: Rust ignores SIGPIPE by default.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: run first thing in main, before any thread starts; resetting a signal's
+    // disposition to its default touches no memory of ours.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
@@ -326,7 +366,8 @@ pub fn one_line(error: &anyhow::Error) -> String {
             line.push_str(&text);
         }
     }
-    line.replace('\n', " ")
+    // Messages may quote a file's bytes: no control character reaches the terminal.
+    slayer::files::escape(&line.replace('\n', " ")).into_owned()
 }
 
 fn adapters(json: bool) -> anyhow::Result<ExitCode> {

@@ -1,41 +1,55 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use anyhow::Context;
-use slayer::brush::StrokeFile;
+use anyhow::{Context, bail};
+use slayer::brush::{Stroke, StrokeFile, dabs_for};
+use slayer::io::AtomicBatch;
 use slayer::pipeline::{PipelineSettings, Remeshing, StrokeReport};
 
 use crate::progress::Bar;
 
-/// Applies a stroke file to a mesh or session and writes the result; the input is never
-/// touched. Each stroke is one history entry of the session a `.slayer` output keeps.
-pub fn run(
-    input: &Path,
-    strokes: &Path,
-    output: &Path,
-    stats: Option<&Path>,
-    remeshing: Remeshing,
-    backend: crate::backend::Backend,
-) -> anyhow::Result<ExitCode> {
-    slayer::session::check_save_path(output)?;
-    let mut session = slayer::session::open(input)?;
-    let text =
-        std::fs::read_to_string(strokes).with_context(|| format!("{}", strokes.display()))?;
-    let name = strokes.display().to_string();
+/// What `slayer sculpt` was given.
+pub struct Args<'a> {
+    pub input: &'a Path,
+    pub strokes: &'a Path,
+    pub output: &'a Path,
+    /// The output may be the input file itself.
+    pub in_place: bool,
+    /// The most dabs one stroke may make.
+    pub max_dabs: usize,
+    pub stats: Option<&'a Path>,
+    pub remeshing: Remeshing,
+    pub backend: crate::backend::Backend,
+}
+
+/// Applies a stroke file to a mesh or session and writes the result (and the stats) as one
+/// unit; the input is never touched unless `--in-place` names it as the output. Each stroke is
+/// one history entry of the session a `.slayer` output keeps.
+pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
+    slayer::session::check_save_path(args.output)?;
+    refuse_overwriting_input(args)?;
+    let mut session = slayer::session::open(args.input)?;
+    let text = slayer::files::read_input_text(args.strokes, slayer::files::MAX_INPUT_BYTES)
+        .with_context(|| format!("{}", args.strokes.display()))?;
+    let name = args.strokes.display().to_string();
     let file = StrokeFile::parse(&text, &name)?;
     let strokes = file.resolve(session.mesh(), &name)?;
+    check_dabs(&strokes, args.max_dabs, &name)?;
     let mut pipeline = crate::backend::choose(
-        backend,
+        args.backend,
         PipelineSettings {
-            remeshing,
+            remeshing: args.remeshing,
+            max_dabs_per_stroke: args.max_dabs,
             ..PipelineSettings::default()
         },
     )?
     .pipeline;
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
-    for stroke in &strokes {
-        let (report, recorded) = session.apply_stroke(&mut pipeline, stroke)?;
+    for (i, stroke) in strokes.iter().enumerate() {
+        let (report, recorded) = session
+            .apply_stroke(&mut pipeline, stroke)
+            .with_context(|| format!("{name}: strokes[{i}]"))?;
         if recorded.dropped > 0 {
             bar.println(&format!(
                 "note: the history passed its cap of {} MiB; its {} oldest entries were dropped",
@@ -53,7 +67,18 @@ pub fn run(
     let mesh = session.mesh();
     mesh.validate()
         .context("the sculpted mesh failed validation (not written)")?;
-    slayer::session::save(&session, output, true)?;
+    let mut batch = AtomicBatch::new();
+    slayer::session::stage(&mut batch, &session, args.output, true)?;
+    if let Some(path) = args.stats {
+        let json = serde_json::json!({
+            "backend": pipeline.name(),
+            "strokes": reports,
+            "vertices": mesh.live_vertex_count(),
+            "faces": mesh.live_face_count(),
+        });
+        batch.stage(path, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    }
+    batch.commit()?;
     let samples: usize = reports.iter().map(|r| r.samples).sum();
     let clamped: usize = reports.iter().map(|r| r.clamped).sum();
     let total_ms: f64 = reports.iter().map(|r| r.phases.total()).sum();
@@ -61,16 +86,59 @@ pub fn run(
         "{} strokes, {samples} samples, {clamped} collisions, {:.3} ms per sample -> {}",
         strokes.len(),
         total_ms / samples.max(1) as f64,
-        output.display()
+        args.output.display()
     );
-    if let Some(path) = stats {
-        let json = serde_json::json!({
-            "backend": pipeline.name(),
-            "strokes": reports,
-            "vertices": mesh.live_vertex_count(),
-            "faces": mesh.live_face_count(),
-        });
-        slayer::io::write_atomically(path, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The output (or the stats) naming the input file itself is refused without `--in-place`.
+fn refuse_overwriting_input(args: &Args<'_>) -> anyhow::Result<()> {
+    if args.in_place {
+        return Ok(());
+    }
+    let outputs = [Some(args.output), args.stats];
+    for output in outputs.into_iter().flatten() {
+        if same_file(args.input, output) {
+            bail!(
+                "{}: the output is the input file; give another --output, or --in-place to \
+                 replace the input",
+                output.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` name one file: by device and inode when both exist (links and other
+/// spellings of one path included), by canonical path otherwise.
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return (a.dev(), a.ino()) == (b.dev(), b.ino());
+        }
+    }
+    let canonical = |p: &Path| {
+        let folder = p.parent().filter(|f| !f.as_os_str().is_empty());
+        let folder = folder.unwrap_or(Path::new(".")).canonicalize().ok()?;
+        Some(folder.join(p.file_name()?))
+    };
+    matches!((canonical(a), canonical(b)), (Some(x), Some(y)) if x == y)
+}
+
+/// Refuses, before any stroke runs, a stroke that would make more than `limit` dabs.
+fn check_dabs(strokes: &[Stroke], limit: usize, name: &str) -> anyhow::Result<()> {
+    for (i, stroke) in strokes.iter().enumerate() {
+        let step = stroke.settings().resampling_step();
+        let dabs = dabs_for(&stroke.samples, step);
+        if dabs > limit as f64 {
+            bail!(
+                "{name}: strokes[{i}].samples: the stroke would make about {dabs:.0} dabs at a \
+                 step of {step} world units, more than the {limit} allowed; raise --max-dabs \
+                 or split the stroke"
+            );
+        }
+    }
+    Ok(())
 }

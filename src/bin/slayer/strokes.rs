@@ -13,6 +13,7 @@ pub fn run(
     torture: bool,
     output: &Path,
 ) -> anyhow::Result<ExitCode> {
+    check_stroke_count("--count", strokes)?;
     let kind: SceneKind = scene.parse()?;
     let mesh = generate(&SceneSpec {
         kind,
@@ -38,4 +39,17 @@ pub fn run(
         output.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses a stroke count that no stroke file may hold ([`slayer::brush::MAX_STROKES`]), before
+/// anything is generated: a script of that many strokes could not be replayed.
+pub fn check_stroke_count(flag: &str, count: usize) -> anyhow::Result<()> {
+    let limit = slayer::brush::MAX_STROKES;
+    if count > limit {
+        anyhow::bail!(
+            "{flag} {count} is more strokes than a stroke file may hold ({limit}); \
+             run several scripts with different --seed values instead"
+        );
+    }
+    Ok(())
 }

@@ -1,0 +1,156 @@
+//! Issue 22, item 1: work derived from input is bounded before it starts. Two samples far
+//! apart, streamed or in a file, are refused with a clear error and leave the mesh alone.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use slayer::brush::{
+    Brush, BrushKind, Falloff, MAX_STROKES, Resampler, Sample, Stroke, StrokeFile, StrokeSettings,
+};
+use slayer::mesh::Mesh;
+use slayer::pipeline::{Pipeline, PipelineError, PipelineSettings};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+
+fn plaster() -> Mesh {
+    generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 2_000,
+        seed: 1,
+    })
+    .unwrap()
+}
+
+fn sample(x: f32, y: f32, z: f32) -> Sample {
+    Sample {
+        position: Vec3::new(x, y, z),
+        pressure: 1.0,
+        normal: None,
+    }
+}
+
+fn settings(radius: f32) -> StrokeSettings {
+    StrokeSettings {
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius,
+            strength: 0.5,
+            falloff: Falloff::default(),
+            invert: true,
+        },
+        paint: None,
+        layers: vec![1],
+        spacing: 0.25,
+    }
+}
+
+/// The issue's stroke: `[-0.26, 0.43, 0]` then `[1e17, 0, 0]` at radius 0.05 resampled into
+/// dabs without end; now it is refused at once and the mesh is as it was.
+#[test]
+fn two_far_samples_are_refused_before_any_dab() {
+    let mut mesh = plaster();
+    let before = mesh.positions().to_vec();
+    let stroke = Stroke {
+        samples: vec![sample(-0.26, 0.43, 0.0), sample(1e17, 0.0, 0.0)],
+        ..stroke_of(settings(0.05))
+    };
+    let started = Instant::now();
+    let result = Pipeline::new(PipelineSettings::default()).apply_stroke(&mut mesh, &stroke);
+    assert!(
+        started.elapsed() < Duration::from_secs(5),
+        "refused at once"
+    );
+    match result {
+        Err(PipelineError::TooManyDabs(limit)) => {
+            assert_eq!(limit.limit, slayer::brush::MAX_DABS_PER_STROKE);
+            assert!(limit.wanted > 1e18, "{limit:?}");
+            let message = limit.to_string();
+            assert!(message.contains("--max-dabs"), "{message}");
+            assert!(message.contains("100000 allowed"), "{message}");
+        }
+        other => panic!("expected TooManyDabs, got {other:?}"),
+    }
+    assert_eq!(mesh.positions(), &before[..], "the mesh is untouched");
+}
+
+fn stroke_of(settings: StrokeSettings) -> Stroke {
+    Stroke {
+        brush: settings.brush,
+        paint: settings.paint,
+        layers: settings.layers,
+        spacing: settings.spacing,
+        samples: Vec::new(),
+    }
+}
+
+/// A streamed stroke has the same bound: a call whose samples would pass it is refused whole,
+/// runs none of its samples, and the stroke goes on afterwards.
+#[test]
+fn a_streamed_stroke_refuses_samples_past_its_bound_and_goes_on() {
+    let mut mesh = plaster();
+    let mut pipeline = Pipeline::new(PipelineSettings {
+        max_dabs_per_stroke: 40,
+        ..PipelineSettings::default()
+    });
+    let mut stroke = pipeline.begin_stroke(&mut mesh, settings(0.1)).unwrap();
+    let near = [sample(0.3, 0.5, 0.15), sample(0.35, 0.5, 0.15)];
+    let first = stroke.add_samples(&near).unwrap();
+    assert!(first.samples > 0);
+    let before = stroke.mesh().positions().to_vec();
+    // 0.025 per dab: 2 units is 80 dabs, past the bound of 40; a near sample comes first in
+    // the same call and must not run either.
+    let refused = stroke.add_samples(&[sample(0.4, 0.5, 0.15), sample(2.4, 0.5, 0.15)]);
+    match refused {
+        Err(PipelineError::TooManyDabs(limit)) => assert_eq!(limit.limit, 40),
+        other => panic!("expected TooManyDabs, got {other:?}"),
+    }
+    assert_eq!(stroke.mesh().positions(), &before[..], "nothing ran");
+    let again = stroke.add_samples(&[sample(0.45, 0.5, 0.15)]).unwrap();
+    assert!(again.samples > 0, "the stroke goes on from where it was");
+    let report = stroke.finish().unwrap();
+    assert!(report.samples <= 40, "{}", report.samples);
+}
+
+/// The resampler itself: a push past the bound emits nothing and leaves it as it was, and a
+/// stroke never emits more than the bound, its last sample included.
+#[test]
+fn the_resampler_never_emits_past_its_bound() {
+    let mut resampler = Resampler::with_limit(0.1, 25);
+    let mut out = Vec::new();
+    resampler.push(sample(0.0, 0.0, 0.0), &mut out).unwrap();
+    assert!(resampler.push(sample(1e17, 0.0, 0.0), &mut out).is_err());
+    assert_eq!(out.len(), 1, "the refused push emitted nothing");
+    let mut x = 0.0;
+    while resampler.push(sample(x + 0.35, 0.0, 0.0), &mut out).is_ok() {
+        x += 0.35;
+    }
+    resampler.finish(&mut out);
+    assert!(out.len() <= 25, "{}", out.len());
+    assert!(
+        out.len() >= 20,
+        "the bound is used, not feared: {}",
+        out.len()
+    );
+    let end = out.last().unwrap().position.x;
+    assert!(
+        (end - x).abs() < 1e-3,
+        "ends on the last accepted sample: {end} {x}"
+    );
+}
+
+/// A stroke file holds at most MAX_STROKES strokes; more is refused by the parser, in words.
+#[test]
+fn a_stroke_file_with_too_many_strokes_is_refused() {
+    let one = r#"{"brush": "draw", "radius": 0.1, "strength": 0.5, "layers": [0], "samples": [{"position": [0, 0, 0]}]}"#;
+    let text = format!(
+        r#"{{"strokes": [{}]}}"#,
+        vec![one; MAX_STROKES + 1].join(",")
+    );
+    let error = StrokeFile::parse(&text, "many.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains(&format!("{} strokes", MAX_STROKES + 1)),
+        "{error}"
+    );
+    assert!(error.contains(&MAX_STROKES.to_string()), "{error}");
+}
