@@ -468,3 +468,59 @@ fn unbounded_work_is_refused_at_once_with_the_bound() {
     assert!(!script.exists());
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `slayer sculpt` killed with SIGKILL while it writes a 1M-face output: the previous output is
+/// byte-identical, and the temporary file the killed run left is swept by the next write into
+/// that folder.
+#[test]
+fn a_writer_killed_mid_write_leaves_the_previous_file_intact() {
+    let dir = scratch("killed");
+    let input = dir.join("big.ply");
+    write_scene("plane", 1_000_000, &[], &input);
+    let output = dir.join("out.ply");
+    write_scene("plane", 200, &[], &output);
+    let previous = std::fs::read(&output).unwrap();
+    let strokes = stroke_file(&dir, "s.json", SMALL_STROKE);
+    let is_temporary = |name: &str| name.starts_with(".out.ply.slayer-tmp.");
+    let mut caught = false;
+    // The temporary file lives for the write and its sync (tens of milliseconds at 1M faces):
+    // a run that finished before it was seen is tried again on the previous file.
+    for _ in 0..5 {
+        std::fs::write(&output, &previous).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_slayer"))
+            .args(["sculpt", "--input", arg(&input), "--strokes", arg(&strokes)])
+            .args(["--output", arg(&output), "--backend", "cpu"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the binary runs");
+        while child.try_wait().unwrap().is_none() {
+            if listing(&dir).iter().any(|n| is_temporary(n)) {
+                child.kill().unwrap(); // SIGKILL
+                caught = true;
+                break;
+            }
+            std::thread::sleep(Duration::from_micros(500));
+        }
+        child.wait().unwrap();
+        if caught {
+            break;
+        }
+    }
+    assert!(caught, "never saw the writer's temporary file");
+    assert!(
+        std::fs::read(&output).unwrap() == previous,
+        "the previous output changed"
+    );
+    assert!(
+        listing(&dir).iter().any(|n| is_temporary(n)),
+        "the kill left no temporary file"
+    );
+    write_scene("plane", 200, &[], &dir.join("next.ply"));
+    let left: Vec<String> = listing(&dir)
+        .into_iter()
+        .filter(|n| n.contains(".slayer-tmp."))
+        .collect();
+    assert!(left.is_empty(), "stray temporary files: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

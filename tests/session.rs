@@ -375,6 +375,14 @@ fn cli_sculpt_then_undo_every_stroke_gives_the_scene_back() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert_eq!(digest_of(&undone), digest_of(&scene));
+    let redone = path("r.slayer");
+    let out = slayer(&["redo", &s(&undone), "--steps", "6", "-o", &s(&redone)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(digest_of(&redone), digest_of(&sculpted));
     // The undone entries are kept for redo; one more undo than there are is refused.
     let out = slayer(&["undo", &s(&undone), "-o", &s(&path("x.slayer"))]);
     assert!(!out.status.success());

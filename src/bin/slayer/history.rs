@@ -67,32 +67,47 @@ pub fn list(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Undoes `steps` entries of a session file's history and writes the result.
-pub fn undo(path: &Path, steps: usize, output: &Path) -> anyhow::Result<ExitCode> {
+/// Which way `slayer undo` / `slayer redo` steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    Undo,
+    Redo,
+}
+
+/// Undoes (or redoes) `steps` entries of a session file's history and writes the result.
+pub fn step(path: &Path, way: Step, steps: usize, output: &Path) -> anyhow::Result<ExitCode> {
     slayer::session::check_save_path(output)?;
     let mut session = open_session(path)?;
-    let done = session.history().done();
-    if steps > done {
+    let history = session.history();
+    let (available, verb, what) = match way {
+        Step::Undo => (history.done(), "undid", "to undo"),
+        Step::Redo => (history.entries().len() - history.done(), "redid", "to redo"),
+    };
+    if steps > available {
         anyhow::bail!(
-            "{}: --steps {steps} is more than the {done} entries there are to undo",
+            "{}: --steps {steps} is more than the {available} entries there are {what}",
             path.display()
         );
     }
     let started = std::time::Instant::now();
     for _ in 0..steps {
-        session.undo();
+        match way {
+            Step::Undo => session.undo(),
+            Step::Redo => session.redo(),
+        };
     }
     let millis = started.elapsed().as_secs_f64() * 1e3;
     session
         .mesh()
         .validate()
-        .context("the mesh after undoing failed validation (not written)")?;
+        .context("the mesh after stepping through the history failed validation (not written)")?;
     slayer::session::save(&session, output, true)?;
+    let history = session.history();
     println!(
-        "undid {steps} of {done} entries in {millis:.1} ms -> {} ({} left to undo, {} to redo)",
+        "{verb} {steps} of {available} entries in {millis:.1} ms -> {} ({} left to undo, {} to redo)",
         output.display(),
-        session.history().done(),
-        session.history().entries().len() - session.history().done()
+        history.done(),
+        history.entries().len() - history.done()
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -110,6 +110,17 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Redo the first undone entries of a session file's history and write the result.
+    Redo {
+        /// Session file (.slayer).
+        session: PathBuf,
+        /// How many entries to redo.
+        #[arg(long, default_value_t = 1)]
+        steps: usize,
+        /// Output: a session (.slayer) or a mesh.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// List a session file's history: each entry and the bytes it holds.
     History {
         /// Session file (.slayer).
@@ -266,7 +277,12 @@ fn main() -> ExitCode {
             session,
             steps,
             output,
-        } => history::undo(&session, steps, &output),
+        } => history::step(&session, history::Step::Undo, steps, &output),
+        Command::Redo {
+            session,
+            steps,
+            output,
+        } => history::step(&session, history::Step::Redo, steps, &output),
         Command::History { session, json } => history::list(&session, json),
         Command::Render {
             file,
