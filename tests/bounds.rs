@@ -40,6 +40,7 @@ fn settings(radius: f32) -> StrokeSettings {
         paint: None,
         layers: vec![1],
         spacing: 0.25,
+        symmetry: None,
     }
 }
 
@@ -78,6 +79,7 @@ fn stroke_of(settings: StrokeSettings) -> Stroke {
         paint: settings.paint,
         layers: settings.layers,
         spacing: settings.spacing,
+        symmetry: None,
         samples: Vec::new(),
     }
 }

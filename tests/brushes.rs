@@ -85,6 +85,7 @@ fn stroke(kind: BrushKind, invert: bool, points: &[Vec3]) -> Stroke {
         },
         layers: vec![0],
         spacing: 0.25,
+        symmetry: None,
         samples: points
             .iter()
             .map(|&position| Sample {

@@ -79,6 +79,7 @@ fn push_down(mesh: &Mesh, rng: &mut ChaCha8Rng, edge: f32) -> Stroke {
         },
         layers: (1..mesh.layer_count() as u32).collect(),
         spacing: 0.25,
+        symmetry: None,
         samples,
     }
 }
@@ -227,6 +228,7 @@ fn masked_vertices_and_inactive_layers_stay_still() {
         },
         layers: vec![2, 0],
         spacing: 0.25,
+        symmetry: None,
         samples: vec![Sample {
             position: before[center_vertex],
             pressure: 1.0,
@@ -352,6 +354,7 @@ fn a_fold_within_one_layer_still_collides() {
         },
         layers: vec![0],
         spacing: 0.25,
+        symmetry: None,
         // Back and forth over the upper fold, so every vertex there is pressed many times.
         samples: (0..=8)
             .map(|k| Sample {

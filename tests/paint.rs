@@ -95,6 +95,7 @@ fn stroke(kind: BrushKind, paint: Option<Paint>, layers: Vec<u32>, at: Vec3) -> 
         paint,
         layers,
         spacing: 0.25,
+        symmetry: None,
         samples: vec![Sample {
             position: at,
             pressure: 1.0,

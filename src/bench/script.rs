@@ -156,6 +156,7 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
             layers: active.into_iter().map(LayerRef::Index).collect(),
             paint: None,
             spacing: spec.spacing,
+            symmetry: None,
             samples: points,
         });
     }

@@ -8,7 +8,7 @@ use serde_json::{Map, Value};
 use super::stroke::{
     LayerRef, PaintSpec, SampleSpec, StencilSpec, StrokeFile, StrokeSpec, default_spacing,
 };
-use super::{BrushKind, Falloff};
+use super::{BrushKind, Falloff, SymmetrySpec};
 use crate::files::escape;
 
 /// The most strokes a stroke file may hold.
@@ -23,7 +23,8 @@ pub(super) type Mistake = (String, String);
 
 const FILE_FIELDS: &[&str] = &["version", "strokes"];
 const STROKE_FIELDS: &[&str] = &[
-    "brush", "radius", "strength", "falloff", "invert", "layers", "paint", "spacing", "samples",
+    "brush", "radius", "strength", "falloff", "invert", "layers", "paint", "spacing", "symmetry",
+    "samples",
 ];
 const SAMPLE_FIELDS: &[&str] = &["position", "pressure", "normal"];
 const PAINT_FIELDS: &[&str] = &[
@@ -243,10 +244,40 @@ fn stroke(value: &Value, at: &str) -> Result<StrokeSpec, Mistake> {
             .map(|v| paint(v, &object.at("paint")))
             .transpose()?,
         spacing: object.number("spacing")?.unwrap_or_else(default_spacing),
+        symmetry: object
+            .get("symmetry")
+            .map(|v| symmetry(v, &object.at("symmetry")))
+            .transpose()?,
         samples: samples(
             object.required("samples", "a list of samples")?,
             &object.at("samples"),
         )?,
+    })
+}
+
+fn symmetry(value: &Value, at: &str) -> Result<SymmetrySpec, Mistake> {
+    if let Some(axis) = value.as_str() {
+        return Ok(SymmetrySpec::Axis(axis.to_string()));
+    }
+    let object = Object::new(value, at, &["point", "normal"])
+        .map_err(|_| (at.to_string(), format!("{} is not an axis (\"x\", \"y\", \"z\") or a plane {{\"point\": [..], \"normal\": [..]}}", describe(value))))?;
+    Ok(SymmetrySpec::Plane {
+        point: object
+            .triple("point", "a point [x, y, z]")?
+            .ok_or_else(|| {
+                (
+                    object.at("point"),
+                    "is missing: a point [x, y, z]".to_string(),
+                )
+            })?,
+        normal: object
+            .triple("normal", "a direction [x, y, z]")?
+            .ok_or_else(|| {
+                (
+                    object.at("normal"),
+                    "is missing: a direction [x, y, z]".to_string(),
+                )
+            })?,
     })
 }
 

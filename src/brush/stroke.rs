@@ -48,7 +48,7 @@ use thiserror::Error;
 use std::sync::Arc;
 
 use super::decode::MAX_SAMPLES_PER_STROKE;
-use super::{Brush, BrushKind, Falloff, Paint, Pattern, Stencil};
+use super::{Brush, BrushKind, Falloff, Mirror, Paint, Pattern, Stencil, SymmetrySpec};
 use crate::files::escape;
 use crate::material;
 use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
@@ -168,6 +168,9 @@ pub struct StrokeSpec {
     pub paint: Option<PaintSpec>,
     #[serde(default = "default_spacing")]
     pub spacing: f32,
+    /// Brush every sample and its image across this plane too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub symmetry: Option<SymmetrySpec>,
     pub samples: Vec<SampleSpec>,
 }
 
@@ -198,6 +201,8 @@ pub struct Stroke {
     pub layers: Vec<LayerId>,
     /// Resampling step as a share of the radius.
     pub spacing: f32,
+    /// Every sample brushed with its image across this plane, in the same steps.
+    pub symmetry: Option<Mirror>,
     pub samples: Vec<Sample>,
 }
 
@@ -211,6 +216,8 @@ pub struct StrokeSettings {
     pub layers: Vec<LayerId>,
     /// Resampling step as a share of the radius.
     pub spacing: f32,
+    /// Every sample brushed with its image across this plane, in the same steps.
+    pub symmetry: Option<Mirror>,
 }
 
 impl StrokeSettings {
@@ -228,6 +235,7 @@ impl Stroke {
             paint: self.paint.clone(),
             layers: self.layers.clone(),
             spacing: self.spacing,
+            symmetry: self.symmetry,
         }
     }
 }
@@ -444,6 +452,12 @@ fn resolve_stroke(
         },
         layers,
         spacing: spec.spacing,
+        symmetry: spec
+            .symmetry
+            .as_ref()
+            .map(|symmetry| symmetry.resolve(mesh))
+            .transpose()
+            .map_err(|message| (".symmetry".to_string(), message))?,
         samples,
     })
 }

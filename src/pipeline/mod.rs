@@ -24,7 +24,7 @@
 //! let brush = Brush { kind: BrushKind::Draw, radius: 0.1, strength: 0.5,
 //!                     falloff: Falloff::default(), invert: true };
 //! let mut stroke = pipeline.begin_stroke(&mut mesh, StrokeSettings {
-//!     brush, paint: None, layers: vec![1], spacing: 0.25,
+//!     brush, paint: None, layers: vec![1], spacing: 0.25, symmetry: None,
 //! })?;
 //! for x in [0.3f32, 0.35, 0.4, 0.45, 0.5] {
 //!     // One pointer event: the samples it completes run now.

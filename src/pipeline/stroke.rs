@@ -5,6 +5,8 @@
 //! remeshes what the stroke touched. Feeding the samples one at a time or all at once runs the
 //! same samples through the same arithmetic, so the CPU backend's meshes are bit-identical.
 
+mod mirrored;
+
 use std::time::Instant;
 
 use glam::Vec3;
@@ -63,6 +65,8 @@ struct Active {
     samples_run: usize,
     /// What a grab caught at its first sample.
     captured: Option<Vec<(u32, f32)>>,
+    /// What a mirrored grab's image caught at its first sample.
+    captured_image: Option<Vec<(u32, f32)>>,
     touched_list: Vec<u32>,
     report: StrokeReport,
 }
@@ -132,6 +136,7 @@ impl<'a> StrokeInProgress<'a> {
                 previous: None,
                 samples_run: 0,
                 captured: None,
+                captured_image: None,
                 touched_list: Vec::new(),
                 report: StrokeReport {
                     phases,
@@ -261,10 +266,13 @@ impl Active {
 
     /// Whether the kernels may run the samples of a call ahead: each is one step that nothing
     /// else touches between — not a grab (it moves what its first sample caught), not with
-    /// remeshing between samples.
+    /// remeshing between samples, not mirrored (two dabs a step).
     fn plans_ahead(&self, remeshing: Remeshing) -> bool {
         let kind = self.stroke.brush.kind;
-        kind.deforms() && kind != BrushKind::Grab && remeshing != Remeshing::AfterSample
+        kind.deforms()
+            && kind != BrushKind::Grab
+            && remeshing != Remeshing::AfterSample
+            && self.stroke.symmetry.is_none()
     }
 
     /// The dabs `samples` start with, as [`Active::open_sample`] will ask for them.
@@ -314,45 +322,41 @@ impl Active {
         let number = self.samples_run;
         self.samples_run += 1;
         call.samples += 1;
+        if let Some(mirror) = self.stroke.symmetry {
+            return self.run_mirrored_sample(kernels, mesh, (sample, mirror), call);
+        }
         let opened = self.open_sample(kernels, mesh, sample, number, &mut call.phases);
         if opened.selection.is_empty() {
             return None;
         }
-        // Paint in the same pass as the deformation, where the brush is before it moves
-        // anything; booked under deformation.
-        if let Some(spec) = &self.stroke.paint {
-            let started = Instant::now();
-            let dab = Dab {
-                frame: opened.frame,
-                ..opened.probe
-            };
-            let painted = paint(&self.state(), mesh, &dab, &opened.selection, spec);
-            let brdfs = mesh.brdfs_mut();
-            for (&(v, _), brdf) in opened.selection.iter().zip(painted) {
-                brdfs[v as usize] = brdf;
-            }
-            call.changed
-                .extend(opened.selection.iter().map(|&(v, _)| v));
-            call.phases.deformation += millis(started);
-        }
+        self.paint_opened(mesh, &opened, call);
         if !self.stroke.brush.kind.deforms() {
             return None;
         }
         let moved = self.deform_in_steps(kernels, mesh, (opened, number), call);
-
-        // Normals of the moved vertices and of their neighbours, whose faces also turned.
-        let started = Instant::now();
-        let mut refresh: Vec<u32> = moved
-            .iter()
-            .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
-            .collect();
-        refresh.sort_unstable();
-        refresh.dedup();
-        mesh.recompute_normals_at(&refresh);
-        kernels.normals_changed(mesh, &refresh);
-        call.changed.extend_from_slice(&refresh);
-        call.phases.deformation += millis(started);
+        refresh_normals(kernels, mesh, &moved, call);
         Some(moved)
+    }
+
+    /// Paints the stroke's material (if it paints) under an opened dab, in the same pass as
+    /// the deformation, where the brush is before it moves anything; booked under deformation.
+    fn paint_opened(&self, mesh: &mut Mesh, opened: &Opened, call: &mut SamplesReport) {
+        let Some(spec) = &self.stroke.paint else {
+            return;
+        };
+        let started = Instant::now();
+        let dab = Dab {
+            frame: opened.frame,
+            ..opened.probe
+        };
+        let painted = paint(&self.state(), mesh, &dab, &opened.selection, spec);
+        let brdfs = mesh.brdfs_mut();
+        for (&(v, _), brdf) in opened.selection.iter().zip(painted) {
+            brdfs[v as usize] = brdf;
+        }
+        call.changed
+            .extend(opened.selection.iter().map(|&(v, _)| v));
+        call.phases.deformation += millis(started);
     }
 
     /// The sample's selection and brush frame: a grab keeps the vertices it caught at its
@@ -595,6 +599,27 @@ impl Active {
 
 /// What a step reads that lasts for the stroke (a free function so that a step can borrow the
 /// stroke's scratch beside it).
+/// Recomputes the normals of the moved vertices and of their neighbours, whose faces also
+/// turned, and tells the kernels; booked under deformation.
+fn refresh_normals(
+    kernels: &mut dyn StepKernels,
+    mesh: &mut Mesh,
+    moved: &[u32],
+    call: &mut SamplesReport,
+) {
+    let started = Instant::now();
+    let mut refresh: Vec<u32> = moved
+        .iter()
+        .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
+        .collect();
+    refresh.sort_unstable();
+    refresh.dedup();
+    mesh.recompute_normals_at(&refresh);
+    kernels.normals_changed(mesh, &refresh);
+    call.changed.extend_from_slice(&refresh);
+    call.phases.deformation += millis(started);
+}
+
 fn stroke_state<'s>(
     prepared: &'s Prepared,
     active: &'s [bool],

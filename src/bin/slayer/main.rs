@@ -91,6 +91,10 @@ enum Command {
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
+        /// Mirror every stroke that names no `symmetry` of its own across the plane through the
+        /// mesh's centre across this axis.
+        #[arg(long, value_name = "x|y|z", value_parser = ["x", "y", "z"])]
+        symmetry: Option<String>,
         /// Remesh the touched region: after every stroke, after every stroke sample, or off.
         #[arg(long, default_value = "stroke", value_name = "stroke|sample|off")]
         remesh: slayer::pipeline::Remeshing,
@@ -260,6 +264,7 @@ fn main() -> ExitCode {
             in_place,
             max_dabs,
             stats,
+            symmetry,
             remesh,
             backend,
         } => sculpt::run(&sculpt::Args {
@@ -269,6 +274,7 @@ fn main() -> ExitCode {
             in_place,
             max_dabs,
             stats: stats.as_deref(),
+            symmetry: symmetry.as_deref(),
             remeshing: remesh,
             backend,
         }),

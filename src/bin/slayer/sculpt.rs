@@ -2,7 +2,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use slayer::brush::{Stroke, StrokeFile, dabs_for};
+use slayer::brush::{Stroke, StrokeFile, SymmetrySpec, dabs_for};
 use slayer::io::AtomicBatch;
 use slayer::pipeline::{PipelineSettings, Remeshing, StrokeReport};
 
@@ -18,6 +18,8 @@ pub struct Args<'a> {
     /// The most dabs one stroke may make.
     pub max_dabs: usize,
     pub stats: Option<&'a Path>,
+    /// `x`, `y` or `z`: the mirror of strokes that name none.
+    pub symmetry: Option<&'a str>,
     pub remeshing: Remeshing,
     pub backend: crate::backend::Backend,
 }
@@ -32,7 +34,12 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let text = slayer::files::read_input_text(args.strokes, slayer::files::MAX_INPUT_BYTES)
         .with_context(|| format!("{}", args.strokes.display()))?;
     let name = args.strokes.display().to_string();
-    let file = StrokeFile::parse(&text, &name)?;
+    let mut file = StrokeFile::parse(&text, &name)?;
+    if let Some(axis) = args.symmetry {
+        for stroke in file.strokes.iter_mut().filter(|s| s.symmetry.is_none()) {
+            stroke.symmetry = Some(SymmetrySpec::Axis(axis.to_string()));
+        }
+    }
     let strokes = file.resolve(session.mesh(), &name)?;
     check_dabs(&strokes, args.max_dabs, &name)?;
     let mut pipeline = crate::backend::choose(
