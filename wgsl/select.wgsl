@@ -79,7 +79,13 @@ fn consider(v: u32) {
     if distance_squared > params.radius * params.radius {
         return;
     }
-    let weight = falloff_weight(params.falloff, params.blend_n, sqrt(distance_squared) / params.radius);
+    var weight = falloff_weight(params.falloff, params.blend_n, sqrt(distance_squared) / params.radius);
+    // A partial mask (bits 8..15, 1 to 254 of 255) moves the vertex that much less; an exact
+    // product of exact factors, as the mirror computes it.
+    let mask_level = (flags[v] >> 8u) & 255u;
+    if mask_level != 0u {
+        weight *= f32(255u - mask_level) * MASK_STEP;
+    }
     if weight <= 0.0 {
         return;
     }

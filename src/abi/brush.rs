@@ -38,6 +38,7 @@ pub fn brush_code(kind: BrushKind) -> u32 {
         BrushKind::Crease => 7,
         BrushKind::Twist => 8,
         BrushKind::Paint => 9,
+        BrushKind::Mask => 10,
     }
 }
 

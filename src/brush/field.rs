@@ -70,7 +70,7 @@ pub fn displacement(
         BrushKind::Crease => {
             -frame.normal * (sign * amount * DRAW_RATE * brush.radius) + pinch(position) * amount
         }
-        BrushKind::Paint => Vec3::ZERO,
+        BrushKind::Paint | BrushKind::Mask => Vec3::ZERO,
         BrushKind::Twist => {
             let angle = sign * amount * TWIST_RATE;
             let turned = Quat::from_axis_angle(frame.normal, angle) * (position - frame.center);

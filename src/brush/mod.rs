@@ -49,11 +49,14 @@ pub enum BrushKind {
     Twist,
     /// Move nothing; only paint the stroke's material (every brush can paint as it deforms).
     Paint,
+    /// Move nothing; paint the mask with the falloff (invert: unmask). Masked vertices move
+    /// less (fully masked: not at all) but still collide.
+    Mask,
 }
 
 impl BrushKind {
     /// Every brush.
-    pub const ALL: [BrushKind; 10] = [
+    pub const ALL: [BrushKind; 11] = [
         BrushKind::Draw,
         BrushKind::Inflate,
         BrushKind::Deflate,
@@ -64,10 +67,11 @@ impl BrushKind {
         BrushKind::Crease,
         BrushKind::Twist,
         BrushKind::Paint,
+        BrushKind::Mask,
     ];
 
-    /// The brushes that move vertices: all but the last, `Paint`.
-    pub const DEFORMING: &[BrushKind] = Self::ALL.split_last().unwrap().1;
+    /// The brushes that move vertices: all but the last two, `Paint` and `Mask`.
+    pub const DEFORMING: &[BrushKind] = Self::ALL.split_at(Self::ALL.len() - 2).0;
 
     pub fn name(self) -> &'static str {
         match self {
@@ -81,12 +85,13 @@ impl BrushKind {
             BrushKind::Crease => "crease",
             BrushKind::Twist => "twist",
             BrushKind::Paint => "paint",
+            BrushKind::Mask => "mask",
         }
     }
 
-    /// Whether the brush moves vertices (all but `paint`).
+    /// Whether the brush moves vertices (all but `paint` and `mask`).
     pub fn deforms(self) -> bool {
-        self != BrushKind::Paint
+        !matches!(self, BrushKind::Paint | BrushKind::Mask)
     }
 }
 

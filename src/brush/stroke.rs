@@ -441,6 +441,12 @@ fn resolve_stroke(
         }
         (None, _) => None,
     };
+    if paint.is_some() && spec.brush == BrushKind::Mask {
+        return fail(
+            ".paint",
+            "the mask brush paints the mask, not a material: leave `paint` out".into(),
+        );
+    }
     Ok(Stroke {
         paint,
         brush: Brush {

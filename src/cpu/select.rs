@@ -7,7 +7,7 @@ use glam::{IVec3, UVec3, Vec3};
 use super::shared::{falloff_weight, invocations, packed_position};
 use crate::abi::{SelectParams, SelectedVertex};
 use crate::grid::{cell_coordinates, hash_cell};
-use crate::mesh::VertexFlags;
+use crate::mesh::{VertexFlags, partial_mask_factor};
 
 /// The per-vertex inputs and the hash table the kernel binds.
 pub struct SelectInputs<'a> {
@@ -43,11 +43,14 @@ fn consider(
     if distance_squared > params.radius * params.radius {
         return;
     }
-    let weight = falloff_weight(
+    let mut weight = falloff_weight(
         params.falloff,
         params.blend_n,
         distance_squared.sqrt() / params.radius,
     );
+    if let Some(factor) = partial_mask_factor(inputs.flags[v as usize]) {
+        weight *= factor;
+    }
     if weight <= 0.0 {
         return;
     }

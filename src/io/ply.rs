@@ -311,7 +311,7 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
     };
     let mut positions: Vec<Vec3> = Vec::new();
     let mut brdfs: Vec<Brdf> = Vec::new();
-    let mut masked: Vec<bool> = Vec::new();
+    let mut masks: Vec<VertexFlags> = Vec::new();
     let mut has_brdf = false;
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut face_layers: Vec<LayerId> = Vec::new();
@@ -403,7 +403,7 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
             if is_vertex {
                 positions.push(Vec3::from_array(position));
                 brdfs.push(Brdf::from_array(brdf));
-                masked.push(flags & VertexFlags::MASKED.bits() != 0);
+                masks.push(VertexFlags::from_bits_truncate(flags) & VertexFlags::PERSISTENT);
             } else if is_face {
                 if polygon.len() < 3 {
                     return Err(body.error(format!(
@@ -470,7 +470,7 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
         .map(|v| positions[v])
         .collect();
     let brdfs: Vec<Brdf> = (0..brdfs.len()).filter(keep).map(|v| brdfs[v]).collect();
-    let masked: Vec<bool> = (0..masked.len()).filter(keep).map(|v| masked[v]).collect();
+    let masks: Vec<VertexFlags> = (0..masks.len()).filter(keep).map(|v| masks[v]).collect();
     for f in &mut faces {
         *f = f.map(|v| remap[v as usize]);
     }
@@ -480,9 +480,9 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
         mesh.set_brdfs(brdfs)
             .map_err(|e| IoError::building(name, e, &positions))?;
     }
-    if masked.contains(&true) {
-        for (flag, m) in mesh.flags_mut().iter_mut().zip(masked) {
-            flag.set(VertexFlags::MASKED, m);
+    if masks.iter().any(|m| !m.is_empty()) {
+        for (flag, m) in mesh.flags_mut().iter_mut().zip(masks) {
+            *flag |= m;
         }
     }
     Ok(mesh)
@@ -531,7 +531,7 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
             buffer.extend_from_slice(&value.to_le_bytes());
         }
         buffer.extend_from_slice(&mesh.vertex_layers()[v].to_le_bytes());
-        let persistent = mesh.flags()[v] & VertexFlags::MASKED;
+        let persistent = mesh.flags()[v] & VertexFlags::PERSISTENT;
         buffer.extend_from_slice(&persistent.bits().to_le_bytes());
     }
     for (t, &layer) in mesh.faces().iter().zip(mesh.face_layers()) {

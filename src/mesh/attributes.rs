@@ -117,5 +117,54 @@ bitflags::bitflags! {
         const MASKED = 1 << 1;
         /// Deleted; removed by the next compaction.
         const DEAD = 1 << 2;
+        /// A partial mask, 1 to 254 of 255 ([`VertexFlags::mask`]): brushes move the vertex
+        /// that much less. Zero with `MASKED` clear is unmasked; a full mask is `MASKED`.
+        const MASK_LEVEL = 0xff << 8;
     }
+}
+
+/// One step of a partial mask: levels are multiples of it.
+const MASK_STEP: f32 = 1.0 / 255.0;
+
+impl VertexFlags {
+    /// The mask as a weight in [0, 1]: 0 unmasked, 1 fully masked (brushes never move it).
+    pub fn mask(self) -> f32 {
+        if self.contains(VertexFlags::MASKED) {
+            1.0
+        } else {
+            self.mask_level() as f32 * MASK_STEP
+        }
+    }
+
+    /// Sets the mask to `weight`, clamped into [0, 1] and rounded to 1/255 (NaN unmasks).
+    pub fn set_mask(&mut self, weight: f32) {
+        let level = if weight.is_nan() {
+            0
+        } else {
+            (weight.clamp(0.0, 1.0) * 255.0).round() as u32
+        };
+        self.remove(VertexFlags::MASKED | VertexFlags::MASK_LEVEL);
+        match level {
+            0 => {}
+            255 => self.insert(VertexFlags::MASKED),
+            _ => *self |= VertexFlags::from_bits_retain(level << 8),
+        }
+    }
+
+    /// The partial mask level, 0 to 254.
+    fn mask_level(self) -> u32 {
+        (self.bits() >> 8) & 0xff
+    }
+
+    /// The bits a file keeps (the mask); the others are the engine's own.
+    pub const PERSISTENT: VertexFlags = VertexFlags::MASKED.union(VertexFlags::MASK_LEVEL);
+}
+
+/// What a brush's falloff weight is multiplied by at a vertex with flags `bits` (as the kernels
+/// read them): `None` when no partial mask is set, so unmasked weights are not touched at all.
+/// The same arithmetic as `wgsl/select.wgsl`: the level's complement times one step, both exact
+/// in `f32`, one rounding.
+pub fn partial_mask_factor(bits: u32) -> Option<f32> {
+    let level = (bits >> 8) & 0xff;
+    (level != 0).then(|| (255 - level) as f32 * MASK_STEP)
 }

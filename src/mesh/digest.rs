@@ -5,7 +5,7 @@
 use super::{INVALID, Mesh, VertexFlags};
 
 impl Mesh {
-    /// BLAKE3 over the live vertices in order (position, BRDF, layer, mask) and the live faces
+    /// BLAKE3 over the live vertices in order (position, BRDF, layer, mask with its partial level) and the live faces
     /// in order (corners renumbered over the live vertices, layer), and the layer names. Normals
     /// are left out: they are derived from the positions, and readers recompute them.
     pub fn digest(&self) -> String {
@@ -25,7 +25,7 @@ impl Mesh {
             bytes.extend_from_slice(bytemuck::bytes_of(&self.positions[v]));
             bytes.extend_from_slice(bytemuck::bytes_of(&self.brdfs[v]));
             bytes.extend_from_slice(&self.vertex_layers[v].to_le_bytes());
-            let mask = self.flags[v] & VertexFlags::MASKED;
+            let mask = self.flags[v] & VertexFlags::PERSISTENT;
             bytes.extend_from_slice(&mask.bits().to_le_bytes());
         }
         bytes.extend_from_slice(&live.to_le_bytes());

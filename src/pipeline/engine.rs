@@ -197,8 +197,11 @@ impl Pipeline {
             }
         };
         let version = mesh.version();
+        // The grid holds positions and the live vertices: a mask or paint edit between
+        // strokes leaves it as it is.
         if let Some(prepared) = &mut self.prepared
-            && prepared.version == version
+            && prepared.version.topology == version.topology
+            && prepared.version.positions == version.positions
         {
             if prepared.max_edge > EDGE_BOUND_SLACK * prepared.exact_max_edge {
                 prepared.exact_max_edge = longest_edge(mesh, None);

@@ -12,7 +12,7 @@ use crate::abi::{SelectedVertex, frame_params};
 use crate::brush::{Dab, DabFrame, Paint, displacement, paint_share};
 use crate::collide::StrokeState;
 use crate::cpu;
-use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags};
+use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags, partial_mask_factor};
 
 /// The brush frame of `probe` (its centre, radius and motion) over `selection`: the falloff-
 /// weighted normal (unless the sample brings its own `normal`) and centroid under the brush.
@@ -90,15 +90,53 @@ pub fn longest_move(mesh: &Mesh, selection: &[(u32, f32)], targets: &[Vec3]) -> 
         .fold(0.0f32, f32::max)
 }
 
-/// Brush selection: active, unmasked vertices with positive falloff weight, sorted by index.
+/// Brush selection: active, unmasked vertices with positive falloff weight (less by a partial
+/// mask), sorted by index.
 pub fn select(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
     let brush = &dab.brush;
     let center = dab.frame.center;
+    within_brush(state, mesh, dab)
+        .into_iter()
+        .filter(|&v| selectable(state, mesh, v))
+        .filter_map(|v| {
+            let t = mesh.positions()[v as usize].distance(center) / brush.radius;
+            let mut w = brush.falloff.weight(t);
+            if let Some(factor) = partial_mask_factor(mesh.flags()[v as usize].bits()) {
+                w *= factor;
+            }
+            (w > 0.0).then_some((v, w))
+        })
+        .collect()
+}
+
+/// The mask brush's selection: vertices of active layers under the brush with their falloff
+/// weights, masked ones included (it paints the mask), sorted by index.
+pub fn select_for_mask(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
+    let brush = &dab.brush;
+    let center = dab.frame.center;
+    within_brush(state, mesh, dab)
+        .into_iter()
+        .filter(|&v| {
+            state.active[mesh.vertex_layers()[v as usize] as usize]
+                && !mesh.flags()[v as usize].contains(VertexFlags::DEAD)
+        })
+        .filter_map(|v| {
+            let t = mesh.positions()[v as usize].distance(center) / brush.radius;
+            let w = brush.falloff.weight(t);
+            (w > 0.0).then_some((v, w))
+        })
+        .collect()
+}
+
+/// The live vertices within the brush's sphere, ascending.
+fn within_brush(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<u32> {
+    let radius = dab.brush.radius;
+    let center = dab.frame.center;
     let mut found = Vec::new();
     match state.grid {
-        Some(grid) => grid.vertices_in_sphere(mesh.positions(), center, brush.radius, &mut found),
+        Some(grid) => grid.vertices_in_sphere(mesh.positions(), center, radius, &mut found),
         None => {
-            let r2 = brush.radius * brush.radius;
+            let r2 = radius * radius;
             found.extend(
                 mesh.positions()
                     .iter()
@@ -113,14 +151,6 @@ pub fn select(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)
     }
     found.sort_unstable();
     found
-        .into_iter()
-        .filter(|&v| selectable(state, mesh, v))
-        .filter_map(|v| {
-            let t = mesh.positions()[v as usize].distance(center) / brush.radius;
-            let w = brush.falloff.weight(t);
-            (w > 0.0).then_some((v, w))
-        })
-        .collect()
 }
 
 /// On an active layer, not masked, alive.

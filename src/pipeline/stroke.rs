@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::engine::{Pipeline, Prepared, Scratch, longest_edge, millis, remesh_touched};
 use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
-use super::step::{brush_frame, longest_move, paint, steps_for};
+use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
 use crate::brush::{BrushKind, Dab, DabFrame, Resampler, Sample, StrokeSettings};
 use crate::collide::{StrokeState, collide_with};
@@ -39,7 +39,7 @@ pub struct SamplesReport {
     pub moves: usize,
     pub clamped: usize,
     pub reverted: usize,
-    /// Vertices whose position, normal or BRDF changed in this call (ascending): what a
+    /// Vertices whose position, normal, BRDF or mask changed in this call (ascending): what a
     /// viewer uploads again. Vertices remeshing added are among them.
     pub changed: Vec<u32>,
     /// Remeshing between samples rewrote faces ([`Remeshing::AfterSample`]): the index
@@ -322,6 +322,10 @@ impl Active {
         let number = self.samples_run;
         self.samples_run += 1;
         call.samples += 1;
+        if self.stroke.brush.kind == BrushKind::Mask {
+            self.mask_sample(mesh, sample, call);
+            return None;
+        }
         if let Some(mirror) = self.stroke.symmetry {
             return self.run_mirrored_sample(kernels, mesh, (sample, mirror), call);
         }
@@ -336,6 +340,38 @@ impl Active {
         let moved = self.deform_in_steps(kernels, mesh, (opened, number), call);
         refresh_normals(kernels, mesh, &moved, call);
         Some(moved)
+    }
+
+    /// The mask brush: raises the mask of the vertices under the dab (and its mirror image) by
+    /// the falloff weight × strength × pressure of what is left unmasked (inverted: lowers it
+    /// by that share). Moves nothing.
+    fn mask_sample(&mut self, mesh: &mut Mesh, sample: &Sample, call: &mut SamplesReport) {
+        let started = Instant::now();
+        let probe = self.probe_at(sample, self.previous);
+        self.previous = Some(sample.position);
+        let mut dabs = vec![probe];
+        dabs.extend(
+            self.stroke
+                .symmetry
+                .map(|m| mirrored::image_dab(&probe, &m)),
+        );
+        let brush = self.stroke.brush;
+        let amount = brush.strength * sample.pressure;
+        for dab in &dabs {
+            let selection = select_for_mask(&self.state(), mesh, dab);
+            let flags = mesh.flags_mut();
+            for &(v, weight) in &selection {
+                let flag = &mut flags[v as usize];
+                let (mask, share) = (flag.mask(), (weight * amount).clamp(0.0, 1.0));
+                flag.set_mask(if brush.invert {
+                    mask * (1.0 - share)
+                } else {
+                    mask + (1.0 - mask) * share
+                });
+            }
+            call.changed.extend(selection.iter().map(|&(v, _)| v));
+        }
+        call.phases.deformation += millis(started);
     }
 
     /// Paints the stroke's material (if it paints) under an opened dab, in the same pass as

@@ -36,7 +36,7 @@ pub use history::{DEFAULT_HISTORY_CAP_BYTES, Entry, History};
 use serde::{Deserialize, Serialize};
 
 use crate::brush::{BrushKind, Falloff, Stroke};
-use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta, VertexFlags};
+use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta};
 use crate::pipeline::{Pipeline, PipelineError, StrokeReport};
 
 /// How a layer meets what comes within the collision distance of it.
@@ -124,6 +124,8 @@ pub enum SessionError {
     NoSuchLayer { layer: LayerId, layer_count: usize },
     #[error("a layer name must be one line of at most 255 bytes, not {0:?}")]
     BadLayerName(String),
+    #[error("vertex {0} does not exist or belongs to no face")]
+    NoSuchVertex(u32),
 }
 
 impl Session {
@@ -236,9 +238,57 @@ impl Session {
 
     /// Clears the mask of every vertex, as one history entry.
     pub fn clear_mask(&mut self) -> Recorded {
-        let mut edit = self.edit("clear mask");
-        for flags in edit.mesh().flags_mut() {
-            flags.remove(VertexFlags::MASKED);
+        self.mask_where("clear mask", |_, _| Some(0.0))
+    }
+
+    /// Inverts the mask (a weight `m` becomes `1 − m`), as one history entry.
+    pub fn invert_mask(&mut self) -> Recorded {
+        self.mask_where("invert mask", |_, mask| Some(1.0 - mask))
+    }
+
+    /// Sets the mask of every vertex of `layer` to `weight` (0 unmasks, 1 masks fully), as one
+    /// history entry.
+    pub fn mask_layer(&mut self, layer: LayerId, weight: f32) -> Result<Recorded, SessionError> {
+        self.check_layer(layer)?;
+        let layers = self.mesh.vertex_layers().to_vec();
+        Ok(self.mask_where("mask layer", |v, _| (layers[v] == layer).then_some(weight)))
+    }
+
+    /// Sets the mask of the connected component holding `vertex` to `weight`, as one history
+    /// entry.
+    pub fn mask_component(&mut self, vertex: u32, weight: f32) -> Result<Recorded, SessionError> {
+        let mesh = &self.mesh;
+        let live = (vertex as usize) < mesh.vertex_count() && !mesh.is_vertex_dead(vertex);
+        let Some(face) = live.then(|| mesh.faces_around(vertex).next()).flatten() else {
+            return Err(SessionError::NoSuchVertex(vertex));
+        };
+        let components = mesh.components();
+        let wanted = components.face_component[face as usize];
+        let mut inside = vec![false; mesh.vertex_count()];
+        for (f, tri) in mesh.faces().iter().enumerate() {
+            if !mesh.is_face_dead(f) && components.face_component[f] == wanted {
+                tri.iter().for_each(|&v| inside[v as usize] = true);
+            }
+        }
+        Ok(self.mask_where("mask component", |v, _| inside[v].then_some(weight)))
+    }
+
+    /// Sets the mask of each live vertex to what `new_mask(vertex, mask)` says (`None` keeps
+    /// it), as one history entry labelled `label`.
+    fn mask_where(
+        &mut self,
+        label: &str,
+        new_mask: impl Fn(usize, f32) -> Option<f32>,
+    ) -> Recorded {
+        let mut edit = self.edit(label);
+        let mesh = edit.mesh();
+        let dead: Vec<bool> = (0..mesh.vertex_count() as u32)
+            .map(|v| mesh.is_vertex_dead(v))
+            .collect();
+        for (v, flags) in mesh.flags_mut().iter_mut().enumerate() {
+            if let Some(weight) = new_mask(v, flags.mask()).filter(|_| !dead[v]) {
+                flags.set_mask(weight);
+            }
         }
         edit.commit()
     }

@@ -306,12 +306,16 @@ fn select_scans_vertices_for_huge_brushes_and_folds_wide_dispatches() {
 
 #[test]
 fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
-    // The mirror against `pipeline::step::select` (the CPU backend) on a mesh with masked
-    // vertices and an inactive layer; GPU against the mirror for the same brushes.
+    // The mirror against `pipeline::step::select` (the CPU backend) on a mesh with masked and
+    // partly masked vertices and an inactive layer; GPU against the mirror for the same brushes.
     let gpu = gpu();
     let mut mesh = slayer::scene::shapes::stacked_sheets(3, 40, 30, 0.1, 0.05);
     for v in (0..mesh.vertex_count()).step_by(7) {
         mesh.flags_mut()[v].insert(VertexFlags::MASKED);
+    }
+    // Partial masks lower the weights: the same product on every side.
+    for (k, v) in (3..mesh.vertex_count()).step_by(5).enumerate() {
+        mesh.flags_mut()[v].set_mask([0.2, 0.5, 0.9][k % 3]);
     }
     let grid = SpatialHash::build(&mesh, 0.1).unwrap();
     let active = [true, false, true];

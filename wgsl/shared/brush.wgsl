@@ -19,6 +19,7 @@ const BRUSH_PINCH: u32 = 6u;
 const BRUSH_CREASE: u32 = 7u;
 const BRUSH_TWIST: u32 = 8u;
 const BRUSH_PAINT: u32 = 9u;
+const BRUSH_MASK: u32 = 10u;
 
 const FALLOFF_BLEND: u32 = 0u;
 const FALLOFF_SMOOTH: u32 = 1u;

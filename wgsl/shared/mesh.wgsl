@@ -3,6 +3,8 @@
 
 const VERTEX_LOCKED: u32 = 1u;
 const VERTEX_MASKED: u32 = 2u;
+// One step of a partial mask (flags bits 8..15).
+const MASK_STEP: f32 = 1.0 / 255.0;
 const VERTEX_DEAD: u32 = 4u;
 
 const INVALID: u32 = 0xffffffffu;

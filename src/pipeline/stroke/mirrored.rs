@@ -164,7 +164,7 @@ impl Active {
 
 /// The image of a dab across `mirror`: its centre, plane point, normal and motion mirrored;
 /// a twist turns the other way (a reflection reverses the sense of a turn).
-fn image_dab(dab: &Dab, mirror: &Mirror) -> Dab {
+pub(super) fn image_dab(dab: &Dab, mirror: &Mirror) -> Dab {
     let frame = dab.frame;
     let mut brush = dab.brush;
     if brush.kind == BrushKind::Twist {
