@@ -153,10 +153,7 @@ fn mask_edits_are_undoable_and_files_keep_partial_masks() {
         masks.iter().any(|&m| (m - 0.25).abs() < 0.003),
         "component 0.75 inverted"
     );
-    assert!(
-        masks.contains(&1.0),
-        "unmasked layer 1 inverted to full"
-    );
+    assert!(masks.contains(&1.0), "unmasked layer 1 inverted to full");
     assert!(session.mask_component(u32::MAX, 1.0).is_err());
 
     // Files keep every level.

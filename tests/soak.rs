@@ -1,0 +1,219 @@
+//! The soak test: random strokes of every brush, with random layers, radii (extreme ones
+//! included), strengths and pressures, remeshing on, over plaster and a closed sphere, checked
+//! exactly every 100 strokes — 0 intersecting triangle pairs, `validate()`, bounded growth —
+//! through the session, so every stroke is also undone at the end back to the input.
+//!
+//! The short version: 500 strokes in all on ~5K faces. The full one, 10⁴ strokes on ~20K faces:
+//! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --ignored --nocapture`. Times
+//! are printed, never asserted.
+//!
+//! Both are `#[ignore]`d until what they found is fixed (issue "Hardening"): on the sphere, the
+//! 81st stroke of seed 43 (a grab about as wide as the sphere, dragged over 7 samples) leaves 7
+//! crossing triangle pairs and takes 20–47 s; on plaster single strokes of huge brushes take
+//! minutes (a draw of radius 22 over 6 samples: 177 s; a grab of radius 0.76: 188 s). Run them
+//! with `-- --ignored` to reproduce; `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use slayer::brush::{BrushKind, LayerRef, SampleSpec, StrokeFile, StrokeSpec};
+use slayer::collide::find_intersections;
+use slayer::mesh::Mesh;
+use slayer::pipeline::{Pipeline, PipelineSettings};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+use slayer::session::Session;
+
+/// Strokes between exact checks (`SLAYER_SOAK_CHECK_EVERY` to narrow a failure down).
+fn check_every() -> usize {
+    std::env::var("SLAYER_SOAK_CHECK_EVERY")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100)
+}
+
+/// Strokes in all, and the faces of each scene: the short version's, or what
+/// `SLAYER_SOAK_STROKES` asks for on the full scenes.
+fn size() -> (usize, usize) {
+    match std::env::var("SLAYER_SOAK_STROKES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        Some(strokes) => (strokes, 20_000),
+        None => (500, 5_000),
+    }
+}
+
+/// A random stroke: any brush, a random subset of layers, a radius from a twentieth of an edge
+/// to far past the mesh (some refused), a path of 1 to 8 samples from a vertex.
+fn random_stroke(mesh: &Mesh, rng: &mut ChaCha8Rng) -> StrokeSpec {
+    let edge = mesh.mean_edge_length();
+    let brush = BrushKind::ALL[rng.random_range(0..BrushKind::ALL.len())];
+    let radius = match rng.random_range(0..10) {
+        0 => edge * rng.random_range(0.04..0.5),
+        1 => edge * rng.random_range(100.0..2000.0),
+        _ => edge * rng.random_range(2.0..30.0),
+    };
+    let mut layers: Vec<LayerRef> = (0..mesh.layer_count() as u32)
+        .filter(|_| rng.random_bool(0.6))
+        .map(LayerRef::Index)
+        .collect();
+    if layers.is_empty() {
+        layers.push(LayerRef::Index(0));
+    }
+    let start = loop {
+        let v = rng.random_range(0..mesh.vertex_count()) as u32;
+        if !mesh.is_vertex_dead(v) {
+            break mesh.positions()[v as usize];
+        }
+    };
+    let direction = Vec3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        0.0,
+    );
+    let step = direction.normalize_or_zero() * radius * rng.random_range(0.1..1.0);
+    let samples = (0..rng.random_range(1..=8))
+        .map(|i| SampleSpec {
+            position: (start + step * i as f32).to_array(),
+            pressure: rng.random_range(0.0..=1.0),
+            normal: None,
+        })
+        .collect();
+    StrokeSpec {
+        brush,
+        radius,
+        strength: rng.random_range(0.0..=1.0),
+        falloff: Default::default(),
+        invert: rng.random_bool(0.3),
+        layers,
+        paint: (brush == BrushKind::Paint).then(|| slayer::brush::PaintSpec::material("rust")),
+        spacing: 0.25,
+        symmetry: None,
+        samples,
+    }
+}
+
+/// Runs `count` random strokes on `input` and checks it every [`check_every`] strokes.
+fn soak(kind: SceneKind, input: Mesh, count: usize, seed: u64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut session = Session::new(input.clone());
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let (mut refused, mut collisions, mut slowest) = (0usize, 0usize, (0.0f64, String::new()));
+    let faces_at_start = input.live_face_count();
+    for i in 0..count {
+        let spec = random_stroke(session.mesh(), &mut rng);
+        let file = StrokeFile {
+            version: 1,
+            strokes: vec![spec],
+        };
+        let as_json = serde_json::to_string(&file).unwrap_or_default();
+        let strokes = match file.resolve(session.mesh(), "soak") {
+            Ok(strokes) => strokes,
+            Err(_) => {
+                refused += 1;
+                continue;
+            }
+        };
+        let started = Instant::now();
+        match session.apply_stroke(&mut pipeline, &strokes[0]) {
+            Ok((report, _)) => collisions += report.clamped,
+            Err(_) => refused += 1,
+        }
+        let seconds = started.elapsed().as_secs_f64();
+        if seconds > 2.0 {
+            let s = &strokes[0];
+            eprintln!(
+                "{kind:?} stroke {i}: {seconds:.1} s, {:?} radius {:.4} strength {} over {} samples",
+                s.brush.kind,
+                s.brush.radius,
+                s.brush.strength,
+                s.samples.len()
+            );
+        }
+        if seconds > slowest.0 {
+            let s = &strokes[0];
+            slowest = (
+                seconds,
+                format!(
+                    "{:?} radius {:.4} over {} samples",
+                    s.brush.kind,
+                    s.brush.radius,
+                    s.samples.len()
+                ),
+            );
+        }
+        if (i + 1) % check_every() == 0 || i + 1 == count {
+            let mesh = session.mesh();
+            mesh.validate()
+                .unwrap_or_else(|e| panic!("{kind:?} stroke {i}: {e}"));
+            let crossings = find_intersections(mesh).total();
+            assert_eq!(
+                crossings, 0,
+                "{kind:?}: {crossings} crossings after stroke {i}"
+            );
+            // Remeshing keeps the edge length: the surface may grow, not explode.
+            let faces = mesh.live_face_count();
+            assert!(
+                faces < 8 * faces_at_start,
+                "{kind:?}: {faces} faces after stroke {i}"
+            );
+        }
+    }
+    eprintln!(
+        "{kind:?}: {count} strokes, {refused} refused, {collisions} collisions, slowest {:.2} s ({}), {} → {} faces, history {:.1} MiB, peak memory of the test process {}",
+        slowest.0,
+        slowest.1,
+        faces_at_start,
+        session.mesh().live_face_count(),
+        session.history().bytes() as f64 / 1048576.0,
+        peak_memory()
+    );
+    while session.undo().is_some() {}
+    if session.history().dropped() == 0 {
+        assert_eq!(
+            session.mesh().digest(),
+            input.digest(),
+            "{kind:?}: undo all"
+        );
+    }
+}
+
+/// The process's peak resident memory as Linux reports it (`VmHWM`), for the printout.
+fn peak_memory() -> String {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(|l| l[6..].trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+#[test]
+#[ignore = "finds minute-long strokes on plaster (issue Hardening); run with --ignored"]
+fn random_strokes_on_plaster_keep_it_sound() {
+    let (strokes, faces) = size();
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: faces,
+        seed: 9,
+    })
+    .unwrap();
+    soak(SceneKind::Plaster, mesh, strokes / 2, 41);
+}
+
+#[test]
+#[ignore = "finds crossings on the sphere (issue Hardening); run with --ignored"]
+fn random_strokes_on_a_closed_sphere_keep_it_sound() {
+    let (strokes, faces) = size();
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Sphere,
+        triangles: faces,
+        seed: 9,
+    })
+    .unwrap();
+    soak(SceneKind::Sphere, mesh, strokes / 2, 43);
+}
