@@ -151,7 +151,7 @@ fn soak(kind: SceneKind, input: Mesh, count: usize, seed: u64) {
             let crossings = find_intersections(mesh).total();
             assert_eq!(
                 crossings, 0,
-                "{kind:?}: {crossings} crossings after stroke {i}"
+                "{kind:?}: {crossings} crossings after stroke {i}, the last {as_json}"
             );
             // Remeshing keeps the edge length: the surface may grow, not explode.
             let faces = mesh.live_face_count();
