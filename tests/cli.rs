@@ -1,52 +1,10 @@
 //! The `slayer` binary as a user runs it: exit codes, one-line errors, JSON fields.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{arg, assert_one_line_error, scratch, slayer, text, write_scene};
+use std::path::Path;
 use std::process::{Command, Output};
-
-fn slayer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slayer"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("slayer-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// A path as a command-line argument.
-fn arg(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-/// Writes `scene` with about `triangles` triangles to `path` (`slayer scene`, with `extra`
-/// options before `-o`), which must succeed: the input most tests start from.
-fn write_scene(scene: &str, triangles: u32, extra: &[&str], path: &Path) {
-    let triangles = triangles.to_string();
-    let mut args = vec!["scene", scene, "--triangles", &triangles];
-    args.extend_from_slice(extra);
-    args.extend(["-o", arg(path)]);
-    let out = slayer(&args);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-}
-
-fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
-    assert!(!output.status.success(), "expected failure");
-    let stderr = text(&output.stderr);
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "one line: {stderr}");
-    assert!(lines[0].starts_with("error: "), "{stderr}");
-    for s in must_contain {
-        assert!(lines[0].contains(s), "`{s}` missing in: {stderr}");
-    }
-}
 
 #[test]
 fn scene_then_check_reports_clean_layers_as_json() {

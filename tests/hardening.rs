@@ -4,52 +4,12 @@
 //! file bytes never drive the terminal, special files are refused before they are read, and
 //! stroke-file mistakes are told in our words.
 
+mod common;
+
+use common::{arg, assert_one_line_error, scratch, slayer, text, write_scene};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-fn slayer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slayer"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("slayer-hard-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn arg(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-fn write_scene(scene: &str, triangles: u32, extra: &[&str], path: &Path) {
-    let triangles = triangles.to_string();
-    let mut args = vec!["scene", scene, "--triangles", &triangles];
-    args.extend_from_slice(extra);
-    args.extend(["-o", arg(path)]);
-    let out = slayer(&args);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-}
-
-fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
-    assert!(!output.status.success(), "expected failure");
-    let stderr = text(&output.stderr);
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "one line: {stderr}");
-    assert!(lines[0].starts_with("error: "), "{stderr}");
-    for s in must_contain {
-        assert!(lines[0].contains(s), "`{s}` missing in: {stderr}");
-    }
-}
 
 /// Runs the binary, failing the test (not hanging it) if it runs longer than `limit`.
 fn slayer_within(args: &[&str], limit: Duration) -> Output {

@@ -1,0 +1,59 @@
+//! What the tests that run the `slayer` binary share: running it, scratch folders, scenes
+//! written with it, and the check of a one-line error.
+
+// Each test crate uses the part it needs.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the binary with `args` and waits for it.
+pub fn slayer(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_slayer"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// An empty folder for one test, under the system's temporary folder.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("slayer-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Output bytes as text.
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A path as a command-line argument.
+pub fn arg(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// Writes `scene` with about `triangles` triangles to `path` (`slayer scene`, with `extra`
+/// options before `-o`), which must succeed: the input most tests start from.
+pub fn write_scene(scene: &str, triangles: u32, extra: &[&str], path: &Path) {
+    let triangles = triangles.to_string();
+    let mut args = vec!["scene", scene, "--triangles", &triangles];
+    args.extend_from_slice(extra);
+    args.extend(["-o", arg(path)]);
+    let out = slayer(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+/// The command failed with exactly one line on stderr, `error: …`, holding each of
+/// `must_contain`, and no panic.
+pub fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
+    assert!(!output.status.success(), "expected failure");
+    let stderr = text(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    for s in must_contain {
+        assert!(lines[0].contains(s), "`{s}` missing in: {stderr}");
+    }
+}
