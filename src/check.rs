@@ -108,7 +108,10 @@ fn volume_changes(now: &[ClosedComponent], original: &[ClosedComponent]) -> Vec<
                 .enumerate()
                 .filter(|(j, c)| !taken[*j] && c.layer == o.layer)
                 .min_by(|(_, a), (_, b)| {
-                    let (da, db) = (a.centroid.distance(o.centroid), b.centroid.distance(o.centroid));
+                    let (da, db) = (
+                        a.centroid.distance(o.centroid),
+                        b.centroid.distance(o.centroid),
+                    );
                     da.total_cmp(&db)
                 })
                 .map(|(j, c)| (j, c.volume));

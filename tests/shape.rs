@@ -145,7 +145,12 @@ fn a_smooth_dab_at_a_cube_corner_keeps_the_cube() {
 
 #[test]
 fn check_reports_a_closed_component_of_four_faces() {
-    let report = check_mesh(&shapes::tetrahedron(), &LoadNotes::default(), "tetra", |_| {});
+    let report = check_mesh(
+        &shapes::tetrahedron(),
+        &LoadNotes::default(),
+        "tetra",
+        |_| {},
+    );
     assert_eq!(report.smallest_closed_faces, Some(4));
     assert!(
         report.defects.iter().any(|d| d.contains("only 4 faces")),
@@ -185,5 +190,9 @@ fn check_against_the_original_reports_a_lost_volume() {
     assert!((change + 0.1).abs() < 1e-4, "{change}");
     assert!(json["defects"][0].as_str().unwrap().contains("volume"));
     let same = check(&original);
-    assert!(same.status.success(), "{}", String::from_utf8_lossy(&same.stdout));
+    assert!(
+        same.status.success(),
+        "{}",
+        String::from_utf8_lossy(&same.stdout)
+    );
 }

@@ -101,7 +101,8 @@ impl LocalFaceGrid {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
                     let c = self.index(IVec3::new(x, y, z));
-                    let cell = &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize];
+                    let cell =
+                        &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize];
                     if cell.iter().any(|&e| f(e)) {
                         return true;
                     }

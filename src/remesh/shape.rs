@@ -70,7 +70,9 @@ impl ClosedParts {
                     faces: faces.len(),
                     change: 0.0,
                 });
-                parts.of_vertex.extend(vertices.into_iter().map(|v| (v, id)));
+                parts
+                    .of_vertex
+                    .extend(vertices.into_iter().map(|v| (v, id)));
             }
         }
         parts
@@ -233,8 +235,8 @@ impl Remesher<'_> {
         if !lost.iter().all(|&p| near_new(p)) {
             return None;
         }
-        let delta = signed_volume(after.iter().copied(), at)
-            - signed_volume(before.iter().copied(), at);
+        let delta =
+            signed_volume(after.iter().copied(), at) - signed_volume(before.iter().copied(), at);
         let removed = before.len().saturating_sub(after.len());
         if !self.closed.allows(v, delta, removed) {
             return None;
@@ -260,7 +262,10 @@ mod tests {
         let volume = signed_volume(faces, Vec3::splat(7.0));
         let [a, b, c, d] = [0, 1, 2, 3].map(|v| tetra.positions()[v].as_dvec3());
         let expected = (b - a).dot((c - a).cross(d - a)).abs() / 6.0;
-        assert!((volume.abs() - expected).abs() < 1e-9, "{volume} vs {expected}");
+        assert!(
+            (volume.abs() - expected).abs() < 1e-9,
+            "{volume} vs {expected}"
+        );
         let parts = ClosedParts::find(&tetra, &[0, 1, 2, 3]);
         assert_eq!(parts.parts.len(), 1);
         assert_eq!(parts.parts[0].faces, 4);
