@@ -39,7 +39,7 @@ fn write(name: &str, text: &str) -> PathBuf {
     path
 }
 
-fn check_json(path: &PathBuf) -> (bool, serde_json::Value) {
+fn check_json(path: &std::path::Path) -> (bool, serde_json::Value) {
     let out = Command::new(env!("CARGO_BIN_EXE_slayer"))
         .args(["check", "--json", path.to_str().unwrap()])
         .output()

@@ -9,6 +9,10 @@
 //! outside its neighbourhood) than it already was, and the triangles a flip or a collapse
 //! creates are tested exactly against the other layers' triangles nearby. Splits do not move
 //! the surface. The grid is kept up to date through every edit.
+//!
+//! Remeshing keeps the shape (`shape`): no edit moves the surface more than
+//! [`SHAPE_TOLERANCE`]·L from where it was, nor changes a closed component's volume past
+//! [`VOLUME_TOLERANCE`] or takes it below [`MIN_CLOSED_FACES`] faces.
 
 mod reference;
 mod safety;
