@@ -5,7 +5,13 @@ use serde::Serialize;
 use crate::collide::find_intersections;
 use crate::grid::SpatialHash;
 use crate::io::LoadNotes;
-use crate::mesh::Mesh;
+use crate::mesh::{ClosedComponent, Mesh};
+use crate::remesh::MIN_CLOSED_FACES;
+
+/// A closed component whose volume changed by more than this share from the `--against` file
+/// is a defect. Remeshing changes one by at most `remesh::VOLUME_TOLERANCE` (2 %) a pass, so a
+/// remesh or two stay below; the shapes issue 22 found destroyed had lost 7 % to 99 %.
+pub const VOLUME_CHANGE_DEFECT: f64 = 0.05;
 
 /// Figures and defects of one mesh. Field names are part of the `--json` interface.
 #[derive(Debug, Clone, Serialize)]
@@ -29,6 +35,11 @@ pub struct CheckReport {
     pub intersections_between_layers: usize,
     pub intersections_within_layers: usize,
     pub intersection_examples: Vec<[u32; 2]>,
+    /// Closed components (no boundary edge) and the face count of the smallest.
+    pub closed_components: usize,
+    pub smallest_closed_faces: Option<usize>,
+    /// With `--against ORIGINAL`: each closed component of the original and its volume here.
+    pub volume_changes: Option<Vec<VolumeChange>>,
     /// The vertex grid the engine would build (cell = mean edge length).
     pub grid: Option<GridFigures>,
     /// One line per defect; empty when the mesh is clean.
@@ -41,6 +52,82 @@ impl CheckReport {
     pub fn is_clean(&self) -> bool {
         self.defects.is_empty()
     }
+
+    /// Compares the closed components' volumes with those of `original` (the file this one
+    /// was made from), adding a defect for each that changed by more than
+    /// [`VOLUME_CHANGE_DEFECT`] or is gone.
+    pub fn compare_with(&mut self, mesh: &Mesh, original: &Mesh) {
+        let changes = volume_changes(&mesh.closed_components(), &original.closed_components());
+        for c in &changes {
+            match (c.after, c.change) {
+                (None, _) => self.defects.push(format!(
+                    "closed component {} (layer {}, volume {:.6}) of the original has no closed counterpart",
+                    c.component, c.layer, c.before
+                )),
+                (Some(after), Some(change)) if change.abs() > VOLUME_CHANGE_DEFECT => {
+                    self.defects.push(format!(
+                        "closed component {} (layer {}) changed volume by {:+.1} % ({:.6} -> {after:.6}); more than {} % is a lost shape",
+                        c.component,
+                        c.layer,
+                        100.0 * change,
+                        c.before,
+                        100.0 * VOLUME_CHANGE_DEFECT
+                    ))
+                }
+                _ => {}
+            }
+        }
+        self.volume_changes = Some(changes);
+    }
+}
+
+/// One closed component of an original mesh and the component of the same layer nearest to
+/// it in the mesh checked.
+#[derive(Debug, Clone, Serialize)]
+pub struct VolumeChange {
+    /// Its number among the original's closed components.
+    pub component: usize,
+    pub layer: u32,
+    pub before: f64,
+    /// `None` when the mesh checked has no closed component left to match it.
+    pub after: Option<f64>,
+    /// `(after - before) / |before|`.
+    pub change: Option<f64>,
+}
+
+/// Matches each original closed component with the nearest unmatched one of its layer (by
+/// centroid) and compares volumes.
+fn volume_changes(now: &[ClosedComponent], original: &[ClosedComponent]) -> Vec<VolumeChange> {
+    let mut taken = vec![false; now.len()];
+    original
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            let nearest = now
+                .iter()
+                .enumerate()
+                .filter(|(j, c)| !taken[*j] && c.layer == o.layer)
+                .min_by(|(_, a), (_, b)| {
+                    let (da, db) = (
+                        a.centroid.distance(o.centroid),
+                        b.centroid.distance(o.centroid),
+                    );
+                    da.total_cmp(&db)
+                })
+                .map(|(j, c)| (j, c.volume));
+            if let Some((j, _)) = nearest {
+                taken[j] = true;
+            }
+            let after = nearest.map(|(_, v)| v);
+            VolumeChange {
+                component: i,
+                layer: o.layer,
+                before: o.volume,
+                after,
+                change: after.map(|a| (a - o.volume) / o.volume.abs().max(f64::MIN_POSITIVE)),
+            }
+        })
+        .collect()
 }
 
 /// The spatial hash over the mesh's vertices, as the brush pipeline builds it per stroke.
@@ -85,6 +172,8 @@ pub fn check_mesh(
         .flatten();
     progress("testing triangle pairs for intersections");
     let intersections = find_intersections(mesh);
+    let closed = mesh.closed_components();
+    let smallest_closed_faces = closed.iter().map(|c| c.faces).min();
 
     let faces = mesh.live_face_count();
     let mut defects = Vec::new();
@@ -117,6 +206,14 @@ pub fn check_mesh(
                 .collect::<Vec<_>>()
         ));
     }
+    for (i, c) in closed.iter().enumerate() {
+        if c.faces < MIN_CLOSED_FACES {
+            defects.push(format!(
+                "closed component {i} (layer {}) has only {} faces, fewer than {MIN_CLOSED_FACES}: a collapsed shape",
+                c.layer, c.faces
+            ));
+        }
+    }
     CheckReport {
         file: file.to_string(),
         vertices: mesh.live_vertex_count(),
@@ -141,6 +238,9 @@ pub fn check_mesh(
             .iter()
             .map(|p| [p.face_a, p.face_b])
             .collect(),
+        closed_components: closed.len(),
+        smallest_closed_faces,
+        volume_changes: None,
         grid,
         defects,
         digest: mesh.digest(),
@@ -180,6 +280,30 @@ impl std::fmt::Display for CheckReport {
             "  intersections     {}  ({} between layers, {} within a layer)",
             self.intersections, self.intersections_between_layers, self.intersections_within_layers
         )?;
+        if let Some(smallest) = self.smallest_closed_faces {
+            writeln!(
+                f,
+                "  closed            {} components, the smallest {smallest} faces",
+                self.closed_components
+            )?;
+        }
+        for c in self.volume_changes.iter().flatten() {
+            match (c.after, c.change) {
+                (Some(after), Some(change)) => writeln!(
+                    f,
+                    "    volume of closed component {} (layer {}): {:.6} -> {after:.6} ({:+.2} %)",
+                    c.component,
+                    c.layer,
+                    c.before,
+                    100.0 * change
+                )?,
+                _ => writeln!(
+                    f,
+                    "    volume of closed component {} (layer {}): {:.6} -> gone",
+                    c.component, c.layer, c.before
+                )?,
+            }
+        }
         if let Some(g) = &self.grid {
             writeln!(
                 f,

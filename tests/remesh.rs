@@ -169,7 +169,9 @@ fn remeshing_an_irregular_sheet_makes_edges_uniform() {
 /// after each: no crossing ever, a valid mesh, and the worked region mostly back in the edge
 /// band. Mostly: pinches and push-downs leave patches compressed against another layer or an
 /// open boundary where a collapse would stretch a neighbouring edge past 4/3·L, which the
-/// remesher refuses (measured: 86–87 % in band here; the bench's strokes reach 99 %).
+/// remesher refuses, and creases sharper than an edge, where an edit would move the surface
+/// more than `remesh::SHAPE_TOLERANCE`·L (measured: 86–87 % in band before the shape bound,
+/// 75–77 % with it; the bench's strokes reach 99 %).
 #[test]
 fn remeshing_after_strokes_keeps_layers_apart() {
     use slayer::bench::{BrushMix, ScriptSpec, edge_band_fraction_where, generate_script};
@@ -224,7 +226,7 @@ fn remeshing_after_strokes_keeps_layers_apart() {
         };
         let band = edge_band_fraction_where(&mesh, edge as f64, |a, b| worked(a) || worked(b));
         eprintln!("{kind}: band {band}");
-        assert!(band > 0.8, "{kind}: {band} of the worked edges in band");
+        assert!(band > 0.7, "{kind}: {band} of the worked edges in band");
         assert!(
             edits > 100,
             "{kind}: the torture strokes called for only {edits} edits"

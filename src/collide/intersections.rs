@@ -4,12 +4,15 @@
 //! two edge lengths, so a face touches a handful); faces sharing a cell are paired, and a pair is
 //! counted only in the cell holding the lowest corner of the two boxes' overlap, so each pair is
 //! tested once. Narrow phase: [`triangles_intersect`] on exact predicates. Pairs that share a
-//! vertex are a face's own neighbourhood and never count.
+//! vertex are a face's own neighbourhood and never count. Faces of different layers that meet
+//! only at vertex positions they share (a surface split into OBJ groups, welded by position
+//! along the seam) are not crossing either: they count only where they meet beyond those
+//! points ([`neighbours_overlap`]).
 
 use glam::{I64Vec3, Vec3};
 use rayon::prelude::*;
 
-use crate::geom::{Aabb, triangles_intersect};
+use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
 use crate::mesh::{INVALID, Mesh};
 
 /// A face spanning more cells than this is tested against every face instead of being filed
@@ -120,12 +123,19 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             .iter()
             .any(|v| faces[b as usize].contains(v))
     };
+    let layers = mesh.face_layers();
     let test = |a: u32, b: u32| -> bool {
-        !shares_vertex(a, b)
-            && triangles_intersect(
-                mesh.face_positions(a as usize),
-                mesh.face_positions(b as usize),
-            )
+        if shares_vertex(a, b) {
+            return false;
+        }
+        let (ta, tb) = (
+            mesh.face_positions(a as usize),
+            mesh.face_positions(b as usize),
+        );
+        if layers[a as usize] != layers[b as usize] {
+            return seam_pair_intersects(ta, faces[a as usize], tb, faces[b as usize]);
+        }
+        triangles_intersect(ta, tb)
     };
 
     let mut pairs: Vec<IntersectingPair> = group_starts
@@ -183,7 +193,6 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
     }
 
     pairs.par_sort_unstable();
-    let layers = mesh.face_layers();
     let between_layers = pairs
         .iter()
         .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
@@ -193,6 +202,27 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
         within_layers: pairs.len() - between_layers,
         examples: pairs.iter().take(8).copied().collect(),
         skipped_faces,
+    }
+}
+
+/// Whether two faces of different layers intersect, where vertices at the same position count
+/// as shared: a pair meeting only at shared positions (a seam between OBJ groups) does not,
+/// a pair crossing beyond them does, and two faces on the same three positions overlap whole.
+fn seam_pair_intersects(a: [Vec3; 3], a_ids: [u32; 3], b: [Vec3; 3], b_ids: [u32; 3]) -> bool {
+    // Give each of b's vertices that sits on one of a's the id of that vertex, so that the
+    // neighbour test sees the shared points.
+    let mut shared = 0;
+    let b_as_a = std::array::from_fn(|j| match a.iter().position(|&p| p == b[j]) {
+        Some(i) => {
+            shared += 1;
+            a_ids[i]
+        }
+        None => b_ids[j],
+    });
+    match shared {
+        0 => triangles_intersect(a, b),
+        3 => true,
+        _ => neighbours_overlap(a, a_ids, b, b_as_a),
     }
 }
 

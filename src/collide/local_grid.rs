@@ -90,6 +90,28 @@ impl LocalFaceGrid {
         }
     }
 
+    /// Whether `f` holds for some local face filed in a cell overlapping `query`; stops at the
+    /// first.
+    pub fn any_candidate(&self, query: &Aabb, mut f: impl FnMut(u32) -> bool) -> bool {
+        if self.offsets.is_empty() {
+            return false;
+        }
+        let (lo, hi) = self.cell_range(query);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let c = self.index(IVec3::new(x, y, z));
+                    let cell =
+                        &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize];
+                    if cell.iter().any(|&e| f(e)) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
     fn cell_range(&self, b: &Aabb) -> (IVec3, IVec3) {
         // Truncation is floor here: everything below the origin clamps to cell 0 anyway.
         let clamp = |p: Vec3| {

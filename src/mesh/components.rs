@@ -95,3 +95,58 @@ impl Mesh {
         result
     }
 }
+
+/// A closed component (no boundary edge): its layer, face count, enclosed volume and the
+/// centroid of its vertices (to match it with the same component in another version of the
+/// mesh).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClosedComponent {
+    pub layer: LayerId,
+    pub faces: usize,
+    /// Signed: positive when the faces wind outward.
+    pub volume: f64,
+    pub centroid: glam::DVec3,
+}
+
+impl Mesh {
+    /// Every closed component, in order of their first face.
+    pub fn closed_components(&self) -> Vec<ClosedComponent> {
+        let components = self.components();
+        let count = components.count();
+        let mut open = vec![false; count];
+        let mut sums = vec![(glam::DVec3::ZERO, 0usize); count];
+        for (face, tri) in self.faces().iter().enumerate() {
+            let label = components.face_component[face];
+            if label == INVALID {
+                continue;
+            }
+            for (k, &v) in tri.iter().enumerate() {
+                let corner = 3 * face as u32 + k as u32;
+                open[label as usize] |= self.adjacency().opposite[corner as usize] == INVALID;
+                let s = &mut sums[label as usize];
+                s.0 += self.positions()[v as usize].as_dvec3();
+                s.1 += 1;
+            }
+        }
+        let centroids: Vec<glam::DVec3> = sums.iter().map(|(s, n)| *s / *n as f64).collect();
+        let mut volume = vec![0.0f64; count];
+        for (face, tri) in self.faces().iter().enumerate() {
+            let label = components.face_component[face];
+            if label == INVALID || open[label as usize] {
+                continue;
+            }
+            let o = centroids[label as usize];
+            let [a, b, c] = tri.map(|v| self.positions()[v as usize].as_dvec3() - o);
+            volume[label as usize] += a.dot(b.cross(c)) / 6.0;
+        }
+        (0..count)
+            .filter(|&i| !open[i])
+            .map(|i| ClosedComponent {
+                layer: components.layer[i],
+                faces: components.size[i],
+                volume: volume[i],
+                centroid: centroids[i],
+            })
+            .collect()
+    }
+}

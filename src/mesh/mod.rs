@@ -18,7 +18,7 @@ mod validate;
 mod vertex_faces;
 
 pub use attributes::{Brdf, LayerId, MIN_SLOPE, VertexFlags, blinn_exponent, partial_mask_factor};
-pub use components::Components;
+pub use components::{ClosedComponent, Components};
 pub use corner_table::{CornerTable, FanIter, INVALID, face_of, next, prev};
 pub use delta::{MeshDelta, RowsDelta};
 pub use error::MeshError;

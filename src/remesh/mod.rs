@@ -9,9 +9,14 @@
 //! outside its neighbourhood) than it already was, and the triangles a flip or a collapse
 //! creates are tested exactly against the other layers' triangles nearby. Splits do not move
 //! the surface. The grid is kept up to date through every edit.
+//!
+//! Remeshing keeps the shape (`shape`): no edit moves the surface more than
+//! [`SHAPE_TOLERANCE`]·L from where it was, nor changes a closed component's volume past
+//! [`VOLUME_TOLERANCE`] or takes it below [`MIN_CLOSED_FACES`] faces.
 
 mod reference;
 mod safety;
+mod shape;
 
 use std::time::Instant;
 
@@ -24,6 +29,8 @@ use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh, next, prev};
 use reference::ReferenceSurface;
+use shape::ClosedParts;
+pub use shape::{MIN_CLOSED_FACES, SHAPE_TOLERANCE, VOLUME_TOLERANCE};
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
 pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
@@ -75,6 +82,10 @@ pub struct RemeshReport {
     pub relaxed: usize,
     /// Moves and edits refused because they would have come too close to another surface.
     pub refused: usize,
+    /// Edits refused because they would have moved the surface past [`SHAPE_TOLERANCE`],
+    /// changed a closed component's volume past [`VOLUME_TOLERANCE`], or left it fewer than
+    /// [`MIN_CLOSED_FACES`] faces.
+    pub shape_refused: usize,
     /// Longest edge among the faces around the region afterwards (the pipeline's running
     /// bound on edge lengths).
     pub longest_edge: f32,
@@ -90,6 +101,7 @@ impl RemeshReport {
         self.flips += other.flips;
         self.relaxed += other.relaxed;
         self.refused += other.refused;
+        self.shape_refused += other.shape_refused;
         self.longest_edge = self.longest_edge.max(other.longest_edge);
         self.millis += other.millis;
     }
@@ -182,6 +194,8 @@ struct Remesher<'a> {
     /// them does not go away by remeshing, so later rounds do not retry them.
     refused_collapses: rustc_hash::FxHashSet<(u32, u32)>,
     surface: ReferenceSurface,
+    /// The closed components the region is on: their volumes and face counts.
+    closed: ClosedParts,
     report: RemeshReport,
     scratch: Vec<u32>,
     near: Vec<NearFace>,
@@ -236,6 +250,7 @@ impl<'a> Remesher<'a> {
         }
         region.sort_unstable();
         let surface = ReferenceSurface::capture(mesh, grid, &region, settings);
+        let closed = ClosedParts::find(mesh, &region);
         let dirty = vec![false; in_region.len()];
         let mut remesher = Remesher {
             report: RemeshReport {
@@ -251,6 +266,7 @@ impl<'a> Remesher<'a> {
             dirty_list: Vec::new(),
             refused_collapses: Default::default(),
             surface,
+            closed,
             scratch: Vec::new(),
             near: Vec::new(),
             movable: Stamps::default(),
@@ -419,6 +435,8 @@ impl<'a> Remesher<'a> {
             let (f, o) = (c / 3, self.mesh.adjacency().opposite[c as usize]);
             let first_new = self.mesh.face_count() as u32;
             let m = self.mesh.split_edge(c, 0.5);
+            self.closed.adopt(m, a);
+            self.closed.record(a, 0.0, if o == INVALID { 1 } else { 2 });
             self.surface.record_split(f, first_new);
             if o != INVALID {
                 self.surface.record_split(o / 3, first_new + 1);
@@ -491,12 +509,21 @@ impl<'a> Remesher<'a> {
                 if !self.collapse_shape_ok(keep, remove, target, long) {
                     continue;
                 }
+                let (before, after) = self.collapse_faces(keep, remove, target);
+                let now = self.mesh.positions();
+                let lost = [now[keep as usize], now[remove as usize]];
+                let Some(volume) = self.shape_kept(keep, (&before, &after), (&lost, target)) else {
+                    self.report.shape_refused += 1;
+                    continue;
+                };
                 if !self.move_is_safe(keep, target, Some(remove)) {
                     refused = true;
                     continue;
                 }
                 self.grid.remove(remove);
                 let survivor = self.mesh.collapse_edge(corner, target);
+                let removed = before.len() - after.len();
+                self.closed.record(survivor, volume, -(removed as isize));
                 self.grid.move_to(survivor, target);
                 self.mark_dirty_around(survivor);
                 self.report.collapses += 1;
@@ -576,14 +603,22 @@ impl<'a> Remesher<'a> {
                 continue;
             }
             let p = self.mesh.positions();
-            let new_faces = [
-                ([x, a, y], [p[x as usize], p[a as usize], p[y as usize]]),
-                ([y, b, x], [p[y as usize], p[b as usize], p[x as usize]]),
-            ];
+            let [pa, pb, px, py] = [a, b, x, y].map(|v| p[v as usize]);
+            // Faces (x, a, b) and (y, b, a) become (x, a, y) and (y, b, x); the old edge's
+            // midpoint is what the flip takes away from the surface.
+            let (before, after) = ([[px, pa, pb], [py, pb, pa]], [[px, pa, py], [py, pb, px]]);
+            let middle = 0.5 * (px + py);
+            let lost = [0.5 * (pa + pb)];
+            let Some(volume) = self.shape_kept(a, (&before, &after), (&lost, middle)) else {
+                self.report.shape_refused += 1;
+                continue;
+            };
+            let new_faces = [([x, a, y], after[0]), ([y, b, x], after[1])];
             if !self.faces_clear(&new_faces, &[], &[c / 3, o / 3]) {
                 self.report.refused += 1;
                 continue;
             }
+            self.closed.record(a, volume, 0);
             self.mesh.flip_edge(c);
             for w in [a, b, x, y] {
                 self.mark_dirty(w);
@@ -667,10 +702,17 @@ impl<'a> Remesher<'a> {
             if !self.relax_shape_ok(v, target) {
                 continue;
             }
+            let (before, after) = self.moved_faces(v, target);
+            let lost = [self.mesh.positions()[v as usize]];
+            let Some(volume) = self.shape_kept(v, (&before, &after), (&lost, target)) else {
+                self.report.shape_refused += 1;
+                continue;
+            };
             if !self.move_is_safe(v, target, None) {
                 self.report.refused += 1;
                 continue;
             }
+            self.closed.record(v, volume, 0);
             self.mesh.positions_mut()[v as usize] = target;
             self.grid.move_to(v, target);
             self.report.relaxed += 1;

@@ -117,6 +117,26 @@ impl ReferenceSurface {
         });
     }
 
+    /// Whether the original surface of `layer` comes within `distance` (at most an edge
+    /// length) of `p`.
+    pub fn is_near(&self, p: Vec3, layer: u32, distance: f32) -> bool {
+        let query = Aabb { min: p, max: p }.expanded(distance);
+        let d2 = distance * distance;
+        self.grid.any_candidate(&query, |local| {
+            let i = local as usize;
+            if self.layers[i] != layer {
+                return false;
+            }
+            let [a, b, c] = self.triangles[i];
+            // Most candidates are filed under padded boxes: reject on the triangle's own first.
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            if (p.cmplt(lo - distance) | p.cmpgt(hi + distance)).any() {
+                return false;
+            }
+            closest_point_on_triangle(p, a, b, c).distance_squared(p) <= d2
+        })
+    }
+
     /// The closest point of the original surface of `layer` to `p`, within an edge length.
     pub fn project(&self, p: Vec3, layer: u32) -> Option<Vec3> {
         let query = Aabb { min: p, max: p }.expanded(self.search);

@@ -5,25 +5,35 @@ use slayer::check::{CheckReport, check_mesh};
 
 use crate::progress::Steps;
 
-/// Loads and checks `file`; `Err` only for files that cannot be read as a mesh at all.
-pub fn report(file: &Path) -> anyhow::Result<CheckReport> {
+/// Loads and checks `file` (against the file it was made from, if given); `Err` only for
+/// files that cannot be read as a mesh at all.
+pub fn report(file: &Path, against: Option<&Path>) -> anyhow::Result<CheckReport> {
     let steps = Steps::new("check");
     steps.step("reading");
-    let (mesh, notes) = if slayer::session::is_session_path(file) {
-        let session = slayer::session::open(file)?;
-        (session.into_mesh(), slayer::io::LoadNotes::default())
-    } else {
-        slayer::io::load_mesh(file)?
-    };
-    let report = check_mesh(&mesh, &notes, &file.display().to_string(), |s| {
+    let (mesh, notes) = load(file)?;
+    let original = against.map(load).transpose()?;
+    let mut report = check_mesh(&mesh, &notes, &file.display().to_string(), |s| {
         steps.step(s)
     });
+    if let Some((original, _)) = &original {
+        steps.step("comparing closed volumes with the original");
+        report.compare_with(&mesh, original);
+    }
     steps.finish();
     Ok(report)
 }
 
-pub fn run(file: &Path, json: bool) -> anyhow::Result<ExitCode> {
-    let report = report(file)?;
+fn load(file: &Path) -> anyhow::Result<(slayer::mesh::Mesh, slayer::io::LoadNotes)> {
+    Ok(if slayer::session::is_session_path(file) {
+        let session = slayer::session::open(file)?;
+        (session.into_mesh(), slayer::io::LoadNotes::default())
+    } else {
+        slayer::io::load_mesh(file)?
+    })
+}
+
+pub fn run(file: &Path, json: bool, against: Option<&Path>) -> anyhow::Result<ExitCode> {
+    let report = report(file, against)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -159,7 +159,7 @@ pub fn run(
         slayer::io::write_atomically(&both, &side_by_side.to_png()?)?;
         println!("  before and after side by side -> {}", both.display());
     }
-    let report = crate::check::report(&after)?;
+    let report = crate::check::report(&after, None)?;
     println!("{report}");
     Ok(if report.is_clean() {
         ExitCode::SUCCESS

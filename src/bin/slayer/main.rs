@@ -67,6 +67,10 @@ enum Command {
         /// Print one JSON object instead of the table.
         #[arg(long)]
         json: bool,
+        /// The file FILE was made from: report each closed component's volume change, and a
+        /// change over 5 % as a defect.
+        #[arg(long, value_name = "ORIGINAL")]
+        against: Option<PathBuf>,
     },
     /// Apply a stroke file to a mesh or session and write the result (the input is never
     /// modified unless `--in-place` is given). A `.slayer` output keeps every stroke as an
@@ -255,7 +259,11 @@ fn main() -> ExitCode {
             jitter,
             output,
         } => scene::run(&name, triangles, seed, jitter, &output),
-        Command::Check { file, json } => check::run(&file, json),
+        Command::Check {
+            file,
+            json,
+            against,
+        } => check::run(&file, json, against.as_deref()),
         Command::Adapters { json } => adapters(json),
         Command::Sculpt {
             input,

@@ -33,7 +33,7 @@ pub fn run(input: &Path, edge: Option<f32>, output: &Path) -> anyhow::Result<Exi
     let after = mesh.edge_length_stats();
     slayer::io::write_mesh(&mesh, output)?;
     println!(
-        "remeshed to L = {edge}: edge cv {:.3} -> {:.3}, {} -> {} faces ({} splits, {} collapses, {} flips, {} relaxed) in {:.0} ms -> {}",
+        "remeshed to L = {edge}: edge cv {:.3} -> {:.3}, {} -> {} faces ({} splits, {} collapses, {} flips, {} relaxed; {} refused to keep the shape) in {:.0} ms -> {}",
         before.coefficient_of_variation(),
         after.coefficient_of_variation(),
         faces_before,
@@ -42,6 +42,7 @@ pub fn run(input: &Path, edge: Option<f32>, output: &Path) -> anyhow::Result<Exi
         report.collapses,
         report.flips,
         report.relaxed,
+        report.shape_refused,
         report.millis,
         output.display()
     );
