@@ -113,6 +113,7 @@ fn smooth_dab_at_corner(remeshing: Remeshing) -> Mesh {
         paint: None,
         layers: vec![0],
         spacing: 0.25,
+        symmetry: None,
         samples: vec![Sample {
             position: Vec3::ONE,
             pressure: 1.0,
