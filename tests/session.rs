@@ -200,7 +200,9 @@ fn the_memory_cap_drops_the_oldest_entries_and_says_so() {
             .unwrap()
             .1
             .dropped;
-        assert!(session.history().bytes() <= cap);
+        // Under the cap, or one entry larger than the cap on its own, kept alone.
+        let history = session.history();
+        assert!(history.bytes() <= cap || history.entries().len() == 1);
     }
     assert!(dropped > 0, "no entry was dropped");
     assert_eq!(session.history().dropped(), dropped);
