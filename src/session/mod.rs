@@ -396,10 +396,7 @@ fn default_layers(mesh: &Mesh) -> Vec<LayerSettings> {
 
 /// "draw stroke", "paint stroke", "grab stroke (painting)".
 fn stroke_label(stroke: &Stroke) -> String {
-    let kind = serde_json::to_value(stroke.brush.kind)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_else(|| "brush".into());
+    let kind = stroke.brush.kind.name();
     let painting = if stroke.paint.is_some() && stroke.brush.kind != BrushKind::Paint {
         " (painting)"
     } else {
