@@ -9,7 +9,7 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use super::IoError;
-use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh, VertexFlags};
+use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh};
 
 /// What parsing found besides the mesh.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -305,10 +305,7 @@ pub fn write_obj_with_materials(
             writeln!(out, "usemtl {}", sanitize_name(layer_name))?;
         }
         for (v, p) in mesh.positions().iter().enumerate() {
-            if mesh.vertex_layers()[v] == layer
-                && !mesh.flags()[v].contains(VertexFlags::DEAD)
-                && mesh.adjacency().vertex_corner[v] != INVALID
-            {
+            if mesh.vertex_layers()[v] == layer && mesh.is_vertex_live(v as u32) {
                 writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
                 file_index[v] = next_index;
                 next_index += 1;
@@ -337,9 +334,7 @@ pub fn layer_materials(mesh: &Mesh) -> Vec<(LayerId, String, Brdf)> {
         }
     }
     for (v, brdf) in mesh.brdfs().iter().enumerate() {
-        if mesh.flags()[v].contains(VertexFlags::DEAD)
-            || mesh.adjacency().vertex_corner[v] == INVALID
-        {
+        if !mesh.is_vertex_live(v as u32) {
             continue;
         }
         let layer = mesh.vertex_layers()[v] as usize;

@@ -491,10 +491,7 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
 /// Writes the live mesh as binary little-endian PLY.
 pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     let live: Vec<usize> = (0..mesh.vertex_count())
-        .filter(|&v| {
-            !mesh.flags()[v].contains(VertexFlags::DEAD)
-                && mesh.adjacency().vertex_corner[v] != INVALID
-        })
+        .filter(|&v| mesh.is_vertex_live(v as u32))
         .collect();
     let mut file_index = vec![INVALID; mesh.vertex_count()];
     for (i, &v) in live.iter().enumerate() {

@@ -383,16 +383,32 @@ impl Mesh {
     /// The length of each array a [`MeshDelta`] covers: positions, normals, BRDFs, vertex
     /// layers, flags, faces, face layers, opposite corners, vertex corners.
     pub fn array_lengths(&self) -> [usize; 9] {
+        self.arrays_and_sizes().map(|(len, _)| len)
+    }
+
+    /// Bytes the mesh's arrays hold (what a history entry is measured against).
+    pub fn memory_bytes(&self) -> usize {
+        self.arrays_and_sizes()
+            .iter()
+            .map(|(len, size)| len * size)
+            .sum()
+    }
+
+    /// Each array's length and the bytes of one of its rows.
+    fn arrays_and_sizes(&self) -> [(usize, usize); 9] {
+        fn of<T>(values: &[T]) -> (usize, usize) {
+            (values.len(), std::mem::size_of::<T>())
+        }
         [
-            self.positions.len(),
-            self.normals.len(),
-            self.brdfs.len(),
-            self.vertex_layers.len(),
-            self.flags.len(),
-            self.faces.len(),
-            self.face_layers.len(),
-            self.adjacency.opposite.len(),
-            self.adjacency.vertex_corner.len(),
+            of(&self.positions),
+            of(&self.normals),
+            of(&self.brdfs),
+            of(&self.vertex_layers),
+            of(&self.flags),
+            of(&self.faces),
+            of(&self.face_layers),
+            of(&self.adjacency.opposite),
+            of(&self.adjacency.vertex_corner),
         ]
     }
 }

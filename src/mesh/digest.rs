@@ -15,9 +15,7 @@ impl Mesh {
         let mut live_index = vec![INVALID; self.vertex_count()];
         let mut live = 0u32;
         for (v, index) in live_index.iter_mut().enumerate() {
-            if self.flags[v].contains(VertexFlags::DEAD)
-                || self.adjacency.vertex_corner[v] == INVALID
-            {
+            if !self.is_vertex_live(v as u32) {
                 continue;
             }
             *index = live;

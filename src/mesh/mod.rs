@@ -292,6 +292,11 @@ impl Mesh {
         self.flags[vertex as usize].contains(VertexFlags::DEAD)
     }
 
+    /// Not dead and on a face: what files write and the digest counts.
+    pub fn is_vertex_live(&self, vertex: u32) -> bool {
+        !self.is_vertex_dead(vertex) && self.adjacency.vertex_corner[vertex as usize] != INVALID
+    }
+
     /// The vertex at a corner.
     #[inline]
     pub fn corner_vertex(&self, corner: u32) -> u32 {

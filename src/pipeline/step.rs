@@ -93,14 +93,11 @@ pub fn longest_move(mesh: &Mesh, selection: &[(u32, f32)], targets: &[Vec3]) -> 
 /// Brush selection: active, unmasked vertices with positive falloff weight (less by a partial
 /// mask), sorted by index.
 pub fn select(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
-    let brush = &dab.brush;
-    let center = dab.frame.center;
     within_brush(state, mesh, dab)
         .into_iter()
         .filter(|&v| selectable(state, mesh, v))
         .filter_map(|v| {
-            let t = mesh.positions()[v as usize].distance(center) / brush.radius;
-            let mut w = brush.falloff.weight(t);
+            let mut w = falloff_at(mesh, dab, v);
             if let Some(factor) = partial_mask_factor(mesh.flags()[v as usize].bits()) {
                 w *= factor;
             }
@@ -112,20 +109,20 @@ pub fn select(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)
 /// The mask brush's selection: vertices of active layers under the brush with their falloff
 /// weights, masked ones included (it paints the mask), sorted by index.
 pub fn select_for_mask(state: &StrokeState<'_>, mesh: &Mesh, dab: &Dab) -> Vec<(u32, f32)> {
-    let brush = &dab.brush;
-    let center = dab.frame.center;
     within_brush(state, mesh, dab)
         .into_iter()
         .filter(|&v| {
             state.active[mesh.vertex_layers()[v as usize] as usize]
                 && !mesh.flags()[v as usize].contains(VertexFlags::DEAD)
         })
-        .filter_map(|v| {
-            let t = mesh.positions()[v as usize].distance(center) / brush.radius;
-            let w = brush.falloff.weight(t);
-            (w > 0.0).then_some((v, w))
-        })
+        .filter_map(|v| Some((v, falloff_at(mesh, dab, v))).filter(|&(_, w)| w > 0.0))
         .collect()
+}
+
+/// The brush's falloff weight at vertex `v`.
+fn falloff_at(mesh: &Mesh, dab: &Dab, v: u32) -> f32 {
+    let t = mesh.positions()[v as usize].distance(dab.frame.center) / dab.brush.radius;
+    dab.brush.falloff.weight(t)
 }
 
 /// The live vertices within the brush's sphere, ascending.

@@ -20,7 +20,7 @@ fn open_session(path: &Path) -> anyhow::Result<Session> {
 pub fn list(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
     let session = open_session(path)?;
     let history = session.history();
-    let mesh_bytes = mesh_bytes(&session);
+    let mesh_bytes = session.mesh().memory_bytes();
     if json {
         let entries: Vec<_> = history
             .entries()
@@ -110,25 +110,4 @@ pub fn step(path: &Path, way: Step, steps: usize, output: &Path) -> anyhow::Resu
         history.entries().len() - history.done()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-/// The mesh's bytes in memory, every array (what a history entry is compared with).
-fn mesh_bytes(session: &Session) -> usize {
-    let [
-        positions,
-        normals,
-        brdfs,
-        vertex_layers,
-        flags,
-        faces,
-        face_layers,
-        opposite,
-        corner,
-    ] = session.mesh().array_lengths();
-    (positions + normals) * 12
-        + brdfs * 28
-        + (vertex_layers + flags + corner) * 4
-        + faces * 12
-        + face_layers * 4
-        + opposite * 4
 }
