@@ -11,7 +11,8 @@
 //! 81st stroke of seed 43 (a grab about as wide as the sphere, dragged over 7 samples) leaves 7
 //! crossing triangle pairs and takes 20–47 s; on plaster single strokes of huge brushes take
 //! minutes (a draw of radius 22 over 6 samples: 177 s; a grab of radius 0.76: 188 s). Run them
-//! with `-- --ignored` to reproduce; `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke.
+//! with `-- --ignored` to reproduce; `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke, and
+//! `SLAYER_SOAK_TRACE=1` prints each stroke (as a stroke file) before it runs.
 
 use std::time::Instant;
 
@@ -116,6 +117,9 @@ fn soak(kind: SceneKind, input: Mesh, count: usize, seed: u64) {
                 continue;
             }
         };
+        if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
+            eprintln!("stroke {i}: {as_json}");
+        }
         let started = Instant::now();
         match session.apply_stroke(&mut pipeline, &strokes[0]) {
             Ok((report, _)) => collisions += report.clamped,

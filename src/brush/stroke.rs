@@ -53,8 +53,11 @@ use crate::files::escape;
 use crate::material;
 use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
 
-/// A radius beyond this many times the mesh's bounding-box diagonal is rejected as absurd.
-pub const MAX_RADIUS_OVER_EXTENT: f32 = 10.0;
+/// A radius beyond this many times the mesh's bounding-box diagonal is rejected: such a brush
+/// covers the whole mesh from anywhere on it, and brushes that move in proportion to their
+/// radius (draw, inflate, crease) would move it by a fifth of its size per sample (a crease of
+/// 5× the diagonal crushed a 5K-face sphere for over ten minutes).
+pub const MAX_RADIUS_OVER_EXTENT: f32 = 2.0;
 /// The largest stencil PNG read (256 MiB): a texture, not a photograph archive.
 pub const MAX_STENCIL_BYTES: u64 = 256 << 20;
 /// A radius below this share of the mean edge length touches nothing and is rejected.
@@ -318,7 +321,7 @@ fn resolve_stroke(
         return fail(
             ".radius",
             format!(
-                "{} is more than {MAX_RADIUS_OVER_EXTENT} times the mesh's size ({extent})",
+                "{} is more than {MAX_RADIUS_OVER_EXTENT} times the mesh's size ({extent}): it would cover the whole mesh from anywhere on it",
                 spec.radius
             ),
         );

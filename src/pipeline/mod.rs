@@ -82,7 +82,9 @@ pub struct PipelineSettings {
 pub enum Remeshing {
     /// Never: edges stretch and shrink with the brush.
     Off,
-    /// Once per stroke, over every vertex the stroke moved (the paper's choice, and ours).
+    /// Once per stroke, over every vertex the stroke moved (the paper's choice, and ours). A
+    /// grab is also remeshed between its samples wherever it stretched an edge past 2·`L`, so
+    /// a long drag costs in proportion to its length.
     #[default]
     AfterStroke,
     /// After every stroke sample, over the vertices that sample moved: strong grabs keep their

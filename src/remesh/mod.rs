@@ -34,6 +34,8 @@ pub use shape::{MIN_CLOSED_FACES, SHAPE_TOLERANCE, VOLUME_TOLERANCE};
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
 pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
+/// Where along an edge a split puts its new vertex.
+const SPLIT_AT: f32 = 0.5;
 pub const COLLAPSE_BELOW: f32 = 4.0 / 5.0;
 /// A collapse or flip may not turn a face's normal by more than this (cosine).
 const MIN_NORMAL_COSINE: f32 = 0.5;
@@ -432,9 +434,13 @@ impl<'a> Remesher<'a> {
                 break;
             }
             budget -= 1;
+            if !self.split_is_clear(c) {
+                self.report.refused += 1;
+                continue;
+            }
             let (f, o) = (c / 3, self.mesh.adjacency().opposite[c as usize]);
             let first_new = self.mesh.face_count() as u32;
-            let m = self.mesh.split_edge(c, 0.5);
+            let m = self.mesh.split_edge(c, SPLIT_AT);
             self.closed.adopt(m, a);
             self.closed.record(a, 0.0, if o == INVALID { 1 } else { 2 });
             self.surface.record_split(f, first_new);

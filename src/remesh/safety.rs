@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use super::{NearFace, Remesher};
+use super::{NearFace, Remesher, SPLIT_AT};
 use crate::collide::neighbourhood::ring_vertices;
 use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
 use crate::mesh::INVALID;
@@ -80,6 +80,33 @@ impl Remesher<'_> {
         let clear = safe && self.faces_clear_among(&moved, &involved, &[], &near);
         self.near = near;
         clear
+    }
+
+    /// Splitting the edge opposite corner `c` puts the new vertex where floats round the
+    /// edge's midpoint, a hair off the edge. Where surfaces are pressed together within the
+    /// exclusion ring (a grab drawn into a needle), another face can lie within that hair of
+    /// the two faces, and the halves would cross it or fold onto it: checked exactly, as a
+    /// flip's faces are.
+    pub(super) fn split_is_clear(&mut self, c: u32) -> bool {
+        let mesh = &*self.mesh;
+        let (a, b) = mesh.edge_vertices(c);
+        let x = mesh.corner_vertex(c);
+        let m = mesh.vertex_count() as u32;
+        let p = |v: u32| mesh.positions()[v as usize];
+        let at_m = p(a).lerp(p(b), SPLIT_AT);
+        let mut halves = vec![
+            ([x, a, m], [p(x), p(a), at_m]),
+            ([x, m, b], [p(x), at_m, p(b)]),
+        ];
+        let mut replaced = vec![c / 3];
+        let o = mesh.adjacency().opposite[c as usize];
+        if o != INVALID {
+            let y = mesh.corner_vertex(o);
+            halves.push(([y, b, m], [p(y), p(b), at_m]));
+            halves.push(([y, m, a], [p(y), at_m, p(a)]));
+            replaced.push(o / 3);
+        }
+        self.faces_clear(&halves, &[], &replaced)
     }
 
     /// The faces filed near `query` (live ones, at their current positions), in the reusable

@@ -1,0 +1,80 @@
+//! Issue 22, item 2: a long grab. Remeshed only at the stroke's end, a drag of many radii left
+//! edges tens of units long whose splitting compounded (a drag of 10 units over a 2K-face
+//! sphere: 15K splits and 12K collapses, 4.9 s of remeshing); and splitting the needle such a
+//! drag draws out put new vertices a float's hair off their edges, onto faces pressed
+//! together within the exclusion ring (17 crossings). Work is counted here, never timed.
+
+use glam::Vec3;
+use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
+use slayer::collide::find_intersections;
+use slayer::mesh::Mesh;
+use slayer::pipeline::{Pipeline, PipelineSettings, StrokeReport};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+
+fn sphere() -> Mesh {
+    generate(&SceneSpec {
+        kind: SceneKind::Sphere,
+        triangles: 2_000,
+        seed: 1,
+    })
+    .unwrap()
+}
+
+/// A grab of radius 0.15 caught at the sphere's +x pole and dragged `distance` along +x.
+fn drag(mesh: &mut Mesh, distance: f32) -> StrokeReport {
+    let pole = mesh
+        .positions()
+        .iter()
+        .copied()
+        .fold(Vec3::NEG_INFINITY, |a, p| if p.x > a.x { p } else { a });
+    let sample = |position: Vec3| Sample {
+        position,
+        pressure: 1.0,
+        normal: None,
+    };
+    let stroke = Stroke {
+        brush: Brush {
+            kind: BrushKind::Grab,
+            radius: 0.15,
+            strength: 1.0,
+            falloff: Falloff::default(),
+            invert: false,
+        },
+        paint: None,
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        samples: vec![sample(pole), sample(pole + Vec3::X * distance)],
+    };
+    let report = Pipeline::new(PipelineSettings::default())
+        .apply_stroke(mesh, &stroke)
+        .unwrap();
+    mesh.validate().unwrap();
+    report
+}
+
+/// Splits, collapses and flips: the edits remeshing made.
+fn edits(report: &StrokeReport) -> usize {
+    report.remesh.splits + report.remesh.collapses + report.remesh.flips
+}
+
+#[test]
+fn a_long_grab_is_remeshed_as_it_stretches_and_never_crosses() {
+    let (mut short, mut long) = (sphere(), sphere());
+    let (three, ten) = (drag(&mut short, 3.0), drag(&mut long, 10.0));
+    for (mesh, distance) in [(&short, 3), (&long, 10)] {
+        let crossings = find_intersections(mesh).total();
+        assert_eq!(crossings, 0, "a grab of {distance} units: {crossings} crossings");
+    }
+    // The drag reached: the surface was pulled out at least halfway.
+    let reach = long.positions().iter().map(|p| p.x).fold(f32::MIN, f32::max);
+    assert!(reach > 5.0, "the grab pulled the surface only to x = {reach}");
+    // Remeshing work in proportion to the drag (50 % slack), not compounding with it.
+    let ratio = edits(&ten) as f64 / edits(&three).max(1) as f64;
+    assert!(
+        ratio <= 1.5 * 10.0 / 3.0,
+        "remeshing edits: {} for 3 units, {} for 10 (×{ratio:.1})",
+        edits(&three),
+        edits(&ten)
+    );
+}
