@@ -173,3 +173,28 @@ fn mask_edits_are_undoable_and_files_keep_partial_masks() {
     while session.undo().is_some() {}
     assert_eq!(session.mesh().digest(), input.digest());
 }
+
+/// Remeshing splits edges inside masked regions: the new vertex takes the mask of the edge
+/// where it sits, so what was masked stays masked (and a half-way vertex half-masked).
+#[test]
+fn a_split_vertex_keeps_the_mask_of_its_edge() {
+    let mut mesh = Mesh::new(
+        vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)],
+        vec![[0, 1, 2], [2, 1, 3]],
+        vec![0, 0],
+        vec!["sheet".into()],
+    )
+    .unwrap();
+    for (v, mask) in [(0, 1.0), (1, 1.0), (2, 0.0), (3, 1.0)] {
+        mesh.flags_mut()[v].set_mask(mask);
+    }
+    // Corner 2 of face 0 is vertex 2: its opposite edge is (0, 1), both masked.
+    let inside = mesh.split_edge(2, 0.5);
+    assert_eq!(mesh.flags()[inside as usize].mask(), 1.0);
+    // Face 0 is now [0, inside, 2]: its corner 0's opposite edge runs from `inside`
+    // (masked) to vertex 2 (not).
+    let between = mesh.split_edge(0, 0.5);
+    let half = mesh.flags()[between as usize].mask();
+    assert!((half - 0.5).abs() <= 1.0 / 255.0, "mask {half}");
+    mesh.validate().unwrap();
+}

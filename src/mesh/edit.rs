@@ -84,8 +84,8 @@ impl Mesh {
     }
 
     /// Splits the edge opposite `corner` at `t` along it (0 at `next(corner)`'s vertex), adding
-    /// one vertex and one or two faces. Attributes are interpolated; the new vertex is
-    /// unflagged. Returns the new vertex.
+    /// one vertex and one or two faces. Attributes and the mask are interpolated; no other
+    /// flag is set on the new vertex. Returns the new vertex.
     pub fn split_edge(&mut self, corner: u32, t: f32) -> u32 {
         let c0 = corner;
         let (c1, c2) = (next(c0), prev(c0));
@@ -107,7 +107,11 @@ impl Mesh {
         let (ba, bb) = (self.brdfs[a as usize], self.brdfs[b as usize]);
         self.brdfs.push(ba.lerp(&bb, t));
         self.vertex_layers.push(layer);
-        self.flags.push(VertexFlags::empty());
+        // The mask is interpolated too: a split inside a masked region stays masked.
+        let (fa, fb) = (self.flags[a as usize], self.flags[b as usize]);
+        let mut flags = VertexFlags::empty();
+        flags.set_mask(fa.mask() + (fb.mask() - fa.mask()) * t);
+        self.flags.push(flags);
         self.adjacency.vertex_corner.push(INVALID);
 
         // Face f = [x, a, b] becomes [x, a, m]; the new face [x, m, b] takes the b side.
