@@ -42,8 +42,8 @@ pub struct SamplesReport {
     /// Vertices whose position, normal, BRDF or mask changed in this call (ascending): what a
     /// viewer uploads again. Vertices remeshing added are among them.
     pub changed: Vec<u32>,
-    /// Remeshing between samples rewrote faces ([`Remeshing::AfterSample`]): the index
-    /// buffer must be sent again.
+    /// Remeshing between samples rewrote faces ([`Remeshing::AfterSample`], or a grab that
+    /// stretched the surface): the index buffer must be sent again.
     pub topology_changed: bool,
     pub phases: PhaseTimes,
 }
