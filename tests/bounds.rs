@@ -156,3 +156,37 @@ fn a_stroke_file_with_too_many_strokes_is_refused() {
     );
     assert!(error.contains(&MAX_STROKES.to_string()), "{error}");
 }
+
+/// Settings built in code (as the app builds them) get the stroke file's brush checks when the
+/// stroke begins: an absurd radius, strength or spacing is refused by name, and nothing runs.
+#[test]
+fn absurd_brush_settings_are_refused_when_the_stroke_begins() {
+    let mut mesh = plaster();
+    let before = mesh.digest();
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let mut cases: Vec<(StrokeSettings, &str)> = vec![
+        (settings(f32::NAN), "brush.radius"),
+        (settings(-0.1), "brush.radius"),
+        (settings(1e6), "times the mesh's size"),
+    ];
+    let mut strong = settings(0.2);
+    strong.brush.strength = 40.0;
+    cases.push((strong, "brush.strength"));
+    let mut sparse = settings(0.2);
+    sparse.spacing = 0.0;
+    cases.push((sparse, "brush.spacing"));
+    for (bad, expected) in cases {
+        match pipeline.begin_stroke(&mut mesh, bad) {
+            Err(PipelineError::InvalidBrush(message)) => {
+                assert!(message.contains(expected), "{message}")
+            }
+            Err(other) => panic!("{other}"),
+            Ok(_) => panic!("accepted a brush that should name {expected}"),
+        }
+    }
+    assert_eq!(mesh.digest(), before);
+    // The pipeline is still ready for a sane stroke.
+    let mut stroke = pipeline.begin_stroke(&mut mesh, settings(0.2)).unwrap();
+    stroke.add_samples(&[sample(0.0, 0.0, 0.0)]).unwrap();
+    stroke.finish().unwrap();
+}

@@ -76,12 +76,13 @@ fn point() -> impl Strategy<Value = Vec3> {
 /// Triangles that are not too close to degenerate for the grid to bound the answer: a
 /// smallest angle of about a degree or more.
 fn triangle() -> impl Strategy<Value = [Vec3; 3]> {
-    (point(), point(), point()).prop_filter("nearly degenerate", |&(a, b, c)| {
-        let area2 = (b - a).cross(c - a).length();
-        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-        longest > 0.05 && area2 > 0.02 * longest * longest
-    })
-    .prop_map(|(a, b, c)| [a, b, c])
+    (point(), point(), point())
+        .prop_filter("nearly degenerate", |&(a, b, c)| {
+            let area2 = (b - a).cross(c - a).length();
+            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+            longest > 0.05 && area2 > 0.02 * longest * longest
+        })
+        .prop_map(|(a, b, c)| [a, b, c])
 }
 
 proptest! {

@@ -4,8 +4,10 @@
 //! drag draws out put new vertices a float's hair off their edges, onto faces pressed
 //! together within the exclusion ring (17 crossings). Work is counted here, never timed.
 
+mod common;
+
 use glam::Vec3;
-use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
+use slayer::brush::BrushKind;
 use slayer::collide::find_intersections;
 use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings, StrokeReport};
@@ -27,25 +29,8 @@ fn drag(mesh: &mut Mesh, distance: f32) -> StrokeReport {
         .iter()
         .copied()
         .fold(Vec3::NEG_INFINITY, |a, p| if p.x > a.x { p } else { a });
-    let sample = |position: Vec3| Sample {
-        position,
-        pressure: 1.0,
-        normal: None,
-    };
-    let stroke = Stroke {
-        brush: Brush {
-            kind: BrushKind::Grab,
-            radius: 0.15,
-            strength: 1.0,
-            falloff: Falloff::default(),
-            invert: false,
-        },
-        paint: None,
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
-        samples: vec![sample(pole), sample(pole + Vec3::X * distance)],
-    };
+    let stroke =
+        common::one_brush_stroke(BrushKind::Grab, 0.15, &[pole, pole + Vec3::X * distance]);
     let report = Pipeline::new(PipelineSettings::default())
         .apply_stroke(mesh, &stroke)
         .unwrap();
@@ -64,11 +49,21 @@ fn a_long_grab_is_remeshed_as_it_stretches_and_never_crosses() {
     let (three, ten) = (drag(&mut short, 3.0), drag(&mut long, 10.0));
     for (mesh, distance) in [(&short, 3), (&long, 10)] {
         let crossings = find_intersections(mesh).total();
-        assert_eq!(crossings, 0, "a grab of {distance} units: {crossings} crossings");
+        assert_eq!(
+            crossings, 0,
+            "a grab of {distance} units: {crossings} crossings"
+        );
     }
     // The drag reached: the surface was pulled out at least halfway.
-    let reach = long.positions().iter().map(|p| p.x).fold(f32::MIN, f32::max);
-    assert!(reach > 5.0, "the grab pulled the surface only to x = {reach}");
+    let reach = long
+        .positions()
+        .iter()
+        .map(|p| p.x)
+        .fold(f32::MIN, f32::max);
+    assert!(
+        reach > 5.0,
+        "the grab pulled the surface only to x = {reach}"
+    );
     // Remeshing work in proportion to the drag (50 % slack), not compounding with it.
     let ratio = edits(&ten) as f64 / edits(&three).max(1) as f64;
     assert!(

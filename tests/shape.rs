@@ -2,10 +2,12 @@
 //! shape-destroying results it can see (a closed component of fewer than 8 faces; with
 //! `--against`, a closed component's volume change).
 
+mod common;
+
 use std::process::Command;
 
 use glam::Vec3;
-use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
+use slayer::brush::BrushKind;
 use slayer::check::check_mesh;
 use slayer::io::LoadNotes;
 use slayer::mesh::Mesh;
@@ -102,24 +104,7 @@ fn a_coarse_cube_remeshed_finer_is_refined() {
 
 fn smooth_dab_at_corner(remeshing: Remeshing) -> Mesh {
     let mut mesh = cube(1);
-    let stroke = Stroke {
-        brush: Brush {
-            kind: BrushKind::Smooth,
-            radius: 0.12,
-            strength: 1.0,
-            falloff: Falloff::default(),
-            invert: false,
-        },
-        paint: None,
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
-        samples: vec![Sample {
-            position: Vec3::ONE,
-            pressure: 1.0,
-            normal: None,
-        }],
-    };
+    let stroke = common::one_brush_stroke(BrushKind::Smooth, 0.12, &[Vec3::ONE]);
     Pipeline::new(PipelineSettings {
         remeshing,
         ..PipelineSettings::default()

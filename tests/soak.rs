@@ -35,13 +35,11 @@ const SHORT_STROKES: usize = 200;
 const SHORT_FACES: usize = 2_000;
 
 /// Strokes in all, and the faces of each scene: the short version's, or what
-/// `SLAYER_SOAK_STROKES` asks for on the full scenes.
+/// `SLAYER_SOAK_STROKES` asks for, on `SLAYER_SOAK_FACES` (20K unless given).
 fn size() -> (usize, usize) {
-    match std::env::var("SLAYER_SOAK_STROKES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-    {
-        Some(strokes) => (strokes, 20_000),
+    let number = |name: &str| std::env::var(name).ok().and_then(|s| s.parse().ok());
+    match number("SLAYER_SOAK_STROKES") {
+        Some(strokes) => (strokes, number("SLAYER_SOAK_FACES").unwrap_or(20_000)),
         None => (SHORT_STROKES, SHORT_FACES),
     }
 }

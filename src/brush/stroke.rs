@@ -228,6 +228,19 @@ impl StrokeSettings {
     pub fn resampling_step(&self) -> f32 {
         self.spacing * self.brush.radius
     }
+
+    /// The brush checks a stroke file gets, for settings built in code (the app's): a radius
+    /// that is a positive length no more than [`MAX_RADIUS_OVER_EXTENT`] times `extent` (the
+    /// mesh's bounding-box diagonal), strength in [0, 1], spacing in [0.01, 2], a blend's `n`
+    /// in 3..=16. The error names the field and says what is wrong with it.
+    pub fn check(&self, extent: f32) -> Result<(), String> {
+        let brush = &self.brush;
+        check_brush(
+            (brush.radius, brush.strength, self.spacing, brush.falloff),
+            extent,
+        )
+        .map_err(|(field, message)| format!("brush{field}: {message}"))
+    }
 }
 
 impl Stroke {
@@ -304,6 +317,44 @@ impl StrokeFile {
     }
 }
 
+/// What is wrong with a brush's radius, strength, spacing and falloff on a mesh whose
+/// bounding-box diagonal is `extent`, as the field (`.radius`, ...) and a message: the checks a
+/// stroke file and [`StrokeSettings::check`] share.
+fn check_brush(
+    (radius, strength, spacing, falloff): (f32, f32, f32, Falloff),
+    extent: f32,
+) -> Result<(), (&'static str, String)> {
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err((".radius", format!("{radius} is not a positive length")));
+    }
+    if radius > MAX_RADIUS_OVER_EXTENT * extent {
+        return Err((
+            ".radius",
+            format!(
+                "{radius} is more than {MAX_RADIUS_OVER_EXTENT} times the mesh's size ({extent}): it would cover the whole mesh from anywhere on it"
+            ),
+        ));
+    }
+    if !(0.0..=1.0).contains(&strength) {
+        return Err((".strength", format!("{strength} is outside [0, 1]")));
+    }
+    if !(0.01..=2.0).contains(&spacing) {
+        return Err((
+            ".spacing",
+            format!("{spacing} is outside [0.01, 2] (a share of the radius)"),
+        ));
+    }
+    if let Falloff::Blend { n } = falloff
+        && !(3..=16).contains(&n)
+    {
+        return Err((
+            ".falloff.n",
+            format!("{n} is outside 3..=16 (the blend needs n > 2)"),
+        ));
+    }
+    Ok(())
+}
+
 fn resolve_stroke(
     spec: &StrokeSpec,
     mesh: &Mesh,
@@ -311,21 +362,8 @@ fn resolve_stroke(
     edge: f32,
 ) -> Result<Stroke, (String, String)> {
     let fail = |field: &str, message: String| Err((field.to_string(), message));
-    if !(spec.radius.is_finite() && spec.radius > 0.0) {
-        return fail(
-            ".radius",
-            format!("{} is not a positive length", spec.radius),
-        );
-    }
-    if spec.radius > MAX_RADIUS_OVER_EXTENT * extent {
-        return fail(
-            ".radius",
-            format!(
-                "{} is more than {MAX_RADIUS_OVER_EXTENT} times the mesh's size ({extent}): it would cover the whole mesh from anywhere on it",
-                spec.radius
-            ),
-        );
-    }
+    let brush = (spec.radius, spec.strength, spec.spacing, spec.falloff);
+    check_brush(brush, extent).map_err(|(field, message)| (field.to_string(), message))?;
     if spec.radius < MIN_RADIUS_OVER_EDGE * edge {
         return fail(
             ".radius",
@@ -333,26 +371,6 @@ fn resolve_stroke(
                 "{} is far below the mean edge length {edge}: it would touch nothing",
                 spec.radius
             ),
-        );
-    }
-    if !(0.0..=1.0).contains(&spec.strength) {
-        return fail(".strength", format!("{} is outside [0, 1]", spec.strength));
-    }
-    if !(0.01..=2.0).contains(&spec.spacing) {
-        return fail(
-            ".spacing",
-            format!(
-                "{} is outside [0.01, 2] (a share of the radius)",
-                spec.spacing
-            ),
-        );
-    }
-    if let Falloff::Blend { n } = spec.falloff
-        && !(3..=16).contains(&n)
-    {
-        return fail(
-            ".falloff.n",
-            format!("{n} is outside 3..=16 (the blend needs n > 2)"),
         );
     }
     if spec.samples.is_empty() {

@@ -200,6 +200,10 @@ pub enum PipelineError {
     Grid(#[from] GridError),
     #[error("the stroke has ended")]
     StrokeEnded,
+    /// The stroke's brush is out of bounds ([`StrokeSettings::check`](crate::brush::StrokeSettings::check)):
+    /// nothing ran.
+    #[error("{0}")]
+    InvalidBrush(String),
     /// Samples were refused: they would make the stroke more dabs than its bound. The mesh and
     /// the stroke are as they were before the call.
     #[error(transparent)]

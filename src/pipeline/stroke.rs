@@ -103,6 +103,12 @@ impl<'a> StrokeInProgress<'a> {
                 layer_count: mesh.layer_count(),
             });
         }
+        // A mesh with no vertices has no size to measure the brush by; it has no edges either,
+        // which `take_prepared` reports.
+        if let Some((lo, hi)) = mesh.bounds() {
+            let extent = (hi - lo).length().max(f32::MIN_POSITIVE);
+            stroke.check(extent).map_err(PipelineError::InvalidBrush)?;
+        }
         let (prepared, phases) = pipeline.take_prepared(mesh)?;
         let edge = pipeline.edge_length.unwrap_or(1.0);
         let mut scratch = std::mem::take(&mut pipeline.scratch);

@@ -1,5 +1,5 @@
-//! What the tests that run the `slayer` binary share: running it, scratch folders, scenes
-//! written with it, and the check of a one-line error.
+//! What the tests share: running the `slayer` binary, scratch folders, scenes written with it,
+//! the check of a one-line error, and a stroke of one brush built in code.
 
 // Each test crate uses the part it needs.
 #![allow(dead_code)]
@@ -55,5 +55,36 @@ pub fn assert_one_line_error(output: &Output, must_contain: &[&str]) {
     assert!(lines[0].starts_with("error: "), "{stderr}");
     for s in must_contain {
         assert!(lines[0].contains(s), "`{s}` missing in: {stderr}");
+    }
+}
+
+/// A stroke of `kind` at full strength on layer 0 through `samples` (full pressure), with the
+/// default falloff and spacing: what tests of one brush build in code.
+pub fn one_brush_stroke(
+    kind: slayer::brush::BrushKind,
+    radius: f32,
+    samples: &[glam::Vec3],
+) -> slayer::brush::Stroke {
+    use slayer::brush::{Brush, Falloff, Sample, Stroke};
+    Stroke {
+        brush: Brush {
+            kind,
+            radius,
+            strength: 1.0,
+            falloff: Falloff::default(),
+            invert: false,
+        },
+        paint: None,
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        samples: samples
+            .iter()
+            .map(|&position| Sample {
+                position,
+                pressure: 1.0,
+                normal: None,
+            })
+            .collect(),
     }
 }
