@@ -295,11 +295,7 @@ impl StrokeFile {
 
     /// Checks every stroke against `mesh` and resolves layer names.
     pub fn resolve(&self, mesh: &Mesh, source_name: &str) -> Result<Vec<Stroke>, StrokeError> {
-        let extent = mesh
-            .bounds()
-            .map(|(lo, hi)| (hi - lo).length())
-            .unwrap_or(0.0)
-            .max(f32::MIN_POSITIVE);
+        let extent = mesh.extent().unwrap_or(0.0).max(f32::MIN_POSITIVE);
         let edge = mesh.mean_edge_length();
         self.strokes
             .iter()

@@ -144,6 +144,11 @@ impl Mesh {
         any.then_some((lo, hi))
     }
 
+    /// The diagonal of [`Mesh::bounds`]: the mesh's size, what a brush radius is measured by.
+    pub fn extent(&self) -> Option<f32> {
+        self.bounds().map(|(lo, hi)| (hi - lo).length())
+    }
+
     /// Live faces per layer.
     pub fn faces_per_layer(&self) -> Vec<usize> {
         let mut counts = vec![0; self.layer_count()];

@@ -105,8 +105,8 @@ impl<'a> StrokeInProgress<'a> {
         }
         // A mesh with no vertices has no size to measure the brush by; it has no edges either,
         // which `take_prepared` reports.
-        if let Some((lo, hi)) = mesh.bounds() {
-            let extent = (hi - lo).length().max(f32::MIN_POSITIVE);
+        if let Some(extent) = mesh.extent() {
+            let extent = extent.max(f32::MIN_POSITIVE);
             stroke.check(extent).map_err(PipelineError::InvalidBrush)?;
         }
         let (prepared, phases) = pipeline.take_prepared(mesh)?;
