@@ -11,6 +11,7 @@
 #import shared/brush
 #import shared/pages
 #import shared/fixed
+#import shared/order_free
 #paged neighbour 1
 
 struct DeformParams {
@@ -97,17 +98,28 @@ fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
 }
 
+// The centroid of v's neighbours: their offsets from p summed order-free, as the pipeline's
+// `ring_centroid`; p itself where there are none or an offset is not finite.
 fn ring_centroid(v: u32, p: vec3<f32>) -> vec3<f32> {
     let start = neighbour_rows[2u * v];
     let end = start + neighbour_rows[2u * v + 1u];
-    if end == start {
+    var largest = 0.0;
+    for (var j = start; j < end; j++) {
+        let offset = position(neighbour(j)) - p;
+        if !order_free_finite(offset) {
+            return p;
+        }
+        largest = max(largest, order_free_largest(offset));
+    }
+    if largest < ORDER_FREE_MIN_F32 {
         return p;
     }
-    var sum = vec3<f32>(0.0);
+    let exponent = order_free_exponent(largest, end - start);
+    var sum = vec3<i32>(0);
     for (var j = start; j < end; j++) {
-        sum += position(neighbour(j));
+        sum += order_free_term(position(neighbour(j)) - p, exponent);
     }
-    return sum / f32(end - start);
+    return p + order_free_value(sum, exponent) / f32(end - start);
 }
 
 fn pinch(p: vec3<f32>) -> vec3<f32> {

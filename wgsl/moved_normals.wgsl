@@ -11,6 +11,7 @@
 #import shared/mesh
 #import shared/moves
 #import shared/pages
+#import shared/order_free
 #import shared/normals
 #paged topology 1
 

@@ -5,6 +5,7 @@
 
 #import shared/grid
 #import shared/pages
+#import shared/order_free
 #import shared/normals
 #paged topology 1
 

@@ -6,6 +6,7 @@ use glam::Vec3;
 use super::brush_frame::frame_from_sums;
 use super::shared::invocations;
 use crate::abi::{DeformParams, FrameSums, SelectedVertex};
+use crate::geom;
 
 const DRAW_RATE: f32 = 0.1;
 const PINCH_RATE: f32 = 0.25;
@@ -23,17 +24,20 @@ pub struct DeformInputs<'a> {
     pub frame_sums: &'a FrameSums,
 }
 
+/// `ring_centroid` of `wgsl/deform.wgsl`: the neighbours' offsets from `p` summed order-free,
+/// as the pipeline's `ring_centroid`.
 fn ring_centroid(inputs: &DeformInputs<'_>, v: u32, p: Vec3) -> Vec3 {
     let start = inputs.neighbour_rows[2 * v as usize];
     let end = start + inputs.neighbour_rows[2 * v as usize + 1];
     if end == start {
         return p;
     }
-    let mut sum = Vec3::ZERO;
-    for j in start..end {
-        sum += inputs.positions[inputs.neighbours[j as usize] as usize];
+    let offsets =
+        || (start..end).map(|j| inputs.positions[inputs.neighbours[j as usize] as usize] - p);
+    match geom::order_free_sum(offsets) {
+        Some(sum) => p + sum / (end - start) as f32,
+        None => p,
     }
-    sum / (end - start) as f32
 }
 
 fn pinch(params: &DeformParams, p: Vec3) -> Vec3 {

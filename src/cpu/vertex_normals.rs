@@ -1,11 +1,12 @@
 //! Mirror of `wgsl/vertex_normals.wgsl` and of `wgsl/shared/normals.wgsl`:
-//! `Mesh::recompute_normals_at` over the packed topology (faces in fan order, so the sums are
-//! the CPU's, bit for bit).
+//! `Mesh::recompute_normals_at` over the packed topology (the same order-free sums, so the normals
+//! are the CPU's, bit for bit).
 
 use glam::Vec3;
 
 use super::shared::{invocations, packed_position};
 use crate::abi::NormalParams;
+use crate::geom;
 
 /// Writes the normal of each of the first `params.count` `vertices` into `normals` (packed
 /// x, y, z per mesh vertex).
@@ -23,25 +24,24 @@ pub fn vertex_normals(
     }
 }
 
-/// `vertex_normal` of `wgsl/shared/normals.wgsl`: the normalized sum of the cross products of
-/// the faces around `v`, +Z where it vanishes or is not finite.
+/// `vertex_normal` of `wgsl/shared/normals.wgsl`: the faces around `v` each seen from `v`,
+/// summed order-free and normalized ([`geom::fan_normal`]), +Z where that fails.
 pub fn vertex_normal(positions: &[f32], topology: &[u32], vertex_rows_base: u32, v: u32) -> Vec3 {
     let row = (vertex_rows_base + 2 * v) as usize;
     let first = topology[row];
-    let mut sum = Vec3::ZERO;
-    for k in first..first + topology[row + 1] {
-        let f = topology[k as usize] as usize;
-        let a = packed_position(positions, topology[4 * f]);
-        let b = packed_position(positions, topology[4 * f + 1]);
-        let c = packed_position(positions, topology[4 * f + 2]);
-        sum += (b - a).cross(c - a);
-    }
-    let rcp = 1.0 / sum.dot(sum).sqrt();
-    if rcp.is_finite() && rcp > 0.0 {
-        sum * rcp
-    } else {
-        Vec3::Z
-    }
+    geom::fan_normal(|| {
+        (first..first + topology[row + 1]).map(move |k| {
+            let f = topology[k as usize] as usize;
+            let [a, b, c] = [topology[4 * f], topology[4 * f + 1], topology[4 * f + 2]];
+            let [p, q] = match v {
+                _ if v == a => [b, c],
+                _ if v == b => [c, a],
+                _ => [a, b],
+            };
+            let at = |i: u32| packed_position(positions, i);
+            geom::corner_cross(at(v), at(p), at(q))
+        })
+    })
 }
 
 /// Stores `n` as vertex `v`'s row of a packed x, y, z buffer.

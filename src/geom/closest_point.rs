@@ -2,7 +2,36 @@ use glam::Vec3;
 
 /// The point of triangle `abc` closest to `p`, by Voronoi regions (Ericson §5.1.5). Degenerate
 /// triangles fall through to an edge or vertex region and stay finite.
+///
+/// The corners are taken in a canonical order first ([`canonical_corners`]), so the result does
+/// not depend on the order they are given in, and a reflection in a coordinate plane through the
+/// origin reflects it exactly: a mirrored mesh's faces list their corners in reversed order, and
+/// symmetric sculpting must clamp both sides alike to the bit.
 pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let [a, b, c] = canonical_corners([a, b, c]);
+    closest_point_in_order(p, a, b, c)
+}
+
+/// The corners sorted by |x|, then |y|, then |z| (keys a reflection in x = 0, y = 0 or z = 0
+/// keeps); corners with equal keys keep their order.
+fn canonical_corners([mut a, mut b, mut c]: [Vec3; 3]) -> [Vec3; 3] {
+    let before = |p: Vec3, q: Vec3| {
+        let (p, q) = (p.abs(), q.abs());
+        (p.x, p.y, p.z) < (q.x, q.y, q.z)
+    };
+    if before(b, a) {
+        std::mem::swap(&mut a, &mut b);
+    }
+    if before(c, b) {
+        std::mem::swap(&mut b, &mut c);
+    }
+    if before(b, a) {
+        std::mem::swap(&mut a, &mut b);
+    }
+    [a, b, c]
+}
+
+fn closest_point_in_order(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;

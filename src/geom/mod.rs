@@ -3,11 +3,13 @@
 //! triangle–triangle intersection test on Shewchuk's adaptive predicates.
 
 mod closest_point;
+mod order_free;
 mod ray;
 mod separation;
 mod tri_tri;
 
 pub use closest_point::{closest_point_on_triangle, point_triangle_distance_squared};
+pub use order_free::{corner_cross, fan_normal, order_free_sum};
 pub use ray::{Ray, ray_triangle};
 pub use separation::surely_disjoint;
 pub use tri_tri::{neighbours_overlap, triangles_intersect};

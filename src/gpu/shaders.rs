@@ -22,6 +22,10 @@ pub const SHARED: &[(&str, &str)] = &[
         include_str!("../../wgsl/shared/normals.wgsl"),
     ),
     (
+        "shared/order_free",
+        include_str!("../../wgsl/shared/order_free.wgsl"),
+    ),
+    (
         "shared/overlay",
         include_str!("../../wgsl/shared/overlay.wgsl"),
     ),

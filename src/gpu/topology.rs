@@ -7,8 +7,8 @@
 //! Layout, with room for `face_capacity` faces and `vertex_capacity` vertices: face `f` is words
 //! `4f..4f + 4` = (a, b, c, layer), dead faces included so that face ids index directly. From
 //! `vertex_rows_base` on, per vertex its row's absolute start and length (`super::rows`), then
-//! the rows: each vertex's faces in fan order ([`Mesh::faces_around`]), so that normals sum in
-//! the order the CPU's do; dead and isolated vertices have empty rows.
+//! the rows: each vertex's faces in fan order ([`Mesh::faces_around`]; normals are summed
+//! order-free, `shared/order_free.wgsl`); dead and isolated vertices have empty rows.
 
 use super::reusable::Patches;
 use super::rows::SlottedRows;

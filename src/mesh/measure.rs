@@ -4,6 +4,8 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::geom;
+
 use super::{INVALID, Mesh, face_of, next, prev};
 
 /// Length statistics over the unique edges of the live faces.
@@ -109,18 +111,26 @@ impl Mesh {
         }
     }
 
-    /// Sum of the incident faces' cross products, normalized; +Z where that sum vanishes
-    /// (a vertex of only degenerate faces) so that normals are always finite.
+    /// The incident faces' cross products, each seen from the vertex, summed in an order-free
+    /// way ([`geom::fan_normal`]: a mirrored mesh gets mirrored normals to the bit) and
+    /// normalized; +Z where that sum vanishes (a vertex of only degenerate faces) so that
+    /// normals are always finite.
     fn area_weighted_normal(&self, vertex: u32) -> Vec3 {
         if self.adjacency.vertex_corner[vertex as usize] == INVALID {
             return Vec3::Z;
         }
-        let mut sum = Vec3::ZERO;
-        for face in self.faces_around(vertex) {
-            let [a, b, c] = self.face_positions(face as usize);
-            sum += (b - a).cross(c - a);
-        }
-        sum.try_normalize().unwrap_or(Vec3::Z)
+        geom::fan_normal(|| {
+            self.faces_around(vertex).map(move |face| {
+                let [a, b, c] = self.faces[face as usize];
+                let [p, q] = match vertex {
+                    v if v == a => [b, c],
+                    v if v == b => [c, a],
+                    _ => [a, b],
+                };
+                let at = |i: u32| self.positions[i as usize];
+                geom::corner_cross(at(vertex), at(p), at(q))
+            })
+        })
     }
 
     /// Unit normal of a face (zero for a degenerate one).

@@ -12,6 +12,7 @@ use crate::abi::{SelectedVertex, frame_params};
 use crate::brush::{Dab, DabFrame, Paint, displacement, paint_share};
 use crate::collide::StrokeState;
 use crate::cpu;
+use crate::geom;
 use crate::mesh::{Brdf, INVALID, Mesh, VertexFlags, partial_mask_factor};
 
 /// The brush frame of `probe` (its centre, radius and motion) over `selection`: the falloff-
@@ -158,24 +159,26 @@ pub fn selectable(state: &StrokeState<'_>, mesh: &Mesh, v: u32) -> bool {
 }
 
 /// Centroid of a vertex's one-ring; on a boundary, of its two boundary neighbours, so open
-/// sheets do not shrink from their rims.
+/// sheets do not shrink from their rims. The offsets from the vertex are summed order-free
+/// ([`geom::order_free_sum`]), so a mirrored ring gets the mirrored centroid to the bit.
 fn ring_centroid(mesh: &Mesh, v: u32) -> Vec3 {
     let positions = mesh.positions();
-    if mesh.is_boundary_vertex(v) {
+    let p = positions[v as usize];
+    let sum = if mesh.is_boundary_vertex(v) {
         let ring = mesh.neighbours(v);
-        let (first, last) = (ring[0], ring[ring.len() - 1]);
-        return 0.5 * (positions[first as usize] + positions[last as usize]);
-    }
-    let mut sum = Vec3::ZERO;
-    let mut count = 0.0;
-    for c in mesh.adjacency().corners_around(v) {
-        sum += positions[mesh.corner_vertex(crate::mesh::next(c)) as usize];
-        count += 1.0;
-    }
-    if count > 0.0 {
-        sum / count
+        let ends = [ring[0], ring[ring.len() - 1]];
+        geom::order_free_sum(|| ends.iter().map(|&u| positions[u as usize] - p)).map(|s| (s, 2))
     } else {
-        positions[v as usize]
+        let ring = || {
+            mesh.adjacency()
+                .corners_around(v)
+                .map(|c| positions[mesh.corner_vertex(crate::mesh::next(c)) as usize] - p)
+        };
+        geom::order_free_sum(ring).map(|s| (s, ring().count()))
+    };
+    match sum {
+        Some((sum, count)) if count > 0 => p + sum / count as f32,
+        _ => p,
     }
 }
 

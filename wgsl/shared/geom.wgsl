@@ -5,13 +5,45 @@
 // Smallest normal f32 (`f32::MIN_POSITIVE`).
 const MIN_POSITIVE_F32: f32 = 1.17549435e-38;
 
-// The point of triangle abc closest to p (Ericson §5.1.5). Degenerate triangles fall through
-// to an edge or vertex region and stay finite.
+// Whether corner p comes before q in the canonical order: by |x|, then |y|, then |z| (keys a
+// reflection in x = 0, y = 0 or z = 0 keeps), as `canonical_corners` in
+// src/geom/closest_point.rs.
+fn corner_before(p: vec3<f32>, q: vec3<f32>) -> bool {
+    let s = abs(p);
+    let t = abs(q);
+    return s.x < t.x || (s.x == t.x && (s.y < t.y || (s.y == t.y && s.z < t.z)));
+}
+
+// The point of triangle abc closest to p (Ericson §5.1.5), its corners taken in the canonical
+// order first, so that a mirrored face gets the mirrored point to the bit. Degenerate triangles
+// fall through to an edge or vertex region and stay finite.
+fn closest_point_on_triangle(p: vec3<f32>, a_in: vec3<f32>, b_in: vec3<f32>, c_in: vec3<f32>) -> vec3<f32> {
+    var a = a_in;
+    var b = b_in;
+    var c = c_in;
+    if corner_before(b, a) {
+        let t = a;
+        a = b;
+        b = t;
+    }
+    if corner_before(c, b) {
+        let t = b;
+        b = c;
+        c = t;
+    }
+    if corner_before(b, a) {
+        let t = a;
+        a = b;
+        b = t;
+    }
+    return closest_point_in_order(p, a, b, c);
+}
+
 //
 // One exit, the regions as an else-if chain: Mesa 22.3's lavapipe miscompiled early returns
 // from this function once it was inlined into the proximity kernel's loops (later faces were
 // skipped). Every quantity is the same expression as on the CPU, so results are unchanged.
-fn closest_point_on_triangle(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+fn closest_point_in_order(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;
