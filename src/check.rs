@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::collide::find_intersections;
+use crate::collide::{find_intersections, smallest_layer_gap};
 use crate::grid::SpatialHash;
 use crate::io::LoadNotes;
 use crate::mesh::{ClosedComponent, Mesh};
@@ -12,6 +12,9 @@ use crate::remesh::MIN_CLOSED_FACES;
 /// is a defect. Remeshing changes one by at most `remesh::VOLUME_TOLERANCE` (2 %) a pass, so a
 /// remesh or two stay below; the shapes issue 22 found destroyed had lost 7 % to 99 %.
 pub const VOLUME_CHANGE_DEFECT: f64 = 0.05;
+
+/// How far, in mean edges, `check` looks for the smallest gap between layers.
+pub const GAP_REACH_EDGES: f64 = 3.0;
 
 /// Figures and defects of one mesh. Field names are part of the `--json` interface.
 #[derive(Debug, Clone, Serialize)]
@@ -34,7 +37,12 @@ pub struct CheckReport {
     pub intersections: usize,
     pub intersections_between_layers: usize,
     pub intersections_within_layers: usize,
+    /// Faces folded onto a neighbour they share a vertex or an edge with (in `intersections`).
+    pub folded_neighbours: usize,
     pub intersection_examples: Vec<[u32; 2]>,
+    /// The smallest distance from a vertex to another layer's faces, where one is within
+    /// [`GAP_REACH_EDGES`] mean edges (the engine keeps it at least the collision distance).
+    pub smallest_layer_gap: Option<f64>,
     /// Closed components (no boundary edge) and the face count of the smallest.
     pub closed_components: usize,
     pub smallest_closed_faces: Option<usize>,
@@ -172,6 +180,11 @@ pub fn check_mesh(
         .flatten();
     progress("testing triangle pairs for intersections");
     let intersections = find_intersections(mesh);
+    let reach = (GAP_REACH_EDGES * stats.mean) as f32;
+    let smallest_layer_gap = smallest_layer_gap(mesh, reach)
+        .ok()
+        .flatten()
+        .map(f64::from);
     let closed = mesh.closed_components();
     let smallest_closed_faces = closed.iter().map(|c| c.faces).min();
 
@@ -194,10 +207,11 @@ pub fn check_mesh(
     }
     if intersections.total() > 0 {
         defects.push(format!(
-            "{} intersecting triangle pairs ({} between layers, {} within a layer), e.g. faces {:?}",
+            "{} intersecting triangle pairs ({} between layers, {} within a layer, {} folded onto a neighbour), e.g. faces {:?}",
             intersections.total(),
             intersections.between_layers,
             intersections.within_layers,
+            intersections.folded_neighbours,
             intersections
                 .examples
                 .iter()
@@ -233,11 +247,13 @@ pub fn check_mesh(
         intersections: intersections.total(),
         intersections_between_layers: intersections.between_layers,
         intersections_within_layers: intersections.within_layers,
+        folded_neighbours: intersections.folded_neighbours,
         intersection_examples: intersections
             .examples
             .iter()
             .map(|p| [p.face_a, p.face_b])
             .collect(),
+        smallest_layer_gap,
         closed_components: closed.len(),
         smallest_closed_faces,
         volume_changes: None,
@@ -277,9 +293,24 @@ impl std::fmt::Display for CheckReport {
         writeln!(f, "  non-finite        {}", self.non_finite)?;
         writeln!(
             f,
-            "  intersections     {}  ({} between layers, {} within a layer)",
-            self.intersections, self.intersections_between_layers, self.intersections_within_layers
+            "  intersections     {}  ({} between layers, {} within a layer, {} folded onto a neighbour)",
+            self.intersections,
+            self.intersections_between_layers,
+            self.intersections_within_layers,
+            self.folded_neighbours
         )?;
+        match self.smallest_layer_gap {
+            Some(gap) => writeln!(
+                f,
+                "  layer gap         {gap:.6}  ({:.2} mean edges), the smallest vertex-to-other-layer distance",
+                gap / self.mean_edge_length
+            )?,
+            None if self.layers > 1 => writeln!(
+                f,
+                "  layer gap         no layer within {GAP_REACH_EDGES} mean edges of another"
+            )?,
+            None => {}
+        }
         if let Some(smallest) = self.smallest_closed_faces {
             writeln!(
                 f,

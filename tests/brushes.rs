@@ -216,6 +216,105 @@ fn crease_cuts_a_groove() {
     assert!(mesh.positions()[CENTER_VERTEX].z < -0.2);
 }
 
+/// What one dab of strength `s`, pressure 1 and falloff weight `w` does to a vertex at `p`
+/// (normal `n`, one-ring centroid `ring`), brushed at `center` with radius `r`, brush normal +z
+/// and flatten's plane through `plane`: the formulas of `docs/strokes.md`, written here apart
+/// from `brush::field`.
+fn documented_move(
+    kind: BrushKind,
+    (s, w, r): (f32, f32, f32),
+    p: Vec3,
+    n: Vec3,
+    ring: Vec3,
+    (center, plane): (Vec3, Vec3),
+) -> Vec3 {
+    let amount = s * w;
+    let towards_axis = (center - p) * Vec3::new(1.0, 1.0, 0.0);
+    match kind {
+        BrushKind::Draw => Vec3::Z * (0.1 * r * amount),
+        BrushKind::Inflate => n * (0.1 * r * amount),
+        BrushKind::Smooth => (ring - p) * amount.min(1.0),
+        BrushKind::Flatten => -Vec3::Z * ((p.z - plane.z) * amount.min(1.0)),
+        BrushKind::Pinch => towards_axis * (0.25 * amount),
+        BrushKind::Crease => -Vec3::Z * (0.1 * r * amount) + towards_axis * (0.25 * amount),
+        BrushKind::Twist => {
+            let turn = glam::Quat::from_rotation_z(0.5 * amount);
+            center + turn * (p - center) - p
+        }
+        _ => unreachable!("{kind:?} is not profiled"),
+    }
+}
+
+/// Every brush that moves vertices by a formula, one dab at radii of 3, 5 and 8 edges: each
+/// vertex moves by the documented amount (not only in the documented direction).
+#[test]
+fn one_dab_moves_each_vertex_by_the_documented_amount() {
+    let kinds = [
+        BrushKind::Draw,
+        BrushKind::Inflate,
+        BrushKind::Smooth,
+        BrushKind::Flatten,
+        BrushKind::Pinch,
+        BrushKind::Crease,
+        BrushKind::Twist,
+    ];
+    for kind in kinds {
+        for r in [3.0f32, 5.0, 8.0] {
+            let start = if matches!(
+                kind,
+                BrushKind::Smooth | BrushKind::Flatten | BrushKind::Inflate
+            ) {
+                bumpy()
+            } else {
+                sheet()
+            };
+            let mut mesh = start.clone();
+            let mut s = stroke(kind, false, &[CENTER]);
+            s.brush.radius = r;
+            apply(&mut mesh, &s);
+            let strength = s.brush.strength;
+            let weight = |p: Vec3| Falloff::Smooth.weight(p.distance(CENTER) / r);
+            // Flatten's plane: through the weighted centroid of the vertices under the brush.
+            let (sum, total) =
+                start
+                    .positions()
+                    .iter()
+                    .fold((glam::DVec3::ZERO, 0.0f64), |(a, t), &p| {
+                        let w = weight(p) as f64;
+                        (a + p.as_dvec3() * w, t + w)
+                    });
+            let plane = (sum / total).as_vec3();
+            let mut worst = 0.0f32;
+            let mut moved = 0;
+            for v in 0..start.vertex_count() {
+                let p = start.positions()[v];
+                let ring = start.neighbours(v as u32);
+                let centroid = ring
+                    .iter()
+                    .map(|&u| start.positions()[u as usize])
+                    .sum::<Vec3>()
+                    / ring.len() as f32;
+                let expected = documented_move(
+                    kind,
+                    (strength, weight(p), r),
+                    p,
+                    start.normals()[v],
+                    centroid,
+                    (CENTER, plane),
+                );
+                let actual = mesh.positions()[v] - p;
+                worst = worst.max((actual - expected).length());
+                moved += usize::from(actual.length() > 1e-4);
+            }
+            assert!(moved > 10, "{kind:?} at radius {r}: {moved} vertices moved");
+            assert!(
+                worst <= 1e-4 * r,
+                "{kind:?} at radius {r}: {worst:e} off the formula"
+            );
+        }
+    }
+}
+
 fn parse(text: &str) -> Result<Vec<Stroke>, String> {
     let mesh = shapes::stacked_sheets(2, 4, 4, 1.0, 2.0);
     StrokeFile::parse(text, "s.json")

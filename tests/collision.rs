@@ -2,6 +2,8 @@
 //! layers into lower ones, then an exact triangle–triangle test over the whole mesh. Also: the
 //! grid backend against the brute-force reference, and the derived neighbourhood ring.
 
+mod common;
+
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -369,4 +371,31 @@ fn a_fold_within_one_layer_still_collides() {
         .unwrap();
     assert!(report.clamped > 0, "the fold collided with itself");
     assert_sound(&mesh, "fold");
+}
+
+/// Two edges crossing where no vertex comes within the collision distance of the other face:
+/// the proximity clamp sees nothing, and the exact backstop must undo the step that crosses.
+#[test]
+fn the_backstop_undoes_a_crossing_the_clamp_cannot_see() {
+    let (mut mesh, stroke) = common::crossing_edges(1.0);
+    let settings = PipelineSettings {
+        collision_distance: 0.25,
+        ..sculpt_only()
+    };
+    let start = mesh.clone();
+    let report = Pipeline::new(settings)
+        .apply_stroke(&mut mesh, &stroke)
+        .unwrap();
+    assert_eq!(report.clamped, 0, "the clamp saw it: {report:?}");
+    assert!(report.reverted > 0, "nothing was undone: {report:?}");
+    assert_ne!(mesh.positions(), start.positions(), "the blade moved");
+    assert_eq!(find_intersections(&mesh).total(), 0);
+    // The case does cross when nothing stops it: the blade's lower edge moved down as far.
+    let mut free = start.clone();
+    free.positions_mut()[0].z -= 0.5;
+    free.positions_mut()[1].z -= 0.5;
+    assert!(
+        find_intersections(&free).total() > 0,
+        "the hand-built case crosses"
+    );
 }

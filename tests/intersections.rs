@@ -4,7 +4,7 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use slayer::collide::find_intersections;
-use slayer::geom::triangles_intersect;
+use slayer::geom::{neighbours_overlap, triangles_intersect};
 use slayer::mesh::Mesh;
 use slayer::scene::shapes;
 
@@ -98,15 +98,16 @@ fn nearly_touching_is_decided_exactly() {
     assert!(triangles_intersect(base, touching));
 }
 
-fn brute_force(mesh: &Mesh) -> (usize, usize) {
-    let (mut between, mut within) = (0, 0);
+/// Every pair of faces: (between layers, within a layer, folded onto a neighbour).
+fn brute_force(mesh: &Mesh) -> (usize, usize, usize) {
+    let (mut between, mut within, mut folded) = (0, 0, 0);
     for a in 0..mesh.face_count() {
         for b in a + 1..mesh.face_count() {
             let (fa, fb) = (mesh.faces()[a], mesh.faces()[b]);
+            let (ta, tb) = (mesh.face_positions(a), mesh.face_positions(b));
             if fa.iter().any(|v| fb.contains(v)) {
-                continue;
-            }
-            if triangles_intersect(mesh.face_positions(a), mesh.face_positions(b)) {
+                folded += usize::from(neighbours_overlap(ta, fa, tb, fb));
+            } else if triangles_intersect(ta, tb) {
                 if mesh.face_layers()[a] == mesh.face_layers()[b] {
                     within += 1;
                 } else {
@@ -115,7 +116,16 @@ fn brute_force(mesh: &Mesh) -> (usize, usize) {
             }
         }
     }
-    (between, within)
+    (between, within, folded)
+}
+
+fn counts(mesh: &Mesh) -> (usize, usize, usize) {
+    let report = find_intersections(mesh);
+    (
+        report.between_layers,
+        report.within_layers,
+        report.folded_neighbours,
+    )
 }
 
 proptest! {
@@ -132,8 +142,7 @@ proptest! {
         for (v, dz) in bumps {
             mesh.positions_mut()[v % n].z += dz;
         }
-        let report = find_intersections(&mesh);
-        prop_assert_eq!((report.between_layers, report.within_layers), brute_force(&mesh));
+        prop_assert_eq!(counts(&mesh), brute_force(&mesh));
     }
 }
 
@@ -149,14 +158,11 @@ fn a_layer_pushed_through_another_is_counted() {
         report.between_layers > 0 && report.within_layers == 0,
         "{report:?}"
     );
-    assert_eq!(
-        (report.between_layers, report.within_layers),
-        brute_force(&mesh)
-    );
+    assert_eq!(counts(&mesh), brute_force(&mesh));
 }
 
 #[test]
-fn self_intersection_within_a_layer_is_counted_but_neighbours_are_not() {
+fn self_intersection_within_a_layer_is_counted_but_neighbours_touching_are_not() {
     // A sheet folded through itself: lift one corner vertex across a far part of the sheet.
     let mut mesh = shapes::stacked_sheets(1, 6, 6, 1.0, 0.0);
     assert_eq!(
@@ -167,10 +173,7 @@ fn self_intersection_within_a_layer_is_counted_but_neighbours_are_not() {
     mesh.positions_mut()[0] = Vec3::new(3.2, 3.3, 0.0) + Vec3::new(0.0, 0.0, 0.0);
     let report = find_intersections(&mesh);
     assert!(report.within_layers > 0);
-    assert_eq!(
-        (report.between_layers, report.within_layers),
-        brute_force(&mesh)
-    );
+    assert_eq!(counts(&mesh), brute_force(&mesh));
 }
 
 #[test]
@@ -178,11 +181,54 @@ fn absurd_coordinates_stay_bounded() {
     // A face spanning a huge box goes to the oversized path instead of millions of cells.
     let mut mesh = shapes::stacked_sheets(2, 4, 4, 1.0, 2.0);
     mesh.positions_mut()[0] = Vec3::new(1e12, -1e12, 5e11);
-    let report = find_intersections(&mesh);
-    assert_eq!(
-        (report.between_layers, report.within_layers),
-        brute_force(&mesh)
-    );
+    assert_eq!(counts(&mesh), brute_force(&mesh));
     mesh.positions_mut()[1] = Vec3::new(f32::NAN, 0.0, 0.0);
     assert!(find_intersections(&mesh).skipped_faces > 0);
+}
+
+/// A face folded flat onto the faces around it shares vertices with them, which the pair test
+/// skips: the neighbour test counts it, and `check` reports it.
+#[test]
+fn a_face_folded_onto_its_neighbours_is_counted() {
+    let mut mesh = shapes::stacked_sheets(1, 4, 4, 1.0, 0.0);
+    assert_eq!(counts(&mesh), (0, 0, 0));
+    // The corner vertex pulled across its own fan, in the sheet's plane: its faces now lie on
+    // their neighbours.
+    mesh.positions_mut()[0] = Vec3::new(1.5, 1.5, 0.0);
+    let (_, _, folded) = counts(&mesh);
+    assert!(folded > 0, "{:?}", find_intersections(&mesh));
+    assert_eq!(counts(&mesh), brute_force(&mesh));
+    assert_eq!(
+        find_intersections(&mesh).total(),
+        counts(&mesh).0 + counts(&mesh).1 + folded
+    );
+    let notes = slayer::io::LoadNotes::default();
+    let report = slayer::check::check_mesh(&mesh, &notes, "folded", |_| {});
+    assert_eq!(report.folded_neighbours, folded);
+    assert!(
+        report
+            .defects
+            .iter()
+            .any(|d| d.contains("folded onto a neighbour")),
+        "{:?}",
+        report.defects
+    );
+}
+
+/// Two flat sheets 0.2 apart: the smallest gap between layers is that, and none is found
+/// within a shorter reach.
+#[test]
+fn the_smallest_layer_gap_is_measured() {
+    let sheets = shapes::stacked_sheets(2, 6, 6, 0.1, 0.2);
+    let gap = slayer::collide::smallest_layer_gap(&sheets, 0.3).unwrap();
+    assert!(gap.is_some_and(|g| (g - 0.2).abs() < 1e-6), "{gap:?}");
+    assert_eq!(
+        slayer::collide::smallest_layer_gap(&sheets, 0.1).unwrap(),
+        None
+    );
+    let one = shapes::stacked_sheets(1, 6, 6, 0.1, 0.2);
+    assert_eq!(
+        slayer::collide::smallest_layer_gap(&one, 0.3).unwrap(),
+        None
+    );
 }

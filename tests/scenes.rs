@@ -1,8 +1,7 @@
 //! Generated scenes: size within ±5 %, near-uniform edges, layers a few edge lengths apart,
 //! disconnected patches in upper layers, no intersections, and byte-identical output per seed.
 
-use slayer::collide::find_intersections;
-use slayer::grid::SpatialHash;
+use slayer::collide::{find_intersections, smallest_layer_gap};
 use slayer::io::{Format, encode_mesh};
 use slayer::mesh::Mesh;
 use slayer::scene::{SceneKind, SceneSpec, generate};
@@ -14,32 +13,6 @@ fn scene(kind: SceneKind, triangles: usize, seed: u64) -> Mesh {
         seed,
     })
     .unwrap_or_else(|e| panic!("{kind}: {e}"))
-}
-
-/// Smallest distance from a vertex of one layer to a face of another, through the grid.
-fn min_layer_gap(mesh: &Mesh, search: f32) -> f32 {
-    let stats = mesh.edge_length_stats();
-    let grid = SpatialHash::build(mesh, stats.mean as f32).unwrap();
-    let csr = mesh.vertex_faces();
-    let mut gap = f32::INFINITY;
-    for (v, p) in mesh.positions().iter().enumerate() {
-        let layer = mesh.vertex_layers()[v];
-        for f in grid.faces_within(
-            mesh.positions(),
-            mesh.faces(),
-            &csr,
-            *p,
-            search,
-            stats.max as f32,
-        ) {
-            if mesh.face_layers()[f as usize] != layer {
-                let [a, b, c] = mesh.face_positions(f as usize);
-                let d = slayer::geom::point_triangle_distance_squared(*p, a, b, c).sqrt();
-                gap = gap.min(d);
-            }
-        }
-    }
-    gap
 }
 
 #[test]
@@ -86,7 +59,9 @@ fn layered_scenes_are_clean_uniform_and_separated() {
         );
         // Layers float a few edge lengths apart: at least two everywhere.
         let l = stats.mean as f32;
-        let gap = min_layer_gap(&mesh, 4.0 * l);
+        let gap = smallest_layer_gap(&mesh, 4.0 * l)
+            .unwrap()
+            .unwrap_or(f32::INFINITY);
         assert!(
             gap >= 2.0 * l,
             "{kind}: layers only {} edge lengths apart",

@@ -4,7 +4,9 @@
 //! two edge lengths, so a face touches a handful); faces sharing a cell are paired, and a pair is
 //! counted only in the cell holding the lowest corner of the two boxes' overlap, so each pair is
 //! tested once. Narrow phase: [`triangles_intersect`] on exact predicates. Pairs that share a
-//! vertex are a face's own neighbourhood and never count. Faces of different layers that meet
+//! vertex touch there by construction: they count, apart, only where they meet beyond what they
+//! share ([`neighbours_overlap`]: a face folded onto its neighbour, which twist, pinch, crease
+//! and flips can make and the pair test alone cannot see). Faces of different layers that meet
 //! only at vertex positions they share (a surface split into OBJ groups, welded by position
 //! along the seam) are not crossing either: they count only where they meet beyond those
 //! points ([`neighbours_overlap`]).
@@ -34,6 +36,9 @@ pub struct IntersectionReport {
     pub between_layers: usize,
     /// Intersecting pairs on the same layer that share no vertex (self-intersections).
     pub within_layers: usize,
+    /// Pairs that share a vertex or an edge and overlap beyond it: a face folded onto its
+    /// neighbour.
+    pub folded_neighbours: usize,
     /// A few pairs, lowest face indices first, to point a user at the problem.
     pub examples: Vec<IntersectingPair>,
     /// Faces left out because a vertex is not finite.
@@ -42,12 +47,12 @@ pub struct IntersectionReport {
 
 impl IntersectionReport {
     pub fn total(&self) -> usize {
-        self.between_layers + self.within_layers
+        self.between_layers + self.within_layers + self.folded_neighbours
     }
 }
 
-/// Finds every pair of live faces that intersect (closed triangles, so touching counts), skipping
-/// pairs that share a vertex.
+/// Finds every pair of live faces that intersect (closed triangles, so touching counts); pairs
+/// that share a vertex count only where they overlap beyond it.
 pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
     let faces = mesh.faces();
     let positions = mesh.positions();
@@ -125,13 +130,13 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
     };
     let layers = mesh.face_layers();
     let test = |a: u32, b: u32| -> bool {
-        if shares_vertex(a, b) {
-            return false;
-        }
         let (ta, tb) = (
             mesh.face_positions(a as usize),
             mesh.face_positions(b as usize),
         );
+        if shares_vertex(a, b) {
+            return neighbours_overlap(ta, faces[a as usize], tb, faces[b as usize]);
+        }
         if layers[a as usize] != layers[b as usize] {
             return seam_pair_intersects(ta, faces[a as usize], tb, faces[b as usize]);
         }
@@ -193,13 +198,19 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
     }
 
     pairs.par_sort_unstable();
+    let folded_neighbours = pairs
+        .iter()
+        .filter(|p| shares_vertex(p.face_a, p.face_b))
+        .count();
     let between_layers = pairs
         .iter()
+        .filter(|p| !shares_vertex(p.face_a, p.face_b))
         .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
         .count();
     IntersectionReport {
         between_layers,
-        within_layers: pairs.len() - between_layers,
+        within_layers: pairs.len() - between_layers - folded_neighbours,
+        folded_neighbours,
         examples: pairs.iter().take(8).copied().collect(),
         skipped_faces,
     }

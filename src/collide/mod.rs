@@ -8,6 +8,7 @@
 //! the GPU, which both build on it.
 
 mod backstop;
+mod gap;
 mod intersections;
 mod local_grid;
 pub mod neighbourhood;
@@ -17,6 +18,7 @@ mod stamps;
 mod state;
 
 pub use backstop::Backstop;
+pub use gap::smallest_layer_gap;
 pub use intersections::{IntersectingPair, IntersectionReport, find_intersections};
 pub use local_grid::LocalFaceGrid;
 pub use region::{Region, Scratch, StepMoves};

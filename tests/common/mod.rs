@@ -88,3 +88,36 @@ pub fn one_brush_stroke(
             .collect(),
     }
 }
+
+/// Two triangles on edge whose edges cross where no vertex comes near the other's face: the
+/// case vertex–triangle proximity cannot see, left to the exact backstop. Layer 0 stands
+/// upright in the plane x = 0 with its lower edge along y at height `0.3·h`; layer 1 stands in
+/// the plane y = 0 with its upper edge along x at height 0. Returns the mesh and a grab (layer
+/// 0, radius 2.5·h) that drags layer 0 down by 0.8·h: its lower edge would pass through layer
+/// 1's upper edge while every vertex stays more than 0.5·h from the other triangle.
+pub fn crossing_edges(h: f32) -> (slayer::mesh::Mesh, slayer::brush::Stroke) {
+    use glam::Vec3;
+    let z = 0.3 * h;
+    let positions = vec![
+        Vec3::new(0.0, -h, z),
+        Vec3::new(0.0, h, z),
+        Vec3::new(0.0, 0.0, z + h),
+        Vec3::new(-h, 0.0, 0.0),
+        Vec3::new(h, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -h),
+    ];
+    let mesh = slayer::mesh::Mesh::new(
+        positions,
+        vec![[0, 1, 2], [3, 4, 5]],
+        vec![0, 1],
+        vec!["blade".into(), "wall".into()],
+    )
+    .expect("two triangles");
+    let grab_at = Vec3::new(0.0, 0.0, z + 0.5 * h);
+    let stroke = one_brush_stroke(
+        slayer::brush::BrushKind::Grab,
+        2.5 * h,
+        &[grab_at, grab_at - Vec3::Z * (0.8 * h)],
+    );
+    (mesh, stroke)
+}
