@@ -180,6 +180,24 @@ fn demo_writes_and_checks_the_default_material() {
     let stdout = text(&out.stdout);
     assert!(stdout.contains("sLayer paper, Table 1"), "{stdout}");
     assert!(stdout.contains("ok: no defects"), "{stdout}");
+    // What it wrote: a sculpted mesh unlike the generated one, sound, the OBJ the same mesh,
+    // and pictures with something in them.
+    let before = slayer::io::read_mesh(&dir.join("plaster.ply")).unwrap();
+    let after = slayer::io::read_mesh(&dir.join("plaster-sculpted.ply")).unwrap();
+    assert_ne!(before.digest(), after.digest(), "the demo sculpted nothing");
+    after.validate().unwrap();
+    assert_eq!(slayer::collide::find_intersections(&after).total(), 0);
+    let obj = slayer::io::read_mesh(&dir.join("plaster-sculpted.obj")).unwrap();
+    assert_eq!(obj.live_face_count(), after.live_face_count());
+    for png in ["plaster-before.png", "plaster-after.png"] {
+        let image = image::open(dir.join(png)).unwrap().to_rgba8();
+        let first = image.get_pixel(0, 0);
+        let differing = image.pixels().filter(|p| *p != first).count();
+        assert!(
+            differing * 4 > image.pixels().len(),
+            "{png}: {differing} pixels differ from the corner's"
+        );
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -217,6 +235,16 @@ fn strokes_then_sculpt_round_trip_with_stats() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let check = slayer(&["check", arg(&output), "--json"]);
     assert!(check.status.success(), "{}", text(&check.stdout));
+    let digest = |out: &Output| -> String {
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        report["digest"].as_str().unwrap().to_string()
+    };
+    let input_check = slayer(&["check", arg(&input), "--json"]);
+    assert_ne!(
+        digest(&check),
+        digest(&input_check),
+        "the sculpt changed nothing"
+    );
     let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(stats["strokes"].as_array().unwrap().len(), 3);
     assert!(
@@ -506,6 +534,10 @@ fn bench_on_both_backends_writes_parity() {
         .expect("same topology");
     assert!(edges <= 1e-4, "{edges}");
     assert_eq!(parity["collision_count_cpu"], parity["collision_count_gpu"]);
+    assert!(
+        parity["collision_count_cpu"].as_u64().unwrap() > 0,
+        "the strokes never collided: {parity}"
+    );
     for field in ["max_position_deviation", "gpu_over_cpu"] {
         assert!(parity.get(field).is_some(), "missing parity.{field}");
     }
@@ -544,5 +576,73 @@ fn bench_on_both_backends_writes_parity() {
         .unwrap_or_default()
         .to_string();
     assert!(first.contains("unknown backend `quantum`"), "{first}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--backend` and `--remesh` from the command line: the GPU's kernels (lavapipe here) give the
+/// CPU's result, remeshing after every sample changes the topology where `off` keeps it, and
+/// `adapters` names the adapter the GPU runs used.
+#[test]
+fn sculpt_backends_and_remesh_modes_from_the_command_line() {
+    let dir = scratch("sculpt-modes");
+    let (input, strokes) = (dir.join("in.ply"), dir.join("s.json"));
+    write_scene("plaster", 3000, &[], &input);
+    let out = slayer(&[
+        "strokes",
+        "--scene",
+        "plaster",
+        "--triangles",
+        "3000",
+        "--count",
+        "2",
+        "-o",
+        arg(&strokes),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let sculpt = |backend: &str, remesh: &str| {
+        let output = dir.join(format!("{backend}-{remesh}.ply"));
+        let out = slayer_headless(&[
+            "sculpt",
+            "--input",
+            arg(&input),
+            "--strokes",
+            arg(&strokes),
+            "--output",
+            arg(&output),
+            "--backend",
+            backend,
+            "--remesh",
+            remesh,
+        ]);
+        assert!(
+            out.status.success(),
+            "{backend} {remesh}: {}",
+            text(&out.stderr)
+        );
+        slayer::io::read_mesh(&output).unwrap()
+    };
+    let start = slayer::io::read_mesh(&input).unwrap();
+    let (cpu, gpu) = (sculpt("cpu", "off"), sculpt("gpu", "off"));
+    assert_ne!(cpu.digest(), start.digest(), "the strokes changed nothing");
+    assert_eq!(cpu.faces(), start.faces(), "remeshing off keeps the faces");
+    let deviation = cpu
+        .positions()
+        .iter()
+        .zip(gpu.positions())
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max);
+    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
+    let remeshed = sculpt("cpu", "sample");
+    assert_ne!(
+        remeshed.faces(),
+        start.faces(),
+        "remeshing per sample edits the faces"
+    );
+    remeshed.validate().unwrap();
+    assert_eq!(slayer::collide::find_intersections(&remeshed).total(), 0);
+    let adapters = slayer_headless(&["adapters", "--json"]);
+    assert!(adapters.status.success(), "{}", text(&adapters.stderr));
+    let listed: serde_json::Value = serde_json::from_slice(&adapters.stdout).unwrap();
+    assert!(listed.as_array().is_some_and(|a| !a.is_empty()), "{listed}");
     std::fs::remove_dir_all(dir).unwrap();
 }
