@@ -166,17 +166,7 @@ pub fn check_mesh(
         .max(mesh.positions().iter().filter(|p| !p.is_finite()).count());
     progress("building the spatial hash");
     let grid = (non_finite == 0)
-        .then(|| {
-            let started = std::time::Instant::now();
-            let grid = SpatialHash::build(mesh, stats.mean as f32).ok()?;
-            Some(GridFigures {
-                cell_size: grid.cell_size() as f64,
-                occupied_cells: grid.occupied_cells(),
-                max_vertices_per_cell: grid.max_cell_occupancy(),
-                build_ms: started.elapsed().as_secs_f64() * 1e3,
-                memory_bytes: grid.memory_bytes(),
-            })
-        })
+        .then(|| grid_figures(mesh, stats.mean as f32))
         .flatten();
     progress("testing triangle pairs for intersections");
     let intersections = find_intersections(mesh);
@@ -189,45 +179,15 @@ pub fn check_mesh(
     let smallest_closed_faces = closed.iter().map(|c| c.faces).min();
 
     let faces = mesh.live_face_count();
-    let mut defects = Vec::new();
-    if faces == 0 {
-        defects.push("the mesh has no faces".to_string());
-    }
-    if non_finite > 0 {
-        let at = notes
-            .first_non_finite_line
-            .map(|l| format!(" (first at line {l})"))
-            .unwrap_or_default();
-        defects.push(format!(
-            "{non_finite} vertices have non-finite coordinates{at}"
-        ));
-    }
-    if let Err(e) = &validation {
-        defects.push(format!("invalid mesh: {e}"));
-    }
-    if intersections.total() > 0 {
-        defects.push(format!(
-            "{} intersecting triangle pairs ({} between layers, {} within a layer, {} folded onto a neighbour), e.g. faces {:?}",
-            intersections.total(),
-            intersections.between_layers,
-            intersections.within_layers,
-            intersections.folded_neighbours,
-            intersections
-                .examples
-                .iter()
-                .map(|p| [p.face_a, p.face_b])
-                .take(3)
-                .collect::<Vec<_>>()
-        ));
-    }
-    for (i, c) in closed.iter().enumerate() {
-        if c.faces < MIN_CLOSED_FACES {
-            defects.push(format!(
-                "closed component {i} (layer {}) has only {} faces, fewer than {MIN_CLOSED_FACES}: a collapsed shape",
-                c.layer, c.faces
-            ));
-        }
-    }
+    let found = Found {
+        faces,
+        non_finite,
+        first_non_finite_line: notes.first_non_finite_line,
+        validation: &validation,
+        intersections: &intersections,
+        closed: &closed,
+    };
+    let defects = found.defects();
     CheckReport {
         file: file.to_string(),
         vertices: mesh.live_vertex_count(),
@@ -260,6 +220,78 @@ pub fn check_mesh(
         grid,
         defects,
         digest: mesh.digest(),
+    }
+}
+
+/// The figures of the grid the engine would build (cell = `cell`), timed; `None` when it
+/// cannot be built.
+fn grid_figures(mesh: &Mesh, cell: f32) -> Option<GridFigures> {
+    let started = std::time::Instant::now();
+    let grid = SpatialHash::build(mesh, cell).ok()?;
+    Some(GridFigures {
+        cell_size: grid.cell_size() as f64,
+        occupied_cells: grid.occupied_cells(),
+        max_vertices_per_cell: grid.max_cell_occupancy(),
+        build_ms: started.elapsed().as_secs_f64() * 1e3,
+        memory_bytes: grid.memory_bytes(),
+    })
+}
+
+/// What `check_mesh` measured that can make a defect.
+struct Found<'a> {
+    faces: usize,
+    non_finite: usize,
+    first_non_finite_line: Option<usize>,
+    validation: &'a Result<(), crate::mesh::MeshError>,
+    intersections: &'a crate::collide::IntersectionReport,
+    closed: &'a [ClosedComponent],
+}
+
+impl Found<'_> {
+    /// One line per defect.
+    fn defects(&self) -> Vec<String> {
+        let mut defects = Vec::new();
+        if self.faces == 0 {
+            defects.push("the mesh has no faces".to_string());
+        }
+        if self.non_finite > 0 {
+            let at = self
+                .first_non_finite_line
+                .map(|l| format!(" (first at line {l})"))
+                .unwrap_or_default();
+            defects.push(format!(
+                "{} vertices have non-finite coordinates{at}",
+                self.non_finite
+            ));
+        }
+        if let Err(e) = self.validation {
+            defects.push(format!("invalid mesh: {e}"));
+        }
+        let x = self.intersections;
+        if x.total() > 0 {
+            let examples: Vec<[u32; 2]> = x
+                .examples
+                .iter()
+                .map(|p| [p.face_a, p.face_b])
+                .take(3)
+                .collect();
+            defects.push(format!(
+                "{} intersecting triangle pairs ({} between layers, {} within a layer, {} folded onto a neighbour), e.g. faces {examples:?}",
+                x.total(),
+                x.between_layers,
+                x.within_layers,
+                x.folded_neighbours,
+            ));
+        }
+        for (i, c) in self.closed.iter().enumerate() {
+            if c.faces < MIN_CLOSED_FACES {
+                defects.push(format!(
+                    "closed component {i} (layer {}) has only {} faces, fewer than {MIN_CLOSED_FACES}: a collapsed shape",
+                    c.layer, c.faces
+                ));
+            }
+        }
+        defects
     }
 }
 

@@ -54,13 +54,50 @@ impl IntersectionReport {
 /// Finds every pair of live faces that intersect (closed triangles, so touching counts); pairs
 /// that share a vertex count only where they overlap beyond it.
 pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
-    let faces = mesh.faces();
+    let (usable, boxes) = face_boxes(mesh);
+    let skipped_faces = mesh
+        .faces()
+        .iter()
+        .zip(&usable)
+        .filter(|(t, ok)| t[0] != INVALID && !**ok)
+        .count();
+    let cells = Cells {
+        size: broad_phase_cell_size(&boxes, &usable),
+    };
+    let (entries, oversized) = file_in_cells(&boxes, &usable, &cells);
+    let pairs = PairTest { mesh };
+    let mut found = pairs_in_cells(&entries, &boxes, &cells, &pairs);
+    found.extend(pairs_with_oversized(&oversized, &boxes, &usable, &pairs));
+    found.par_sort_unstable();
+    let folded_neighbours = found
+        .iter()
+        .filter(|p| pairs.shares_vertex(p.face_a, p.face_b))
+        .count();
+    let layers = mesh.face_layers();
+    let between_layers = found
+        .iter()
+        .filter(|p| !pairs.shares_vertex(p.face_a, p.face_b))
+        .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
+        .count();
+    IntersectionReport {
+        between_layers,
+        within_layers: found.len() - between_layers - folded_neighbours,
+        folded_neighbours,
+        examples: found.iter().take(8).copied().collect(),
+        skipped_faces,
+    }
+}
+
+/// Which faces can be tested (live, every corner finite), and their boxes (empty where not).
+fn face_boxes(mesh: &Mesh) -> (Vec<bool>, Vec<Aabb>) {
     let positions = mesh.positions();
-    let usable: Vec<bool> = faces
+    let usable: Vec<bool> = mesh
+        .faces()
         .par_iter()
         .map(|t| t[0] != INVALID && t.iter().all(|&v| positions[v as usize].is_finite()))
         .collect();
-    let boxes: Vec<Aabb> = faces
+    let boxes = mesh
+        .faces()
         .par_iter()
         .zip(&usable)
         .map(|(t, &ok)| {
@@ -71,31 +108,39 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             }
         })
         .collect();
-    let skipped_faces = faces
-        .iter()
-        .zip(&usable)
-        .filter(|(t, ok)| t[0] != INVALID && !**ok)
-        .count();
+    (usable, boxes)
+}
 
-    let cell_size = broad_phase_cell_size(&boxes, &usable);
-    let cell_of = |p: Vec3| -> I64Vec3 {
-        let c = (p.as_dvec3() / cell_size).floor();
+/// The broad phase's cubic cells.
+struct Cells {
+    size: f64,
+}
+
+impl Cells {
+    /// The cell holding `p`, clamped to ±[`CELL_LIMIT`].
+    fn of(&self, p: Vec3) -> I64Vec3 {
+        let c = (p.as_dvec3() / self.size).floor();
         I64Vec3::new(c.x as i64, c.y as i64, c.z as i64)
             .clamp(I64Vec3::splat(-CELL_LIMIT), I64Vec3::splat(CELL_LIMIT - 1))
-    };
-    let key_of = |c: I64Vec3| -> u64 {
+    }
+
+    /// A cell's three coordinates in one key.
+    fn key(c: I64Vec3) -> u64 {
         let b = (c + I64Vec3::splat(CELL_LIMIT)).as_u64vec3();
         (b.x << 42) | (b.y << 21) | b.z
-    };
+    }
+}
 
-    // File each box in its cells: (cell key, face) entries, or the face itself when oversized.
+/// Every usable face filed in the cells its box overlaps, as (cell key, face) entries sorted by
+/// cell; and the faces whose boxes span more than [`MAX_CELLS_PER_FACE`] cells, filed nowhere.
+fn file_in_cells(boxes: &[Aabb], usable: &[bool], cells: &Cells) -> (Vec<(u64, u32)>, Vec<u32>) {
     type Filing = (Vec<(u64, u32)>, Option<u32>);
     let (filed, oversized): (Vec<_>, Vec<_>) = boxes
         .par_iter()
         .enumerate()
         .filter(|(f, _)| usable[*f])
         .map(|(f, b)| {
-            let (lo, hi) = (cell_of(b.min), cell_of(b.max));
+            let (lo, hi) = (cells.of(b.min), cells.of(b.max));
             let span = hi - lo + I64Vec3::ONE;
             if span.x * span.y * span.z > MAX_CELLS_PER_FACE {
                 return (Vec::new(), Some(f as u32));
@@ -104,7 +149,7 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
-                        entries.push((key_of(I64Vec3::new(x, y, z)), f as u32));
+                        entries.push((Cells::key(I64Vec3::new(x, y, z)), f as u32));
                     }
                 }
             }
@@ -115,35 +160,54 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
         .unzip();
     let mut entries: Vec<(u64, u32)> = filed.into_iter().flatten().collect();
     entries.par_sort_unstable();
-    let oversized: Vec<u32> = oversized.into_iter().flatten().collect();
+    (entries, oversized.into_iter().flatten().collect())
+}
 
-    let mut group_starts: Vec<usize> = (0..entries.len())
-        .into_par_iter()
-        .filter(|&i| i == 0 || entries[i].0 != entries[i - 1].0)
-        .collect();
-    group_starts.push(entries.len());
+/// The narrow phase of one pair of faces.
+struct PairTest<'a> {
+    mesh: &'a Mesh,
+}
 
-    let shares_vertex = |a: u32, b: u32| {
+impl PairTest<'_> {
+    fn shares_vertex(&self, a: u32, b: u32) -> bool {
+        let faces = self.mesh.faces();
         faces[a as usize]
             .iter()
             .any(|v| faces[b as usize].contains(v))
-    };
-    let layers = mesh.face_layers();
-    let test = |a: u32, b: u32| -> bool {
+    }
+
+    /// Neighbours by [`neighbours_overlap`]; faces of different layers by
+    /// [`seam_pair_intersects`]; the rest by [`triangles_intersect`].
+    fn intersect(&self, a: u32, b: u32) -> bool {
+        let (faces, layers) = (self.mesh.faces(), self.mesh.face_layers());
         let (ta, tb) = (
-            mesh.face_positions(a as usize),
-            mesh.face_positions(b as usize),
+            self.mesh.face_positions(a as usize),
+            self.mesh.face_positions(b as usize),
         );
-        if shares_vertex(a, b) {
+        if self.shares_vertex(a, b) {
             return neighbours_overlap(ta, faces[a as usize], tb, faces[b as usize]);
         }
         if layers[a as usize] != layers[b as usize] {
             return seam_pair_intersects(ta, faces[a as usize], tb, faces[b as usize]);
         }
         triangles_intersect(ta, tb)
-    };
+    }
+}
 
-    let mut pairs: Vec<IntersectingPair> = group_starts
+/// The intersecting pairs among the faces filed in each cell, each pair tested only in the
+/// cell of the lowest corner of its two boxes' overlap.
+fn pairs_in_cells(
+    entries: &[(u64, u32)],
+    boxes: &[Aabb],
+    cells: &Cells,
+    pairs: &PairTest<'_>,
+) -> Vec<IntersectingPair> {
+    let mut group_starts: Vec<usize> = (0..entries.len())
+        .into_par_iter()
+        .filter(|&i| i == 0 || entries[i].0 != entries[i - 1].0)
+        .collect();
+    group_starts.push(entries.len());
+    group_starts
         .par_windows(2)
         .flat_map_iter(|w| {
             let group = &entries[w[0]..w[1]];
@@ -152,14 +216,10 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             for (i, &(_, a)) in group.iter().enumerate() {
                 for &(_, b) in &group[i + 1..] {
                     let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                    if !ba.overlaps(bb) {
+                    if !ba.overlaps(bb) || Cells::key(cells.of(ba.min.max(bb.min))) != cell_key {
                         continue;
                     }
-                    // Count the pair only in the cell of the overlap's lowest corner.
-                    if key_of(cell_of(ba.min.max(bb.min))) != cell_key {
-                        continue;
-                    }
-                    if test(a, b) {
+                    if pairs.intersect(a, b) {
                         found.push(IntersectingPair {
                             face_a: a.min(b),
                             face_b: a.max(b),
@@ -169,51 +229,39 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
             }
             found
         })
-        .collect();
+        .collect()
+}
 
-    // Oversized faces against everything (each pair once).
-    let is_oversized = {
-        let mut flags = vec![false; faces.len()];
-        for &f in &oversized {
-            flags[f as usize] = true;
-        }
-        flags
-    };
-    for &a in &oversized {
-        let found: Vec<IntersectingPair> = (0..faces.len() as u32)
-            .into_par_iter()
-            .filter(|&b| {
-                b != a
-                    && usable[b as usize]
-                    && !(is_oversized[b as usize] && b < a)
-                    && boxes[a as usize].overlaps(&boxes[b as usize])
-                    && test(a, b)
-            })
-            .map(|b| IntersectingPair {
-                face_a: a.min(b),
-                face_b: a.max(b),
-            })
-            .collect();
-        pairs.extend(found);
+/// The intersecting pairs of each oversized face with every usable face (each pair once).
+fn pairs_with_oversized(
+    oversized: &[u32],
+    boxes: &[Aabb],
+    usable: &[bool],
+    pairs: &PairTest<'_>,
+) -> Vec<IntersectingPair> {
+    let mut is_oversized = vec![false; boxes.len()];
+    for &f in oversized {
+        is_oversized[f as usize] = true;
     }
-
-    pairs.par_sort_unstable();
-    let folded_neighbours = pairs
-        .iter()
-        .filter(|p| shares_vertex(p.face_a, p.face_b))
-        .count();
-    let between_layers = pairs
-        .iter()
-        .filter(|p| !shares_vertex(p.face_a, p.face_b))
-        .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
-        .count();
-    IntersectionReport {
-        between_layers,
-        within_layers: pairs.len() - between_layers - folded_neighbours,
-        folded_neighbours,
-        examples: pairs.iter().take(8).copied().collect(),
-        skipped_faces,
+    let mut found = Vec::new();
+    for &a in oversized {
+        found.par_extend(
+            (0..boxes.len() as u32)
+                .into_par_iter()
+                .filter(|&b| {
+                    b != a
+                        && usable[b as usize]
+                        && !(is_oversized[b as usize] && b < a)
+                        && boxes[a as usize].overlaps(&boxes[b as usize])
+                        && pairs.intersect(a, b)
+                })
+                .map(|b| IntersectingPair {
+                    face_a: a.min(b),
+                    face_b: a.max(b),
+                }),
+        );
     }
+    found
 }
 
 /// Whether two faces of different layers intersect, where vertices at the same position count

@@ -335,33 +335,11 @@ pub fn render(
 ) -> Result<Rendered, RenderError> {
     let (width, height) = (options.width, options.height);
     check_size(gpu, width, height)?;
-    let mut visible = vec![options.layers.is_none(); mesh.layer_count()];
-    for &layer in options.layers.iter().flatten() {
-        match visible.get_mut(layer as usize) {
-            Some(slot) => *slot = true,
-            None => {
-                return Err(RenderError::NoSuchLayer {
-                    layer,
-                    layer_count: mesh.layer_count(),
-                });
-            }
-        }
-    }
+    let visible = visible_layers(mesh, options)?;
     if gpu.limits.max_storage_buffers_per_shader_stage < 2 {
         return Err(RenderError::NoVertexStorage);
     }
-
-    // Chunks fit the adapter's storage binding and buffer limits.
-    let binding_limit = gpu
-        .limits
-        .max_storage_buffer_binding_size
-        .min(gpu.limits.max_buffer_size);
-    let fit_vertices = (binding_limit / std::mem::size_of::<RenderVertex>() as u64) as usize;
-    let max_vertices = options
-        .max_vertices_per_draw
-        .unwrap_or(fit_vertices)
-        .clamp(3, fit_vertices.max(3));
-    let max_faces = (binding_limit / 12) as usize;
+    let (max_vertices, max_faces) = chunk_limits(gpu, options);
     let (chunks, bounds) = build_chunks(mesh, &visible, max_vertices, max_faces);
     let faces: usize = chunks.iter().map(|c| c.corners.len() / 3).sum();
     let camera = Camera::fit(&options.camera, bounds, width as f32 / height as f32);
@@ -376,8 +354,75 @@ pub fn render(
     let pipeline = pipeline(gpu, samples)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let uniform = gpu.uniform_buffer("preview uniforms", &uniforms(&camera, options));
+    let draws = bind_chunks(gpu, &pipeline, &uniform, &chunks);
+    drop(chunks);
+    let targets = Targets::new(gpu, (width, height), samples);
+    let readback = Readback::new(gpu, width, height);
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("preview"),
+        });
+    record_draws(&mut encoder, &pipeline, &draws, &targets);
+    readback.record_copy(&mut encoder, &targets.resolved);
+    gpu.queue.submit([encoder.finish()]);
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(GpuError::Validation(error.to_string()).into());
+    }
+    Ok(Rendered {
+        image: Image {
+            width,
+            height,
+            rgba: readback.read(gpu)?,
+        },
+        faces,
+        draws: draws.len(),
+        camera,
+    })
+}
+
+/// Which layers the options show (all when none are named); a named layer the mesh lacks is
+/// an error.
+fn visible_layers(mesh: &Mesh, options: &RenderOptions) -> Result<Vec<bool>, RenderError> {
+    let mut visible = vec![options.layers.is_none(); mesh.layer_count()];
+    for &layer in options.layers.iter().flatten() {
+        match visible.get_mut(layer as usize) {
+            Some(slot) => *slot = true,
+            None => {
+                return Err(RenderError::NoSuchLayer {
+                    layer,
+                    layer_count: mesh.layer_count(),
+                });
+            }
+        }
+    }
+    Ok(visible)
+}
+
+/// The most vertices and faces one draw may take: what fits the adapter's storage binding
+/// and buffer limits (and the options' own cap on vertices).
+fn chunk_limits(gpu: &GpuContext, options: &RenderOptions) -> (usize, usize) {
+    let binding_limit = gpu
+        .limits
+        .max_storage_buffer_binding_size
+        .min(gpu.limits.max_buffer_size);
+    let fit_vertices = (binding_limit / std::mem::size_of::<RenderVertex>() as u64) as usize;
+    let max_vertices = options
+        .max_vertices_per_draw
+        .unwrap_or(fit_vertices)
+        .clamp(3, fit_vertices.max(3));
+    (max_vertices, (binding_limit / 12) as usize)
+}
+
+/// One bind group per chunk (the uniforms, its vertices and corners), with its corner count.
+fn bind_chunks(
+    gpu: &GpuContext,
+    pipeline: &wgpu::RenderPipeline,
+    uniform: &wgpu::Buffer,
+    chunks: &[Chunk],
+) -> Vec<(wgpu::BindGroup, u32)> {
     let layout = pipeline.get_bind_group_layout(0);
-    let bind_groups: Vec<(wgpu::BindGroup, u32)> = chunks
+    chunks
         .iter()
         .map(|chunk| {
             let vertices = gpu.storage_buffer("preview vertices", &chunk.vertices, false);
@@ -402,132 +447,149 @@ pub fn render(
             });
             (group, chunk.corners.len() as u32)
         })
-        .collect();
-    drop(chunks);
+        .collect()
+}
 
-    let size = (width, height);
-    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let resolved = target(
-        gpu,
-        "preview image",
-        size,
-        1,
-        COLOUR_FORMAT,
-        attachment | wgpu::TextureUsages::COPY_SRC,
-    );
-    let multisampled = (samples > 1).then(|| {
-        target(
+/// The render targets: the image (resolved, copied out), its multisampled twin when
+/// antialiasing, and depth; each texture kept beside its view for the pass.
+struct Targets {
+    resolved: wgpu::Texture,
+    resolved_view: wgpu::TextureView,
+    multisampled: Option<(wgpu::Texture, wgpu::TextureView)>,
+    depth: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl Targets {
+    fn new(gpu: &GpuContext, size: (u32, u32), samples: u32) -> Targets {
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let copied = attachment | wgpu::TextureUsages::COPY_SRC;
+        let with_view = |texture: wgpu::Texture| {
+            let view = texture.create_view(&Default::default());
+            (texture, view)
+        };
+        let resolved = target(gpu, "preview image", size, 1, COLOUR_FORMAT, copied);
+        let multisampled = (samples > 1).then(|| {
+            let name = "preview samples";
+            with_view(target(gpu, name, size, samples, COLOUR_FORMAT, attachment))
+        });
+        let depth = target(
             gpu,
-            "preview samples",
+            "preview depth",
             size,
             samples,
-            COLOUR_FORMAT,
+            DEPTH_FORMAT,
             attachment,
-        )
-    });
-    let depth = target(
-        gpu,
-        "preview depth",
-        size,
-        samples,
-        DEPTH_FORMAT,
-        attachment,
-    );
-    let resolved_view = resolved.create_view(&Default::default());
-    let multisampled_view = multisampled
-        .as_ref()
-        .map(|t| t.create_view(&Default::default()));
-    let depth_view = depth.create_view(&Default::default());
-
-    // Rows of the readback buffer are padded to the copy alignment.
-    let row_bytes = 4 * width;
-    let padded_row_bytes =
-        row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("preview readback"),
-        size: padded_row_bytes as u64 * height as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-
-    let mut encoder = gpu
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("preview"),
-        });
-    {
-        let [r, g, b] = BACKGROUND;
-        let (view, resolve_target) = match &multisampled_view {
-            Some(samples_view) => (samples_view, Some(&resolved_view)),
-            None => (&resolved_view, None),
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("preview"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline);
-        for (group, corners) in &bind_groups {
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..*corners, 0..1);
+        );
+        Targets {
+            resolved_view: resolved.create_view(&Default::default()),
+            resolved,
+            multisampled,
+            depth: with_view(depth),
         }
     }
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: &resolved,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &readback,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded_row_bytes),
-                rows_per_image: Some(height),
+}
+
+/// Records the render pass: cleared to the background, every chunk drawn, resolved into the
+/// image when multisampled.
+fn record_draws(
+    encoder: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    draws: &[(wgpu::BindGroup, u32)],
+    targets: &Targets,
+) {
+    let [r, g, b] = BACKGROUND;
+    let (view, resolve_target) = match &targets.multisampled {
+        Some((_, samples_view)) => (samples_view, Some(&targets.resolved_view)),
+        None => (&targets.resolved_view, None),
+    };
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("preview"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                store: wgpu::StoreOp::Store,
             },
-        },
-        wgpu::Extent3d {
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.depth.1,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (group, corners) in draws {
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..*corners, 0..1);
+    }
+}
+
+/// The buffer the image is copied into, its rows padded to the copy alignment.
+struct Readback {
+    buffer: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    padded_row_bytes: u32,
+}
+
+impl Readback {
+    fn new(gpu: &GpuContext, width: u32, height: u32) -> Readback {
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded_row_bytes = (4 * width).div_ceil(align) * align;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview readback"),
+            size: padded_row_bytes as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Readback {
+            buffer,
             width,
             height,
-            depth_or_array_layers: 1,
-        },
-    );
-    gpu.queue.submit([encoder.finish()]);
-    if let Some(error) = pollster::block_on(scope.pop()) {
-        return Err(GpuError::Validation(error.to_string()).into());
+            padded_row_bytes,
+        }
     }
-    let padded = gpu.map_read(&readback)?;
-    let mut rgba = Vec::with_capacity(row_bytes as usize * height as usize);
-    for row in padded.chunks_exact(padded_row_bytes as usize) {
-        rgba.extend_from_slice(&row[..row_bytes as usize]);
+
+    fn record_copy(&self, encoder: &mut wgpu::CommandEncoder, image: &wgpu::Texture) {
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: image,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row_bytes),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
     }
-    Ok(Rendered {
-        image: Image {
-            width,
-            height,
-            rgba,
-        },
-        faces,
-        draws: bind_groups.len(),
-        camera,
-    })
+
+    /// The image's RGBA bytes, the padding dropped.
+    fn read(&self, gpu: &GpuContext) -> Result<Vec<u8>, GpuError> {
+        let padded = gpu.map_read(&self.buffer)?;
+        let row_bytes = 4 * self.width as usize;
+        let mut rgba = Vec::with_capacity(row_bytes * self.height as usize);
+        for row in padded.chunks_exact(self.padded_row_bytes as usize) {
+            rgba.extend_from_slice(&row[..row_bytes]);
+        }
+        Ok(rgba)
+    }
 }
