@@ -99,9 +99,7 @@ struct Header {
 
 fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
     let fail = |line: usize, message: &str| Err(IoError::parse(name, Some(line), message));
-    let mut encoding = None;
-    let mut elements: Vec<Element> = Vec::new();
-    let mut layer_names = Vec::new();
+    let mut lines = HeaderLines::default();
     let mut offset = 0;
     let mut line_number = 0;
     loop {
@@ -121,9 +119,52 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
             }
             continue;
         }
-        match words.as_slice() {
+        match lines.take(&words) {
+            Ok(true) => break,
+            Ok(false) => {}
+            Err(HeaderLineError::Unexpected) => {
+                return fail(
+                    line_number,
+                    &format!("unexpected header line `{}`", line.trim()),
+                );
+            }
+            Err(HeaderLineError::Bad(message)) => return fail(line_number, message),
+        }
+    }
+    let Some(encoding) = lines.encoding else {
+        return fail(line_number, "header has no `format` line");
+    };
+    Ok(Header {
+        encoding,
+        elements: lines.elements,
+        layer_names: lines.layer_names,
+        body: offset,
+        lines: line_number,
+    })
+}
+
+/// What the header's lines after the first have said so far.
+#[derive(Default)]
+struct HeaderLines {
+    encoding: Option<Encoding>,
+    elements: Vec<Element>,
+    layer_names: Vec<(u32, String)>,
+}
+
+/// Why a header line was refused.
+enum HeaderLineError {
+    /// A line of no known shape (its text goes in the message).
+    Unexpected,
+    Bad(&'static str),
+}
+
+impl HeaderLines {
+    /// Takes one line's words; `true` at `end_header`.
+    fn take(&mut self, words: &[&str]) -> Result<bool, HeaderLineError> {
+        use HeaderLineError::Bad;
+        match words {
             ["format", kind, _version] => {
-                encoding = Some(match *kind {
+                self.encoding = Some(match *kind {
                     "ascii" => Encoding::Ascii,
                     "binary_little_endian" => Encoding::Binary {
                         little_endian: true,
@@ -131,20 +172,20 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
                     "binary_big_endian" => Encoding::Binary {
                         little_endian: false,
                     },
-                    _ => return fail(line_number, "unknown PLY format"),
+                    _ => return Err(Bad("unknown PLY format")),
                 })
             }
             ["comment", "slayer", "layer", id, rest @ ..] => {
                 if let Ok(id) = id.parse::<u32>() {
-                    layer_names.push((id, rest.join(" ")));
+                    self.layer_names.push((id, rest.join(" ")));
                 }
             }
             ["comment", ..] | ["obj_info", ..] | [] => {}
             ["element", element, count] => {
                 let Ok(count) = count.parse::<usize>() else {
-                    return fail(line_number, "element count is not a non-negative integer");
+                    return Err(Bad("element count is not a non-negative integer"));
                 };
-                elements.push(Element {
+                self.elements.push(Element {
                     name: element.to_string(),
                     count,
                     properties: Vec::new(),
@@ -154,52 +195,41 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
                 let (Some(count), Some(value)) =
                     (Scalar::parse(count_type), Scalar::parse(value_type))
                 else {
-                    return fail(line_number, "unknown property type");
+                    return Err(Bad("unknown property type"));
                 };
                 if !count.is_integer() {
-                    return fail(line_number, "list count type must be an integer type");
+                    return Err(Bad("list count type must be an integer type"));
                 }
-                let Some(element) = elements.last_mut() else {
-                    return fail(line_number, "property before any element");
-                };
-                element.properties.push(Property {
-                    name: property.to_string(),
-                    value,
-                    list: Some(count),
-                });
+                self.push_property(property, value, Some(count))?;
             }
             ["property", value_type, property] => {
                 let Some(value) = Scalar::parse(value_type) else {
-                    return fail(line_number, "unknown property type");
+                    return Err(Bad("unknown property type"));
                 };
-                let Some(element) = elements.last_mut() else {
-                    return fail(line_number, "property before any element");
-                };
-                element.properties.push(Property {
-                    name: property.to_string(),
-                    value,
-                    list: None,
-                });
+                self.push_property(property, value, None)?;
             }
-            ["end_header"] => break,
-            _ => {
-                return fail(
-                    line_number,
-                    &format!("unexpected header line `{}`", line.trim()),
-                );
-            }
+            ["end_header"] => return Ok(true),
+            _ => return Err(HeaderLineError::Unexpected),
         }
+        Ok(false)
     }
-    let Some(encoding) = encoding else {
-        return fail(line_number, "header has no `format` line");
-    };
-    Ok(Header {
-        encoding,
-        elements,
-        layer_names,
-        body: offset,
-        lines: line_number,
-    })
+
+    fn push_property(
+        &mut self,
+        name: &str,
+        value: Scalar,
+        list: Option<Scalar>,
+    ) -> Result<(), HeaderLineError> {
+        let Some(element) = self.elements.last_mut() else {
+            return Err(HeaderLineError::Bad("property before any element"));
+        };
+        element.properties.push(Property {
+            name: name.to_string(),
+            value,
+            list,
+        });
+        Ok(())
+    }
 }
 
 /// Reads values from the body in either encoding.
@@ -309,171 +339,24 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
         line: header.lines,
         name,
     };
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut brdfs: Vec<Brdf> = Vec::new();
-    let mut masks: Vec<VertexFlags> = Vec::new();
-    let mut has_brdf = false;
-    let mut faces: Vec<[u32; 3]> = Vec::new();
-    let mut face_layers: Vec<LayerId> = Vec::new();
-    let mut saw_vertices = false;
-
+    let mut rows = Rows::default();
     for element in &header.elements {
-        // Never reserve more rows than the remaining bytes could hold.
-        let capacity = element.count.min(body.remaining() + 1);
-        let is_vertex = element.name == "vertex";
-        let is_face = element.name == "face";
-        if is_vertex {
-            if saw_vertices {
-                return Err(body.error("more than one vertex element"));
-            }
-            saw_vertices = true;
-            for axis in ["x", "y", "z"] {
-                if !element
-                    .properties
-                    .iter()
-                    .any(|p| p.name == axis && p.list.is_none())
-                {
-                    return Err(body.error(format!("vertex element has no `{axis}` property")));
-                }
-            }
-            has_brdf = BRDF_PROPERTIES
-                .iter()
-                .all(|b| element.properties.iter().any(|p| p.name == *b));
-            positions.reserve(capacity);
-        }
-        if is_face
-            && !element.properties.iter().any(|p| {
-                p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
-            })
-        {
-            return Err(body.error("face element has no `vertex_indices` list"));
-        }
-        for row in 0..element.count {
-            body.start_row()?;
-            let mut position = [0f32; 3];
-            let mut brdf = [0f32; 7];
-            let mut flags = 0u32;
-            let mut polygon: Vec<u32> = Vec::new();
-            let mut layer = 0u32;
-            for property in &element.properties {
-                if let Some(count_type) = property.list {
-                    let count = body.read(count_type)?;
-                    let Some(count) = as_index(count) else {
-                        return Err(body.error(format!("{} {row}: bad list length", element.name)));
-                    };
-                    let wanted = is_face
-                        && (property.name == "vertex_indices" || property.name == "vertex_index");
-                    for _ in 0..count {
-                        let value = body.read(property.value)?;
-                        if wanted {
-                            let Some(index) = as_index(value) else {
-                                return Err(body.error(format!(
-                                    "face {row}: vertex index {value} is not a valid index"
-                                )));
-                            };
-                            polygon.push(index);
-                        }
-                    }
-                    continue;
-                }
-                let value = body.read(property.value)?;
-                if is_vertex {
-                    match property.name.as_str() {
-                        "x" => position[0] = value as f32,
-                        "y" => position[1] = value as f32,
-                        "z" => position[2] = value as f32,
-                        "flags" => flags = as_index(value).unwrap_or(0),
-                        other => {
-                            if let Some(k) = BRDF_PROPERTIES.iter().position(|b| *b == other) {
-                                brdf[k] = value as f32;
-                            }
-                        }
-                    }
-                } else if is_face && property.name == "layer" {
-                    layer = match as_index(value) {
-                        Some(l) if l < MAX_LAYERS => l,
-                        _ => {
-                            return Err(body.error(format!(
-                                "face {row}: layer {value} is not a valid layer id"
-                            )));
-                        }
-                    };
-                }
-            }
-            if is_vertex {
-                positions.push(Vec3::from_array(position));
-                brdfs.push(Brdf::from_array(brdf));
-                masks.push(VertexFlags::from_bits_truncate(flags) & VertexFlags::PERSISTENT);
-            } else if is_face {
-                if polygon.len() < 3 {
-                    return Err(body.error(format!(
-                        "face {row} has {} corners; at least 3 are needed",
-                        polygon.len()
-                    )));
-                }
-                if let Some(&bad) = polygon.iter().find(|&&i| i as usize >= positions.len()) {
-                    return Err(body.error(format!(
-                        "face {row}: vertex index {bad} is out of range ({} vertices)",
-                        positions.len()
-                    )));
-                }
-                for k in 1..polygon.len() - 1 {
-                    faces.push([polygon[0], polygon[k], polygon[k + 1]]);
-                    face_layers.push(layer);
-                }
-            }
-        }
+        rows.read_element(element, &mut body)?;
     }
-    if faces.is_empty() {
+    if rows.faces.is_empty() {
         return Err(IoError::parse(name, None, "no faces"));
     }
-    // Named layers count even when no face uses them any more.
-    let named = header
-        .layer_names
-        .iter()
-        .map(|(id, _)| id + 1)
-        .filter(|&n| n <= MAX_LAYERS);
-    let layer_count = face_layers
-        .iter()
-        .map(|&l| l + 1)
-        .chain(named)
-        .max()
-        .unwrap_or(0);
-    let layer_names = (0..layer_count)
-        .map(|l| {
-            header
-                .layer_names
-                .iter()
-                .find(|(id, _)| *id == l)
-                .map(|(_, n)| n.clone())
-                .unwrap_or_else(|| format!("layer{l}"))
-        })
-        .collect();
-    // Vertices no face uses are dropped rather than rejected: PLY writers often leave them.
-    let mut used = vec![false; positions.len()];
-    for f in &faces {
-        for &v in f {
-            used[v as usize] = true;
-        }
-    }
-    let mut remap = vec![INVALID; positions.len()];
-    let mut kept = 0u32;
-    for (v, slot) in remap.iter_mut().enumerate() {
-        if used[v] {
-            *slot = kept;
-            kept += 1;
-        }
-    }
-    let keep = |v: &usize| used[*v];
-    let positions: Vec<Vec3> = (0..positions.len())
-        .filter(keep)
-        .map(|v| positions[v])
-        .collect();
-    let brdfs: Vec<Brdf> = (0..brdfs.len()).filter(keep).map(|v| brdfs[v]).collect();
-    let masks: Vec<VertexFlags> = (0..masks.len()).filter(keep).map(|v| masks[v]).collect();
-    for f in &mut faces {
-        *f = f.map(|v| remap[v as usize]);
-    }
+    let layer_names = layer_names(&header.layer_names, &rows.face_layers);
+    rows.drop_unused_vertices();
+    let Rows {
+        positions,
+        brdfs,
+        masks,
+        has_brdf,
+        faces,
+        face_layers,
+        ..
+    } = rows;
     let mut mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
         .map_err(|e| IoError::building(name, e, &positions))?;
     if has_brdf {
@@ -486,6 +369,218 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
         }
     }
     Ok(mesh)
+}
+
+/// What the body's vertex and face rows gave.
+#[derive(Default)]
+struct Rows {
+    positions: Vec<Vec3>,
+    brdfs: Vec<Brdf>,
+    masks: Vec<VertexFlags>,
+    /// The vertex element has every BRDF property.
+    has_brdf: bool,
+    faces: Vec<[u32; 3]>,
+    face_layers: Vec<LayerId>,
+    saw_vertices: bool,
+}
+
+/// One row of an element, the properties slayer reads.
+#[derive(Default)]
+struct Row {
+    position: [f32; 3],
+    brdf: [f32; 7],
+    flags: u32,
+    polygon: Vec<u32>,
+    layer: u32,
+}
+
+fn is_index_list(property: &Property) -> bool {
+    property.list.is_some()
+        && (property.name == "vertex_indices" || property.name == "vertex_index")
+}
+
+impl Rows {
+    /// Reads every row of `element`: vertices and faces kept, other elements skipped.
+    fn read_element(&mut self, element: &Element, body: &mut Body<'_>) -> Result<(), IoError> {
+        let is_vertex = element.name == "vertex";
+        let is_face = element.name == "face";
+        if is_vertex {
+            self.start_vertices(element, body)?;
+        }
+        if is_face && !element.properties.iter().any(is_index_list) {
+            return Err(body.error("face element has no `vertex_indices` list"));
+        }
+        for row in 0..element.count {
+            body.start_row()?;
+            let read = read_row(element, row, body)?;
+            if is_vertex {
+                self.positions.push(Vec3::from_array(read.position));
+                self.brdfs.push(Brdf::from_array(read.brdf));
+                let mask = VertexFlags::from_bits_truncate(read.flags) & VertexFlags::PERSISTENT;
+                self.masks.push(mask);
+            } else if is_face {
+                self.push_polygon(&read, row, body)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the one vertex element's properties and reserves what the file can hold.
+    fn start_vertices(&mut self, element: &Element, body: &Body<'_>) -> Result<(), IoError> {
+        if self.saw_vertices {
+            return Err(body.error("more than one vertex element"));
+        }
+        self.saw_vertices = true;
+        for axis in ["x", "y", "z"] {
+            let found = element
+                .properties
+                .iter()
+                .any(|p| p.name == axis && p.list.is_none());
+            if !found {
+                return Err(body.error(format!("vertex element has no `{axis}` property")));
+            }
+        }
+        self.has_brdf = BRDF_PROPERTIES
+            .iter()
+            .all(|b| element.properties.iter().any(|p| p.name == *b));
+        // Never reserve more rows than the remaining bytes could hold.
+        self.positions
+            .reserve(element.count.min(body.remaining() + 1));
+        Ok(())
+    }
+
+    /// A face row's polygon, checked and split into a fan of triangles.
+    fn push_polygon(&mut self, read: &Row, row: usize, body: &Body<'_>) -> Result<(), IoError> {
+        let polygon = &read.polygon;
+        if polygon.len() < 3 {
+            return Err(body.error(format!(
+                "face {row} has {} corners; at least 3 are needed",
+                polygon.len()
+            )));
+        }
+        if let Some(&bad) = polygon
+            .iter()
+            .find(|&&i| i as usize >= self.positions.len())
+        {
+            return Err(body.error(format!(
+                "face {row}: vertex index {bad} is out of range ({} vertices)",
+                self.positions.len()
+            )));
+        }
+        for k in 1..polygon.len() - 1 {
+            self.faces.push([polygon[0], polygon[k], polygon[k + 1]]);
+            self.face_layers.push(read.layer);
+        }
+        Ok(())
+    }
+
+    /// Drops vertices no face uses rather than rejecting them (PLY writers often leave them),
+    /// renumbering the faces.
+    fn drop_unused_vertices(&mut self) {
+        let mut used = vec![false; self.positions.len()];
+        for f in &self.faces {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        let mut remap = vec![INVALID; self.positions.len()];
+        let mut kept = 0u32;
+        for (v, slot) in remap.iter_mut().enumerate() {
+            if used[v] {
+                *slot = kept;
+                kept += 1;
+            }
+        }
+        fn keep<T: Copy>(rows: &[T], used: &[bool]) -> Vec<T> {
+            rows.iter()
+                .zip(used)
+                .filter(|(_, u)| **u)
+                .map(|(r, _)| *r)
+                .collect()
+        }
+        self.positions = keep(&self.positions, &used);
+        self.brdfs = keep(&self.brdfs, &used);
+        self.masks = keep(&self.masks, &used);
+        for f in &mut self.faces {
+            *f = f.map(|v| remap[v as usize]);
+        }
+    }
+}
+
+/// Reads one row of `element` (its `row`th), keeping what slayer uses of it.
+fn read_row(element: &Element, row: usize, body: &mut Body<'_>) -> Result<Row, IoError> {
+    let is_vertex = element.name == "vertex";
+    let is_face = element.name == "face";
+    let mut read = Row::default();
+    for property in &element.properties {
+        if let Some(count_type) = property.list {
+            let count = body.read(count_type)?;
+            let Some(count) = as_index(count) else {
+                return Err(body.error(format!("{} {row}: bad list length", element.name)));
+            };
+            let wanted = is_face && is_index_list(property);
+            for _ in 0..count {
+                let value = body.read(property.value)?;
+                if wanted {
+                    let Some(index) = as_index(value) else {
+                        return Err(body.error(format!(
+                            "face {row}: vertex index {value} is not a valid index"
+                        )));
+                    };
+                    read.polygon.push(index);
+                }
+            }
+            continue;
+        }
+        let value = body.read(property.value)?;
+        if is_vertex {
+            match property.name.as_str() {
+                "x" => read.position[0] = value as f32,
+                "y" => read.position[1] = value as f32,
+                "z" => read.position[2] = value as f32,
+                "flags" => read.flags = as_index(value).unwrap_or(0),
+                other => {
+                    if let Some(k) = BRDF_PROPERTIES.iter().position(|b| *b == other) {
+                        read.brdf[k] = value as f32;
+                    }
+                }
+            }
+        } else if is_face && property.name == "layer" {
+            read.layer = match as_index(value) {
+                Some(l) if l < MAX_LAYERS => l,
+                _ => {
+                    return Err(
+                        body.error(format!("face {row}: layer {value} is not a valid layer id"))
+                    );
+                }
+            };
+        }
+    }
+    Ok(read)
+}
+
+/// A name per layer: those the header's comments give, `layerN` for the rest. Named layers
+/// count even when no face uses them any more.
+fn layer_names(named: &[(u32, String)], face_layers: &[LayerId]) -> Vec<String> {
+    let named_count = named
+        .iter()
+        .map(|(id, _)| id + 1)
+        .filter(|&n| n <= MAX_LAYERS);
+    let layer_count = face_layers
+        .iter()
+        .map(|&l| l + 1)
+        .chain(named_count)
+        .max()
+        .unwrap_or(0);
+    (0..layer_count)
+        .map(|l| {
+            named
+                .iter()
+                .find(|(id, _)| *id == l)
+                .map(|(_, n)| n.clone())
+                .unwrap_or_else(|| format!("layer{l}"))
+        })
+        .collect()
 }
 
 /// Writes the live mesh as binary little-endian PLY.
