@@ -351,12 +351,15 @@ fn check_brush(
     Ok(())
 }
 
+/// A field's path (from the stroke) and what is wrong with it.
+type FieldError = (String, String);
+
 fn resolve_stroke(
     spec: &StrokeSpec,
     mesh: &Mesh,
     extent: f32,
     edge: f32,
-) -> Result<Stroke, (String, String)> {
+) -> Result<Stroke, FieldError> {
     let fail = |field: &str, message: String| Err((field.to_string(), message));
     let brush = (spec.radius, spec.strength, spec.spacing, spec.falloff);
     check_brush(brush, extent).map_err(|(field, message)| (field.to_string(), message))?;
@@ -369,101 +372,9 @@ fn resolve_stroke(
             ),
         );
     }
-    if spec.samples.is_empty() {
-        return fail(".samples", "a stroke needs at least one sample".into());
-    }
-    if spec.samples.len() > MAX_SAMPLES_PER_STROKE {
-        return fail(
-            ".samples",
-            format!(
-                "{} samples is more than a stroke may have ({MAX_SAMPLES_PER_STROKE})",
-                spec.samples.len()
-            ),
-        );
-    }
-    if spec.layers.is_empty() {
-        return fail(".layers", "a stroke needs at least one active layer".into());
-    }
-    let mut layers = Vec::new();
-    for (k, layer) in spec.layers.iter().enumerate() {
-        let id = match layer {
-            LayerRef::Index(i) if (*i as usize) < mesh.layer_count() => *i,
-            LayerRef::Index(i) => {
-                return fail(
-                    &format!(".layers[{k}]"),
-                    format!(
-                        "layer {i} does not exist (the mesh has {} layers)",
-                        mesh.layer_count()
-                    ),
-                );
-            }
-            LayerRef::Name(name) => match mesh.layer_names().iter().position(|n| n == name) {
-                Some(i) => i as LayerId,
-                None => {
-                    return fail(
-                        &format!(".layers[{k}]"),
-                        format!(
-                            "no layer is named `{}` (the mesh has: {})",
-                            escape(name),
-                            escape(&mesh.layer_names().join(", "))
-                        ),
-                    );
-                }
-            },
-        };
-        layers.push(id);
-    }
-    layers.sort_unstable();
-    layers.dedup();
-    let mut samples = Vec::with_capacity(spec.samples.len());
-    for (k, s) in spec.samples.iter().enumerate() {
-        let at = |field: &str| format!(".samples[{k}].{field}");
-        let position = Vec3::from_array(s.position);
-        if !position.is_finite() || position.abs().max_element() > MAX_COORDINATE {
-            return fail(
-                &at("position"),
-                format!("{:?} is not a usable position", s.position),
-            );
-        }
-        if !(0.0..=1.0).contains(&s.pressure) {
-            return fail(&at("pressure"), format!("{} is outside [0, 1]", s.pressure));
-        }
-        let normal = match s.normal {
-            None => None,
-            Some(n) => match Vec3::from_array(n).try_normalize() {
-                Some(unit) => Some(unit),
-                None => return fail(&at("normal"), format!("{n:?} is not a direction")),
-            },
-        };
-        samples.push(Sample {
-            position,
-            pressure: s.pressure,
-            normal,
-        });
-    }
-    let paint = match (&spec.paint, spec.brush) {
-        (Some(paint), kind) => {
-            let mut paint = resolve_paint(paint)
-                .map_err(|(field, message)| (format!(".paint{field}"), message))?;
-            if kind == BrushKind::Paint {
-                paint.opacity *= spec.strength;
-            }
-            Some(paint)
-        }
-        (None, BrushKind::Paint) => {
-            return fail(
-                ".paint",
-                "the paint brush needs a `paint` (e.g. {\"material\": \"rust\"})".into(),
-            );
-        }
-        (None, _) => None,
-    };
-    if paint.is_some() && spec.brush == BrushKind::Mask {
-        return fail(
-            ".paint",
-            "the mask brush paints the mask, not a material: leave `paint` out".into(),
-        );
-    }
+    let samples = resolve_samples(&spec.samples)?;
+    let layers = resolve_layers(&spec.layers, mesh)?;
+    let paint = resolve_stroke_paint(spec)?;
     Ok(Stroke {
         paint,
         brush: Brush {
@@ -483,6 +394,107 @@ fn resolve_stroke(
             .map_err(|message| (".symmetry".to_string(), message))?,
         samples,
     })
+}
+
+/// The active layers, by index or name, sorted and without repeats.
+fn resolve_layers(refs: &[LayerRef], mesh: &Mesh) -> Result<Vec<LayerId>, FieldError> {
+    if refs.is_empty() {
+        let message = "a stroke needs at least one active layer";
+        return Err((".layers".into(), message.into()));
+    }
+    let mut layers = Vec::new();
+    for (k, layer) in refs.iter().enumerate() {
+        let id = match layer {
+            LayerRef::Index(i) if (*i as usize) < mesh.layer_count() => Ok(*i),
+            LayerRef::Index(i) => Err(format!(
+                "layer {i} does not exist (the mesh has {} layers)",
+                mesh.layer_count()
+            )),
+            LayerRef::Name(name) => mesh
+                .layer_names()
+                .iter()
+                .position(|n| n == name)
+                .map(|i| i as LayerId)
+                .ok_or_else(|| {
+                    format!(
+                        "no layer is named `{}` (the mesh has: {})",
+                        escape(name),
+                        escape(&mesh.layer_names().join(", "))
+                    )
+                }),
+        };
+        layers.push(id.map_err(|message| (format!(".layers[{k}]"), message))?);
+    }
+    layers.sort_unstable();
+    layers.dedup();
+    Ok(layers)
+}
+
+/// The samples, each position usable, pressure in [0, 1] and normal a direction.
+fn resolve_samples(specs: &[SampleSpec]) -> Result<Vec<Sample>, FieldError> {
+    if specs.is_empty() {
+        return Err((
+            ".samples".into(),
+            "a stroke needs at least one sample".into(),
+        ));
+    }
+    if specs.len() > MAX_SAMPLES_PER_STROKE {
+        let message = format!(
+            "{} samples is more than a stroke may have ({MAX_SAMPLES_PER_STROKE})",
+            specs.len()
+        );
+        return Err((".samples".into(), message));
+    }
+    let mut samples = Vec::with_capacity(specs.len());
+    for (k, s) in specs.iter().enumerate() {
+        let fail = |field: &str, message: String| Err((format!(".samples[{k}].{field}"), message));
+        let position = Vec3::from_array(s.position);
+        if !position.is_finite() || position.abs().max_element() > MAX_COORDINATE {
+            return fail(
+                "position",
+                format!("{:?} is not a usable position", s.position),
+            );
+        }
+        if !(0.0..=1.0).contains(&s.pressure) {
+            return fail("pressure", format!("{} is outside [0, 1]", s.pressure));
+        }
+        let normal = match s.normal {
+            None => None,
+            Some(n) => match Vec3::from_array(n).try_normalize() {
+                Some(unit) => Some(unit),
+                None => return fail("normal", format!("{n:?} is not a direction")),
+            },
+        };
+        samples.push(Sample {
+            position,
+            pressure: s.pressure,
+            normal,
+        });
+    }
+    Ok(samples)
+}
+
+/// The paint a stroke lays down: required by the paint brush (its strength scales the
+/// opacity), refused by the mask brush.
+fn resolve_stroke_paint(spec: &StrokeSpec) -> Result<Option<Paint>, FieldError> {
+    let fail = |message: &str| Err((".paint".to_string(), message.to_string()));
+    match (&spec.paint, spec.brush) {
+        (Some(_), BrushKind::Mask) => {
+            fail("the mask brush paints the mask, not a material: leave `paint` out")
+        }
+        (Some(paint), kind) => {
+            let mut paint = resolve_paint(paint)
+                .map_err(|(field, message)| (format!(".paint{field}"), message))?;
+            if kind == BrushKind::Paint {
+                paint.opacity *= spec.strength;
+            }
+            Ok(Some(paint))
+        }
+        (None, BrushKind::Paint) => {
+            fail("the paint brush needs a `paint` (e.g. {\"material\": \"rust\"})")
+        }
+        (None, _) => Ok(None),
+    }
 }
 
 fn preset(name: &str) -> Result<Brdf, String> {
