@@ -29,21 +29,7 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         IoError::parse(name, Some(line), "not a text file (invalid UTF-8)")
     })?;
     let (mut report, file_positions) = prescan(text, name)?;
-
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let mut reader = LineCounter {
-        inner: io::BufReader::new(text.as_bytes()),
-        lines: 0,
-    };
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
+    let models = load_models(text, name)?;
 
     // tobj numbers each object's vertices in the order faces first use them; putting them back
     // in file order keeps vertex numbers stable across a write and a read.
@@ -59,8 +45,7 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
     let mut face_layers: Vec<LayerId> = Vec::new();
     let mut layer_names: Vec<String> = Vec::new();
     for model in &models {
-        let m = &model.mesh;
-        if m.indices.len() < 3 {
+        if model.mesh.indices.len() < 3 {
             continue;
         }
         let layer = layer_names.len() as LayerId;
@@ -69,72 +54,10 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         } else {
             model.name.clone()
         });
-        // Weld by exact bit pattern (+0 and -0 are one point); NaN never welds.
-        let mut welded: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-        let mut local_to_welded = Vec::with_capacity(m.positions.len() / 3);
-        let mut welded_points: Vec<(u64, Vec3)> = Vec::new();
-        for (i, p) in m.positions.chunks_exact(3).enumerate() {
-            let p = Vec3::new(p[0], p[1], p[2]);
-            let unmatched = (1u64 << 32) + i as u64;
-            let order = if p.is_nan() {
-                unmatched
-            } else {
-                file_order
-                    .get(&weld_key(p))
-                    .map_or(unmatched, |&o| o as u64)
-            };
-            let existing = if p.is_nan() {
-                None
-            } else {
-                welded.get(&weld_key(p)).copied()
-            };
-            let id = existing.unwrap_or_else(|| {
-                welded_points.push((order, p));
-                let id = (welded_points.len() - 1) as u32;
-                if !p.is_nan() {
-                    welded.insert(weld_key(p), id);
-                }
-                id
-            });
-            if existing.is_some() {
-                report.welded_vertices += 1;
-            }
-            local_to_welded.push(id);
-        }
-        let mut by_order: Vec<u32> = (0..welded_points.len() as u32).collect();
-        by_order.sort_by_key(|&id| welded_points[id as usize].0);
-        let mut welded_to_global = vec![0u32; welded_points.len()];
-        for &id in &by_order {
-            welded_to_global[id as usize] = positions.len() as u32;
-            positions.push(welded_points[id as usize].1);
-        }
-        let local_to_global: Vec<u32> = local_to_welded
-            .iter()
-            .map(|&id| welded_to_global[id as usize])
-            .collect();
-        for (k, tri) in m.indices.chunks_exact(3).enumerate() {
-            let face = [tri[0], tri[1], tri[2]]
-                .map(|i| local_to_global.get(i as usize).copied().unwrap_or(INVALID));
-            if face.contains(&INVALID) {
-                return Err(IoError::parse(
-                    name,
-                    None,
-                    format!(
-                        "object `{}`: triangle {k} has a vertex index out of range",
-                        model.name
-                    ),
-                ));
-            }
-            if face[0] == face[1] || face[1] == face[2] || face[0] == face[2] {
-                return Err(IoError::parse(
-                    name,
-                    None,
-                    format!(
-                        "object `{}`: triangle {k} uses the same point twice (coincident corners)",
-                        model.name
-                    ),
-                ));
-            }
+        let (points, local_to_global) =
+            weld(&model.mesh, &file_order, positions.len(), &mut report);
+        positions.extend(points);
+        for face in model_faces(model, &local_to_global, name)? {
             faces.push(face);
             face_layers.push(layer);
         }
@@ -145,6 +68,103 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
     let mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
         .map_err(|e| IoError::building(name, e, &positions))?;
     Ok((mesh, report))
+}
+
+/// The file's objects through tobj, triangulated (points and lines ignored); an error names
+/// the line tobj stopped at.
+fn load_models(text: &str, name: &str) -> Result<Vec<tobj::Model>, IoError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let mut reader = LineCounter {
+        inner: io::BufReader::new(text.as_bytes()),
+        lines: 0,
+    };
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
+    Ok(models)
+}
+
+/// One object's points welded by exact bit pattern (+0 and −0 are one point; NaN never welds),
+/// in file order (`file_order`: each point's first line); and each of tobj's vertices' number
+/// in the mesh, the welded points numbered from `base`.
+fn weld(
+    mesh: &tobj::Mesh,
+    file_order: &FxHashMap<[u32; 3], u32>,
+    base: usize,
+    report: &mut ObjReport,
+) -> (Vec<Vec3>, Vec<u32>) {
+    let mut welded: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    let mut local_to_welded = Vec::with_capacity(mesh.positions.len() / 3);
+    let mut welded_points: Vec<(u64, Vec3)> = Vec::new();
+    for (i, p) in mesh.positions.chunks_exact(3).enumerate() {
+        let p = Vec3::new(p[0], p[1], p[2]);
+        let unmatched = (1u64 << 32) + i as u64;
+        let key = (!p.is_nan()).then(|| weld_key(p));
+        let order = key
+            .and_then(|k| file_order.get(&k))
+            .map_or(unmatched, |&o| o as u64);
+        let existing = key.and_then(|k| welded.get(&k).copied());
+        let id = existing.unwrap_or_else(|| {
+            welded_points.push((order, p));
+            let id = (welded_points.len() - 1) as u32;
+            if let Some(k) = key {
+                welded.insert(k, id);
+            }
+            id
+        });
+        if existing.is_some() {
+            report.welded_vertices += 1;
+        }
+        local_to_welded.push(id);
+    }
+    let mut by_order: Vec<u32> = (0..welded_points.len() as u32).collect();
+    by_order.sort_by_key(|&id| welded_points[id as usize].0);
+    let mut welded_to_global = vec![0u32; welded_points.len()];
+    let mut points = Vec::with_capacity(welded_points.len());
+    for &id in &by_order {
+        welded_to_global[id as usize] = (base + points.len()) as u32;
+        points.push(welded_points[id as usize].1);
+    }
+    let local_to_global = local_to_welded
+        .iter()
+        .map(|&id| welded_to_global[id as usize])
+        .collect();
+    (points, local_to_global)
+}
+
+/// An object's triangles in the mesh's numbering; an index out of range or a corner used
+/// twice is an error naming the object and triangle.
+fn model_faces(
+    model: &tobj::Model,
+    local_to_global: &[u32],
+    name: &str,
+) -> Result<Vec<[u32; 3]>, IoError> {
+    let fail = |message: String| Err(IoError::parse(name, None, message));
+    let mut faces = Vec::with_capacity(model.mesh.indices.len() / 3);
+    for (k, tri) in model.mesh.indices.chunks_exact(3).enumerate() {
+        let face = [tri[0], tri[1], tri[2]]
+            .map(|i| local_to_global.get(i as usize).copied().unwrap_or(INVALID));
+        if face.contains(&INVALID) {
+            return fail(format!(
+                "object `{}`: triangle {k} has a vertex index out of range",
+                model.name
+            ));
+        }
+        if face[0] == face[1] || face[1] == face[2] || face[0] == face[2] {
+            return fail(format!(
+                "object `{}`: triangle {k} uses the same point twice (coincident corners)",
+                model.name
+            ));
+        }
+        faces.push(face);
+    }
+    Ok(faces)
 }
 
 /// Checks every `v` and `f` line for what tobj would reject without a line number or accept
