@@ -201,55 +201,18 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         println!("the same strokes on the GPU path ({adapter}):");
         println!("{}", paper_table(&gpu_scenes));
         print!("{}", gpu_memory_lines(&gpu_scenes));
-        for (name, p) in &parities {
-            println!(
-                "parity {name}: max position deviation {}, collisions cpu {} gpu {}; gpu/cpu time: {}",
-                p.max_position_deviation_edges.map_or(
-                    "n/a (remeshing made the topologies differ)".to_string(),
-                    |d| format!("{d:.2e} L")
-                ),
-                p.collision_count_cpu,
-                p.collision_count_gpu,
-                p.gpu_over_cpu
-                    .iter()
-                    .map(|(k, v)| format!("{k} {v:.2}x"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-        }
+        print_parities(&parities);
     }
-    let mut scaling = Vec::new();
-    if options.scaling {
-        for &faces in &options.scaling_sizes {
-            let r = bench_scene(
-                SceneKind::Plaster,
-                faces,
-                options.strokes.min(8),
-                options.seed,
-                (
-                    options.remeshing,
-                    if resolved == Backend::Both {
-                        Backend::Cpu
-                    } else {
-                        resolved
-                    },
-                    options.samples_per_call,
-                ),
-            )?
-            .result;
-            scaling.push(ScalingRow {
-                faces: r.faces,
-                ms_per_sample: r.ms_per_sample,
-                ms_per_remesh: r.ms_per_remesh,
-                samples: r.samples,
-                steps: r.steps,
-                moves: r.moves,
-                gpu_memory: r.gpu_memory,
-            });
-        }
-        println!("scaling: the same strokes (radius 12 L) on plaster of growing size");
-        println!("{}", scaling_table(&scaling));
-    }
+    let scaling = if options.scaling {
+        let backend = if resolved == Backend::Both {
+            Backend::Cpu
+        } else {
+            resolved
+        };
+        scaling_rows(options, backend)?
+    } else {
+        Vec::new()
+    };
     let clean = scenes
         .iter()
         .chain(&gpu_scenes)
@@ -281,6 +244,54 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// One line per scene comparing the GPU path with the CPU's.
+fn print_parities(parities: &[(String, Parity)]) {
+    for (name, p) in parities {
+        println!(
+            "parity {name}: max position deviation {}, collisions cpu {} gpu {}; gpu/cpu time: {}",
+            p.max_position_deviation_edges.map_or(
+                "n/a (remeshing made the topologies differ)".to_string(),
+                |d| format!("{d:.2e} L")
+            ),
+            p.collision_count_cpu,
+            p.collision_count_gpu,
+            p.gpu_over_cpu
+                .iter()
+                .map(|(k, v)| format!("{k} {v:.2}x"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+}
+
+/// `--scaling`: the same strokes (at most 8) on plaster at each of the sizes, printed as a
+/// table.
+fn scaling_rows(options: &Options, backend: Backend) -> anyhow::Result<Vec<ScalingRow>> {
+    let mut scaling = Vec::new();
+    for &faces in &options.scaling_sizes {
+        let r = bench_scene(
+            SceneKind::Plaster,
+            faces,
+            options.strokes.min(8),
+            options.seed,
+            (options.remeshing, backend, options.samples_per_call),
+        )?
+        .result;
+        scaling.push(ScalingRow {
+            faces: r.faces,
+            ms_per_sample: r.ms_per_sample,
+            ms_per_remesh: r.ms_per_remesh,
+            samples: r.samples,
+            steps: r.steps,
+            moves: r.moves,
+            gpu_memory: r.gpu_memory,
+        });
+    }
+    println!("scaling: the same strokes (radius 12 L) on plaster of growing size");
+    println!("{}", scaling_table(&scaling));
+    Ok(scaling)
 }
 
 fn write_svg(path: &Path, rows: &[ScalingRow]) -> anyhow::Result<()> {

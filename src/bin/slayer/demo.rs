@@ -1,10 +1,10 @@
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
 use slayer::bench::{ScriptSpec, generate_script, gpu_memory_lines, paper_table};
-use slayer::brush::{BrushKind, PaintSpec, StencilSpec, StrokeFile};
+use slayer::brush::{BrushKind, PaintSpec, StencilSpec, Stroke, StrokeFile};
 use slayer::gpu::GpuContext;
 use slayer::mesh::Mesh;
 use slayer::pipeline::PipelineSettings;
@@ -73,41 +73,7 @@ pub fn run(
     // The backend first: a wrong choice fails before minutes of work.
     let mut pipeline = crate::backend::choose(backend, PipelineSettings::default())?.pipeline;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let spec = SceneSpec {
-        triangles,
-        ..SceneSpec::new(SceneKind::Plaster)
-    };
-    println!(
-        "slayer demo: default material `{}` with {} triangles",
-        spec.kind, spec.triangles
-    );
-    let started = Instant::now();
-    let steps = Steps::new("demo");
-    steps.step("generating");
-    let mut mesh = generate(&spec)?;
-    let before = out.join("plaster.ply");
-    steps.step(&format!("writing {}", before.display()));
-    slayer::io::write_mesh(&mesh, &before)?;
-    let mut script = generate_script(
-        &mesh,
-        &ScriptSpec {
-            strokes: DEMO_STROKES,
-            ..ScriptSpec::default()
-        },
-    );
-    add_paint(&mut script);
-    let strokes_path = out.join("strokes.json");
-    slayer::io::write_atomically(&strokes_path, script.to_json().as_bytes())?;
-    let strokes = script.resolve(&mesh, &strokes_path.display().to_string())?;
-    steps.finish();
-    println!(
-        "  generated {} layers, {} vertices, {} faces in {:.1} s -> {}",
-        mesh.layer_count(),
-        mesh.live_vertex_count(),
-        mesh.live_face_count(),
-        started.elapsed().as_secs_f64(),
-        before.display()
-    );
+    let (mut mesh, strokes, strokes_path) = generate_scene_and_strokes(out, triangles)?;
 
     // Rendering needs some Vulkan adapter (lavapipe will do); without one the demo still
     // sculpts and says what to install.
@@ -142,16 +108,7 @@ pub fn run(
     println!("{}", paper_table(std::slice::from_ref(&result)));
     print!("{}", gpu_memory_lines(std::slice::from_ref(&result)));
 
-    let after = out.join("plaster-sculpted.ply");
-    let after_obj = out.join("plaster-sculpted.obj");
-    slayer::io::write_mesh(&mesh, &after)?;
-    slayer::io::write_mesh(&mesh, &after_obj)?;
-    println!(
-        "  wrote {}, {} and {}",
-        after.display(),
-        after_obj.display(),
-        after_obj.with_extension("mtl").display()
-    );
+    let after = write_sculpted(out, &mesh)?;
     if let (Some(gpu), Some(before_image)) = (&gpu, before_image) {
         let after_image = render_to(gpu, &mesh, &out.join("plaster-after.png"))?;
         let both = out.join("plaster-before-after.png");
@@ -166,4 +123,63 @@ pub fn run(
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// The default material at `triangles`, written to `plaster.ply`, and the demo's painted
+/// strokes over it, written to `strokes.json` (returned with its path).
+fn generate_scene_and_strokes(
+    out: &Path,
+    triangles: usize,
+) -> anyhow::Result<(Mesh, Vec<Stroke>, PathBuf)> {
+    let spec = SceneSpec {
+        triangles,
+        ..SceneSpec::new(SceneKind::Plaster)
+    };
+    println!(
+        "slayer demo: default material `{}` with {} triangles",
+        spec.kind, spec.triangles
+    );
+    let started = Instant::now();
+    let steps = Steps::new("demo");
+    steps.step("generating");
+    let mesh = generate(&spec)?;
+    let before = out.join("plaster.ply");
+    steps.step(&format!("writing {}", before.display()));
+    slayer::io::write_mesh(&mesh, &before)?;
+    let mut script = generate_script(
+        &mesh,
+        &ScriptSpec {
+            strokes: DEMO_STROKES,
+            ..ScriptSpec::default()
+        },
+    );
+    add_paint(&mut script);
+    let strokes_path = out.join("strokes.json");
+    slayer::io::write_atomically(&strokes_path, script.to_json().as_bytes())?;
+    let strokes = script.resolve(&mesh, &strokes_path.display().to_string())?;
+    steps.finish();
+    println!(
+        "  generated {} layers, {} vertices, {} faces in {:.1} s -> {}",
+        mesh.layer_count(),
+        mesh.live_vertex_count(),
+        mesh.live_face_count(),
+        started.elapsed().as_secs_f64(),
+        before.display()
+    );
+    Ok((mesh, strokes, strokes_path))
+}
+
+/// Writes the sculpted mesh as PLY and as OBJ with its `.mtl`; returns the PLY's path.
+fn write_sculpted(out: &Path, mesh: &Mesh) -> anyhow::Result<PathBuf> {
+    let after = out.join("plaster-sculpted.ply");
+    let after_obj = out.join("plaster-sculpted.obj");
+    slayer::io::write_mesh(mesh, &after)?;
+    slayer::io::write_mesh(mesh, &after_obj)?;
+    println!(
+        "  wrote {}, {} and {}",
+        after.display(),
+        after_obj.display(),
+        after_obj.with_extension("mtl").display()
+    );
+    Ok(after)
 }

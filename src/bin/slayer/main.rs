@@ -246,7 +246,23 @@ fn main() -> ExitCode {
         cli.command,
         Command::Check { json: true, .. } | Command::Adapters { json: true }
     );
-    let result = match cli.command {
+    match dispatch(cli.command) {
+        Ok(code) => code,
+        Err(error) => {
+            let line = one_line(&error);
+            eprintln!("error: {line}");
+            if json_errors {
+                println!("{}", serde_json::json!({ "error": line }));
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Runs a subcommand. A table more than a function: one arm per subcommand, each handing its
+/// arguments on, so it is as long as the list of subcommands.
+fn dispatch(command: Command) -> anyhow::Result<ExitCode> {
+    match command {
         Command::Demo {
             out,
             triangles,
@@ -341,7 +357,7 @@ fn main() -> ExitCode {
                 Ok(scenes) => scenes,
                 Err(e) => {
                     eprintln!("error: {e}");
-                    return ExitCode::FAILURE;
+                    return Ok(ExitCode::FAILURE);
                 }
             };
             bench::run(&bench::Options {
@@ -356,17 +372,6 @@ fn main() -> ExitCode {
                 remeshing: remesh,
                 samples_per_call: samples_per_call.map(|n| n as usize),
             })
-        }
-    };
-    match result {
-        Ok(code) => code,
-        Err(error) => {
-            let line = one_line(&error);
-            eprintln!("error: {line}");
-            if json_errors {
-                println!("{}", serde_json::json!({ "error": line }));
-            }
-            ExitCode::FAILURE
         }
     }
 }
