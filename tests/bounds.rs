@@ -190,3 +190,45 @@ fn absurd_brush_settings_are_refused_when_the_stroke_begins() {
     stroke.add_samples(&[sample(0.0, 0.0, 0.0)]).unwrap();
     stroke.finish().unwrap();
 }
+
+/// A sample whose move needs more than `MAX_STEPS_PER_SAMPLE` steps (here a draw over steps
+/// of a thousandth of an edge: over 400 needed) moves that many steps, none longer than the step
+/// limit, and is counted, not cut silently.
+#[test]
+fn a_runaway_sample_moves_its_most_steps_each_within_the_limit_and_is_counted() {
+    use slayer::pipeline::step::MAX_STEPS_PER_SAMPLE;
+    let mut mesh = slayer::scene::shapes::stacked_sheets(1, 30, 30, 1.0, 0.0);
+    let start = mesh.clone();
+    let mut stroke = stroke_of(StrokeSettings {
+        layers: vec![0],
+        ..settings(6.0)
+    });
+    stroke.brush.strength = 0.8;
+    stroke.brush.invert = false;
+    stroke.samples = vec![Sample {
+        normal: Some(Vec3::Z),
+        ..sample(15.0, 15.0, 0.0)
+    }];
+    let max_step = 0.001;
+    let mut pipeline = Pipeline::new(PipelineSettings {
+        max_step,
+        remeshing: slayer::pipeline::Remeshing::Off,
+        ..PipelineSettings::default()
+    });
+    let report = pipeline.apply_stroke(&mut mesh, &stroke).unwrap();
+    assert_eq!(report.capped_samples, 1, "{report:?}");
+    assert_eq!(report.steps, MAX_STEPS_PER_SAMPLE);
+    // The centre would rise 0.1 · 6 · 0.8 = 0.48; it rises 256 steps of at most 0.001 L.
+    let edge = pipeline.edge_length().unwrap();
+    let limit = MAX_STEPS_PER_SAMPLE as f32 * max_step * edge * 1.0001;
+    let centre = 15 * 31 + 15;
+    let rise = mesh.positions()[centre].z - start.positions()[centre].z;
+    assert!(rise > 0.2 && rise <= limit, "rose {rise}");
+    let farthest = mesh
+        .positions()
+        .iter()
+        .zip(start.positions())
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max);
+    assert!(farthest <= limit, "a vertex moved {farthest}");
+}

@@ -166,6 +166,9 @@ pub struct StrokeReport {
     pub clamped: usize,
     /// Moves undone by the exact backstop.
     pub reverted: usize,
+    /// Samples whose move needed more than [`step::MAX_STEPS_PER_SAMPLE`] steps (a runaway brush):
+    /// each moved only that many steps of at most `max_step`.
+    pub capped_samples: usize,
     /// Distinct vertices the stroke moved.
     pub touched: usize,
     /// What remeshing did, summed over the stroke's remeshing passes.
@@ -186,6 +189,7 @@ impl StrokeReport {
         self.moves += call.moves;
         self.clamped += call.clamped;
         self.reverted += call.reverted;
+        self.capped_samples += call.capped_samples;
         self.phases.add(&call.phases);
     }
 }

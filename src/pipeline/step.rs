@@ -72,14 +72,45 @@ pub fn frame_of_sums(sums: &cpu::FrameSums, probe: &Dab, normal: Option<Vec3>) -
     }
 }
 
-/// Steps per sample are capped: a sample asking for more is a runaway brush, and moves farther
-/// than this many steps of `max_step` in this many.
+/// Steps per sample are capped: a sample asking for more is a runaway brush. It moves this many
+/// steps of at most `max_step` each, so short of its whole move, and is counted
+/// ([`StrokeReport::capped_samples`](crate::pipeline::StrokeReport::capped_samples)).
 pub const MAX_STEPS_PER_SAMPLE: usize = 256;
+
+/// How a sample's move is split into steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepSplit {
+    pub steps: usize,
+    /// The share of the sample's whole move each step carries: `1 / steps`, less when capped.
+    pub share: f32,
+    /// The move needed more than [`MAX_STEPS_PER_SAMPLE`] steps.
+    pub capped: bool,
+}
 
 /// The steps a sample whose longest move is `longest_move` takes, each of at most
 /// `step_limit` (Algorithm 2 splits a motion so that no step crosses a layer).
-pub fn steps_for(longest_move: f32, step_limit: f32) -> usize {
-    ((longest_move / step_limit).ceil() as usize).clamp(1, MAX_STEPS_PER_SAMPLE)
+pub fn steps_for(longest_move: f32, step_limit: f32) -> StepSplit {
+    let needed = (longest_move / step_limit).ceil();
+    if needed.is_nan() || needed <= 1.0 {
+        return StepSplit {
+            steps: 1,
+            share: 1.0,
+            capped: false,
+        };
+    }
+    if needed > MAX_STEPS_PER_SAMPLE as f32 {
+        return StepSplit {
+            steps: MAX_STEPS_PER_SAMPLE,
+            share: 1.0 / needed,
+            capped: true,
+        };
+    }
+    let steps = needed as usize;
+    StepSplit {
+        steps,
+        share: 1.0 / steps as f32,
+        capped: false,
+    }
 }
 
 /// The longest move from each selected vertex's position in `mesh` to its target.

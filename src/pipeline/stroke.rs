@@ -39,6 +39,9 @@ pub struct SamplesReport {
     pub moves: usize,
     pub clamped: usize,
     pub reverted: usize,
+    /// Samples whose move needed more than [`MAX_STEPS_PER_SAMPLE`](super::step::MAX_STEPS_PER_SAMPLE)
+    /// steps: each moved only that many steps' worth.
+    pub capped_samples: usize,
     /// Vertices whose position, normal, BRDF or mask changed in this call (ascending): what a
     /// viewer uploads again. Vertices remeshing added are among them.
     pub changed: Vec<u32>,
@@ -476,12 +479,14 @@ impl Active {
             None => kernels.deform(&self.state(), mesh, &whole, &first_selection, None),
         };
         let limit = self.lengths.step_limit;
-        let steps = steps_for(longest_move(mesh, &first_selection, &full), limit);
+        let split = steps_for(longest_move(mesh, &first_selection, &full), limit);
+        let steps = split.steps;
+        call.capped_samples += usize::from(split.capped);
         call.phases.deformation += millis(started);
         let mut moved_in_sample = Vec::new();
         for k in 0..steps {
             let dab = Dab {
-                share: 1.0 / steps as f32,
+                share: split.share,
                 ..whole
             };
             let at = CallAt::Step {

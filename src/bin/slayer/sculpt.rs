@@ -4,6 +4,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use slayer::brush::{Stroke, StrokeFile, SymmetrySpec, dabs_for};
 use slayer::io::AtomicBatch;
+use slayer::pipeline::step::MAX_STEPS_PER_SAMPLE;
 use slayer::pipeline::{PipelineSettings, Remeshing, StrokeReport};
 
 use crate::progress::Bar;
@@ -62,6 +63,12 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
                 "note: the history passed its cap of {} MiB; its {} oldest entries were dropped",
                 session.history().cap_bytes() >> 20,
                 recorded.dropped
+            ));
+        }
+        if report.capped_samples > 0 {
+            bar.println(&format!(
+                "warning: strokes[{i}]: {} samples moved farther than {MAX_STEPS_PER_SAMPLE} steps allow and were cut short (a runaway brush: lower its strength or radius)",
+                report.capped_samples
             ));
         }
         reports.push(report);

@@ -126,10 +126,12 @@ impl Active {
             })
             .collect();
         let (selection, first_targets) = union_of_moves(mesh, sides, &full);
-        let steps = steps_for(
+        let split = steps_for(
             longest_move(mesh, &selection, &first_targets),
             self.lengths.step_limit,
         );
+        let steps = split.steps;
+        call.capped_samples += usize::from(split.capped);
         call.phases.deformation += millis(started);
         let mut moved = Vec::new();
         let mut first_targets = Some(first_targets);
@@ -139,7 +141,7 @@ impl Active {
                 None => {
                     let started = Instant::now();
                     let state = self.state();
-                    let share = 1.0 / steps as f32;
+                    let share = split.share;
                     let shares: Vec<Vec<Vec3>> = sides
                         .iter()
                         .zip(&whole)
