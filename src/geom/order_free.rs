@@ -60,8 +60,8 @@ enum IntegerSum {
     Sum(IVec3, i32),
 }
 
-/// The terms' sum in integers. Integer addition is associative, so the order of the terms does not matter, and a
-/// reflection (negated components) reflects the sum exactly.
+/// The terms' sum in integers. Integer addition is associative, so the order of the terms does
+/// not matter, and a reflection (negated components) reflects the sum exactly.
 fn integer_sum<I: Iterator<Item = Vec3>>(terms: impl Fn() -> I) -> IntegerSum {
     let mut largest = 0.0f32;
     let mut count = 0u32;
