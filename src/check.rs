@@ -48,6 +48,9 @@ pub struct CheckReport {
     pub smallest_closed_faces: Option<usize>,
     /// With `--against ORIGINAL`: each closed component of the original and its volume here.
     pub volume_changes: Option<Vec<VolumeChange>>,
+    /// With `--against ORIGINAL`: faces on the same three vertices in both whose normal now
+    /// points against the original's (turned over: a fold the intersection test cannot see).
+    pub turned_over_faces: Option<usize>,
     /// The vertex grid the engine would build (cell = mean edge length).
     pub grid: Option<GridFigures>,
     /// One line per defect; empty when the mesh is clean.
@@ -86,7 +89,21 @@ impl CheckReport {
             }
         }
         self.volume_changes = Some(changes);
+        self.turned_over_faces = Some(turned_over_faces(mesh, original));
     }
+}
+
+/// Faces on the same three vertices in `mesh` and `original` whose normals point apart.
+pub fn turned_over_faces(mesh: &Mesh, original: &Mesh) -> usize {
+    let shared = mesh.face_count().min(original.face_count());
+    (0..shared)
+        .filter(|&f| {
+            let face = mesh.faces()[f];
+            face[0] != crate::mesh::INVALID
+                && face == original.faces()[f]
+                && mesh.face_normal(f).dot(original.face_normal(f)) < 0.0
+        })
+        .count()
 }
 
 /// One closed component of an original mesh and the component of the same layer nearest to
@@ -217,6 +234,7 @@ pub fn check_mesh(
         closed_components: closed.len(),
         smallest_closed_faces,
         volume_changes: None,
+        turned_over_faces: None,
         grid,
         defects,
         digest: mesh.digest(),
@@ -349,6 +367,9 @@ impl std::fmt::Display for CheckReport {
                 "  closed            {} components, the smallest {smallest} faces",
                 self.closed_components
             )?;
+        }
+        if let Some(turned) = self.turned_over_faces {
+            writeln!(f, "  turned over       {turned} faces against the original")?;
         }
         for c in self.volume_changes.iter().flatten() {
             match (c.after, c.change) {

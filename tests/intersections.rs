@@ -232,3 +232,25 @@ fn the_smallest_layer_gap_is_measured() {
         None
     );
 }
+
+/// `check --against` counts the faces turned over since the original (their normal points
+/// against the original's): none for the original itself, some once a vertex is pulled
+/// across the faces around it.
+#[test]
+fn faces_turned_over_are_counted_against_the_original() {
+    let original = shapes::stacked_sheets(1, 4, 4, 1.0, 0.0);
+    let notes = slayer::io::LoadNotes::default();
+    let mut same = slayer::check::check_mesh(&original, &notes, "same", |_| {});
+    same.compare_with(&original, &original);
+    assert_eq!(same.turned_over_faces, Some(0));
+    let mut folded = original.clone();
+    // Vertex (1, 1) pulled past (2, 2): the faces it shares with its lower-left neighbours
+    // turn over.
+    folded.positions_mut()[6] = Vec3::new(2.5, 2.5, 0.0);
+    let turned = slayer::check::turned_over_faces(&folded, &original);
+    assert!(turned > 0, "{turned}");
+    let mut report = slayer::check::check_mesh(&folded, &notes, "folded", |_| {});
+    report.compare_with(&folded, &original);
+    assert_eq!(report.turned_over_faces, Some(turned));
+    assert!(report.to_string().contains("turned over"), "{report}");
+}
