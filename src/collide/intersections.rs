@@ -69,16 +69,15 @@ pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
     let mut found = pairs_in_cells(&entries, &boxes, &cells, &pairs);
     found.extend(pairs_with_oversized(&oversized, &boxes, &usable, &pairs));
     found.par_sort_unstable();
-    let folded_neighbours = found
-        .iter()
-        .filter(|p| pairs.shares_vertex(p.face_a, p.face_b))
-        .count();
     let layers = mesh.face_layers();
-    let between_layers = found
-        .iter()
-        .filter(|p| !pairs.shares_vertex(p.face_a, p.face_b))
-        .filter(|p| layers[p.face_a as usize] != layers[p.face_b as usize])
-        .count();
+    let (mut folded_neighbours, mut between_layers) = (0, 0);
+    for p in &found {
+        if pairs.shares_vertex(p.face_a, p.face_b) {
+            folded_neighbours += 1;
+        } else if layers[p.face_a as usize] != layers[p.face_b as usize] {
+            between_layers += 1;
+        }
+    }
     IntersectionReport {
         between_layers,
         within_layers: found.len() - between_layers - folded_neighbours,

@@ -32,14 +32,8 @@ pub fn vertex_normal(positions: &[f32], topology: &[u32], vertex_rows_base: u32,
     geom::fan_normal(|| {
         (first..first + topology[row + 1]).map(move |k| {
             let f = topology[k as usize] as usize;
-            let [a, b, c] = [topology[4 * f], topology[4 * f + 1], topology[4 * f + 2]];
-            let [p, q] = match v {
-                _ if v == a => [b, c],
-                _ if v == b => [c, a],
-                _ => [a, b],
-            };
-            let at = |i: u32| packed_position(positions, i);
-            geom::corner_cross(at(v), at(p), at(q))
+            let face = [topology[4 * f], topology[4 * f + 1], topology[4 * f + 2]];
+            geom::corner_cross(face, v, |i| packed_position(positions, i))
         })
     })
 }

@@ -16,10 +16,18 @@ use glam::{IVec3, Vec3};
 /// `i32`.
 const TERM_BITS: u32 = 22;
 
-/// The cross product of a face at its corner `v`: `(p − v) × (q − v)`, where `p` and `q`
-/// follow `v` in the face's winding. Twice the face's area along its normal.
-pub fn corner_cross(v: Vec3, p: Vec3, q: Vec3) -> Vec3 {
-    (p - v).cross(q - v)
+/// The cross product of `face` at its corner `v`: `(p − v) × (q − v)`, where `p` and `q`
+/// follow `v` in the face's winding (`position` gives a vertex's position). Twice the face's
+/// area along its normal, the same whichever corner the face lists first.
+pub fn corner_cross(face: [u32; 3], v: u32, position: impl Fn(u32) -> Vec3) -> Vec3 {
+    let [a, b, c] = face;
+    let [p, q] = match v {
+        _ if v == a => [b, c],
+        _ if v == b => [c, a],
+        _ => [a, b],
+    };
+    let at = position(v);
+    (position(p) - at).cross(position(q) - at)
 }
 
 /// The unit normal of a fan from its faces' [`corner_cross`]es (`fan` yields them, and is

@@ -121,14 +121,9 @@ impl Mesh {
         }
         geom::fan_normal(|| {
             self.faces_around(vertex).map(move |face| {
-                let [a, b, c] = self.faces[face as usize];
-                let [p, q] = match vertex {
-                    v if v == a => [b, c],
-                    v if v == b => [c, a],
-                    _ => [a, b],
-                };
-                let at = |i: u32| self.positions[i as usize];
-                geom::corner_cross(at(vertex), at(p), at(q))
+                geom::corner_cross(self.faces[face as usize], vertex, |i| {
+                    self.positions[i as usize]
+                })
             })
         })
     }
