@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use crate::collide::{find_intersections, smallest_layer_gap};
 use crate::grid::SpatialHash;
-use crate::io::LoadNotes;
+use crate::io::ImportReport;
 use crate::mesh::{ClosedComponent, Mesh};
 use crate::remesh::MIN_CLOSED_FACES;
 
@@ -53,6 +53,12 @@ pub struct CheckReport {
     pub turned_over_faces: Option<usize>,
     /// The vertex grid the engine would build (cell = mean edge length).
     pub grid: Option<GridFigures>,
+    /// What reading the file repaired (all zero for a clean file or a session).
+    pub repairs: crate::mesh::Repairs,
+    /// What the file held that the mesh does not keep (texture coordinates, normals, ...).
+    pub not_kept: Vec<String>,
+    /// Other notes from reading the file (a material library not read).
+    pub import_notes: Vec<String>,
     /// One line per defect; empty when the mesh is clean.
     pub defects: Vec<String>,
     /// The content digest ([`Mesh::digest`]): equal for the same mesh however it was stored.
@@ -168,7 +174,7 @@ pub struct GridFigures {
 /// Measures a loaded mesh. `progress` is told which step is running.
 pub fn check_mesh(
     mesh: &Mesh,
-    notes: &LoadNotes,
+    notes: &ImportReport,
     file: &str,
     mut progress: impl FnMut(&str),
 ) -> CheckReport {
@@ -236,6 +242,9 @@ pub fn check_mesh(
         volume_changes: None,
         turned_over_faces: None,
         grid,
+        repairs: notes.repairs,
+        not_kept: notes.not_kept.clone(),
+        import_notes: notes.notes.clone(),
         defects,
         digest: mesh.digest(),
     }
@@ -316,6 +325,15 @@ impl Found<'_> {
 impl std::fmt::Display for CheckReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(f, "{}", self.file)?;
+        if self.repairs.any() {
+            writeln!(f, "  repaired          {}", self.repairs)?;
+        }
+        if !self.not_kept.is_empty() {
+            writeln!(f, "  not kept          {}", self.not_kept.join(", "))?;
+        }
+        for note in &self.import_notes {
+            writeln!(f, "  note              {note}")?;
+        }
         writeln!(f, "  vertices          {}", self.vertices)?;
         writeln!(f, "  faces             {}", self.faces)?;
         writeln!(f, "  layers            {}", self.layers)?;

@@ -202,7 +202,7 @@ fn a_face_folded_onto_its_neighbours_is_counted() {
         find_intersections(&mesh).total(),
         counts(&mesh).0 + counts(&mesh).1 + folded
     );
-    let notes = slayer::io::LoadNotes::default();
+    let notes = slayer::io::ImportReport::default();
     let report = slayer::check::check_mesh(&mesh, &notes, "folded", |_| {});
     assert_eq!(report.folded_neighbours, folded);
     assert!(
@@ -239,7 +239,7 @@ fn the_smallest_layer_gap_is_measured() {
 #[test]
 fn faces_turned_over_are_counted_against_the_original() {
     let original = shapes::stacked_sheets(1, 4, 4, 1.0, 0.0);
-    let notes = slayer::io::LoadNotes::default();
+    let notes = slayer::io::ImportReport::default();
     let mut same = slayer::check::check_mesh(&original, &notes, "same", |_| {});
     same.compare_with(&original, &original);
     assert_eq!(same.turned_over_faces, Some(0));

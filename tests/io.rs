@@ -4,7 +4,9 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use slayer::io::{Format, encode_mesh, load_mesh_bytes, read_mesh_bytes};
+use slayer::io::{
+    Format, ImportOptions, encode_mesh, import_bytes, load_mesh_bytes, no_libraries, read_mesh_bytes,
+};
 use slayer::mesh::{Brdf, Mesh, VertexFlags};
 use slayer::scene::{SceneKind, SceneSpec, generate, shapes};
 
@@ -66,14 +68,31 @@ fn ascii_ply_with_quads_and_extra_properties() {
                 property list uchar int vertex_indices\nproperty int layer\nelement edge 1\n\
                 property int a\nproperty int b\nend_header\n0 0 0 255\n1 0 0 0\n1 1 0 0\n0 1 0 0\n\
                 9 9 9 0\n9 8 9 0\n8 9 9 0\n4 0 1 2 3 0\n3 4 4 4 1\n0 1\n";
-    // The second face repeats a vertex: an error naming the face.
-    let e = read_mesh_bytes(text.as_bytes(), Format::Ply, "q.ply")
+    // The second face repeats a vertex: dropped, with its three vertices, or under strict an
+    // error naming the face.
+    let lenient = ImportOptions::default();
+    let (mesh, report) = import_bytes(text.as_bytes(), Format::Ply, "q.ply", &lenient).unwrap();
+    assert_eq!(mesh.live_face_count(), 2, "a quad becomes two triangles");
+    assert_eq!(report.repairs.degenerate_faces, 1);
+    assert_eq!(report.repairs.unreferenced_vertices, 3);
+    let strict = ImportOptions { strict: true };
+    let e = import_bytes(text.as_bytes(), Format::Ply, "q.ply", &strict)
         .unwrap_err()
         .to_string();
     assert!(e.contains("face") && e.contains("repeats"), "{e}");
+    // Another tool's `layer` is not ours: one layer, and the property listed as not kept.
     let fixed = text.replace("3 4 4 4 1", "3 4 5 6 1");
-    let mesh = read_mesh_bytes(fixed.as_bytes(), Format::Ply, "q.ply").unwrap();
-    assert_eq!(mesh.live_face_count(), 3, "a quad becomes two triangles");
+    let (mesh, report) = import_bytes(fixed.as_bytes(), Format::Ply, "q.ply", &lenient).unwrap();
+    assert_eq!(mesh.live_face_count(), 3);
+    assert_eq!(mesh.layer_count(), 1);
+    assert_eq!(
+        report.not_kept,
+        ["face properties `layer`", "1 `edge` rows"],
+        "{report:?}"
+    );
+    // The same file said to be slayer's: its `layer` is read.
+    let ours = fixed.replace("comment hand made", "comment written by slayer");
+    let mesh = read_mesh_bytes(ours.as_bytes(), Format::Ply, "q.ply").unwrap();
     assert_eq!(mesh.layer_count(), 2);
 }
 
@@ -144,7 +163,7 @@ fn malformed_obj_names_file_line_and_problem() {
         ("# nothing here\n", "t.obj: no faces"),
         (
             "v 0 0 0\nv 1 0 0\nv 0 0 0\nf 1 2 3\n",
-            "uses the same point twice",
+            "t.obj: no faces left after the repair (1 degenerate face dropped",
         ),
     ];
     for (text, expected) in cases {
@@ -158,9 +177,12 @@ fn malformed_obj_names_file_line_and_problem() {
 }
 
 #[test]
-fn non_manifold_obj_names_the_edge_and_where_it_is() {
+fn non_manifold_obj_under_strict_names_the_edge_and_where_it_is() {
     let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
-    let e = read(text).unwrap_err();
+    let strict = ImportOptions { strict: true };
+    let e = import_bytes(text.as_bytes(), Format::Obj, "t.obj", &strict)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("non-manifold edge") && e.contains("at (0, 0, 0)"),
         "{e}"
@@ -175,7 +197,7 @@ fn malformed_ply_is_reported() {
         (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n0\n0\n0\n", "no `y` property"),
         (
             b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0",
-            "file ends before all elements are read",
+            "the header's element counts need at least 48000000000 bytes, but the file holds 2",
         ),
         (
             b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n",
@@ -264,6 +286,7 @@ fn thousands_of_mangled_files_give_an_error_or_a_valid_mesh() {
             .to_vec(),
     ));
     let (mut ok, mut errors) = (0, 0);
+    let lenient = ImportOptions::default();
     for round in 0..3000 {
         let (format, original) = &sources[round % sources.len()];
         let bytes = mangle(original, &mut rng);
@@ -279,7 +302,7 @@ fn thousands_of_mangled_files_give_an_error_or_a_valid_mesh() {
             }
         }
         // The lenient path used by `slayer check` must not panic either.
-        let _ = load_mesh_bytes(&bytes, *format, "mangled");
+        let _ = load_mesh_bytes(&bytes, *format, "mangled", &lenient, &no_libraries);
     }
     assert!(
         ok > 100 && errors > 1000,

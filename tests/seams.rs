@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use slayer::collide::find_intersections;
-use slayer::io::parse_obj;
+use slayer::io::{Format, read_mesh_bytes};
 
 /// A geodesic sphere as OBJ text, its faces in group `top` (centroid above z = 0) or `bottom`,
 /// all of them on one shared vertex list: the seam's vertices belong to both groups.
@@ -51,7 +51,7 @@ fn check_json(path: &std::path::Path) -> (bool, serde_json::Value) {
 #[test]
 fn groups_meeting_along_a_seam_are_not_intersecting() {
     let text = sphere_in_two_groups("");
-    let (mesh, _) = parse_obj(text.as_bytes(), "seam.obj").unwrap();
+    let mesh = read_mesh_bytes(text.as_bytes(), Format::Obj, "seam.obj").unwrap();
     assert_eq!(mesh.layer_count(), 2, "one layer per group");
     let report = find_intersections(&mesh);
     assert_eq!(report.total(), 0, "{report:?}");
@@ -72,7 +72,7 @@ fn groups_that_truly_cross_are_still_counted() {
         .positions()
         .len();
     writeln!(text, "f {} {} {}", n + 1, n + 2, n + 3).unwrap();
-    let (mesh, _) = parse_obj(text.as_bytes(), "crossing.obj").unwrap();
+    let mesh = read_mesh_bytes(text.as_bytes(), Format::Obj, "crossing.obj").unwrap();
     let report = find_intersections(&mesh);
     assert!(report.between_layers > 0, "{report:?}");
 

@@ -9,7 +9,7 @@ use std::process::Command;
 use glam::Vec3;
 use slayer::brush::BrushKind;
 use slayer::check::check_mesh;
-use slayer::io::LoadNotes;
+use slayer::io::ImportReport;
 use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
 use slayer::remesh::{RemeshSettings, VOLUME_TOLERANCE, remesh_all};
@@ -133,7 +133,7 @@ fn a_smooth_dab_at_a_cube_corner_keeps_the_cube() {
 fn check_reports_a_closed_component_of_four_faces() {
     let report = check_mesh(
         &shapes::tetrahedron(),
-        &LoadNotes::default(),
+        &ImportReport::default(),
         "tetra",
         |_| {},
     );
@@ -144,7 +144,7 @@ fn check_reports_a_closed_component_of_four_faces() {
         report.defects
     );
     assert!(!report.is_clean());
-    let octahedron = check_mesh(&shapes::octahedron(), &LoadNotes::default(), "octa", |_| {});
+    let octahedron = check_mesh(&shapes::octahedron(), &ImportReport::default(), "octa", |_| {});
     assert!(octahedron.is_clean(), "{:?}", octahedron.defects);
 }
 

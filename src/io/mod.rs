@@ -1,25 +1,30 @@
-//! Mesh files: OBJ (tobj underneath, one layer per `o`/`g`) and PLY (per-vertex BRDF and layer
-//! ids). Readers never panic on malformed input: every problem becomes an [`IoError`] naming the
-//! file and, where it applies, the line. Only regular files are read, at most
+//! Mesh files: OBJ (tobj underneath, one layer per `o`/`g`, materials from its `.mtl`) and PLY
+//! (per-vertex BRDF or colours, layer ids). Readers never panic on malformed input: every
+//! problem becomes an [`IoError`] naming the file and, where it applies, the line; a readable
+//! file that is not a clean manifold mesh is repaired and the repairs reported
+//! ([`ImportReport`]), or refused when the options say strict. Only regular files are read, at most
 //! [`MAX_INPUT_BYTES`](crate::files::MAX_INPUT_BYTES) of them. Writers go through temporary files
 //! and renames ([`AtomicBatch`]), so a failed write never leaves half a mesh where a good one
 //! was, nor an OBJ without its `.mtl`.
 
 mod atomic;
 mod error;
+mod import;
+mod mtl;
 mod obj;
 mod ply;
 
 pub use atomic::{AtomicBatch, sweep_stale_temporaries, write_atomically};
 pub use error::IoError;
-pub use obj::{
-    ObjReport, layer_materials, parse_obj, write_mtl, write_obj, write_obj_with_materials,
-};
-pub use ply::{parse_ply, write_ply};
+pub use import::{ImportOptions, ImportReport};
+pub use mtl::{layer_materials, material_brdf, write_mtl};
+pub use obj::{LibraryReader, write_obj, write_obj_with_materials};
+pub use ply::write_ply;
 
-use std::path::Path;
+use std::path::{Component, Path};
 
 use crate::mesh::Mesh;
+use import::Parsed;
 
 /// File formats by extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,76 +50,101 @@ impl Format {
     }
 }
 
-/// What a lenient load found besides the mesh.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LoadNotes {
-    /// Vertices with a non-finite coordinate, and the first such line (OBJ).
-    pub non_finite_vertices: usize,
-    pub first_non_finite_line: Option<usize>,
-}
-
-/// Reads a mesh and checks it: malformed files, non-finite values and broken meshes are errors.
+/// Reads a mesh, repaired where it needs it: malformed files, non-finite values and what no
+/// repair can mend are errors.
 pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
-    let format = Format::of_path(path)?;
-    let bytes = read_bytes(path)?;
-    read_mesh_bytes(&bytes, format, &path.display().to_string())
+    import_mesh(path, &ImportOptions::default()).map(|(mesh, _)| mesh)
 }
 
-/// [`read_mesh`] on bytes already in memory (`name` is used in messages).
+/// [`read_mesh`] with `options`, and the report of what the import repaired and left out.
+pub fn import_mesh(path: &Path, options: &ImportOptions) -> Result<(Mesh, ImportReport), IoError> {
+    let (mesh, report) = load_mesh(path, options)?;
+    refuse_unusable(mesh, report, &path.display().to_string())
+}
+
+/// [`read_mesh`] on bytes already in memory (`name` is used in messages; an OBJ's material
+/// libraries are not read).
 pub fn read_mesh_bytes(bytes: &[u8], format: Format, name: &str) -> Result<Mesh, IoError> {
-    let (mesh, notes) = load_mesh_bytes(bytes, format, name)?;
-    if notes.non_finite_vertices > 0 {
+    import_bytes(bytes, format, name, &ImportOptions::default()).map(|(mesh, _)| mesh)
+}
+
+/// [`import_mesh`] on bytes already in memory.
+pub fn import_bytes(
+    bytes: &[u8],
+    format: Format,
+    name: &str,
+    options: &ImportOptions,
+) -> Result<(Mesh, ImportReport), IoError> {
+    let (mesh, report) = load_mesh_bytes(bytes, format, name, options, &no_libraries)?;
+    refuse_unusable(mesh, report, name)
+}
+
+/// Refuses non-finite positions (which `check` reports instead) and anything the mesh's own
+/// validation finds.
+fn refuse_unusable(
+    mesh: Mesh,
+    report: ImportReport,
+    name: &str,
+) -> Result<(Mesh, ImportReport), IoError> {
+    if report.non_finite_vertices > 0 {
         return Err(IoError::Parse {
             path: name.to_string(),
-            line: notes.first_non_finite_line,
+            line: report.first_non_finite_line,
             message: format!(
                 "{} vertices have a non-finite coordinate (NaN or infinity)",
-                notes.non_finite_vertices
+                report.non_finite_vertices
             ),
         });
     }
     mesh.validate()
         .map_err(|source| IoError::mesh(name.to_string(), source, &mesh))?;
-    Ok(mesh)
+    Ok((mesh, report))
 }
 
-/// Reads a mesh that is well-formed as a file and as a manifold surface, but lets non-finite
-/// or out-of-range values through (counted in the notes) so that `slayer check` can report them.
-pub fn load_mesh(path: &Path) -> Result<(Mesh, LoadNotes), IoError> {
+/// Reads a mesh that is well-formed as a file and, repaired unless strict, as a manifold
+/// surface, but lets non-finite or out-of-range values through (counted in the report) so that
+/// `slayer check` can report them.
+pub fn load_mesh(path: &Path, options: &ImportOptions) -> Result<(Mesh, ImportReport), IoError> {
     let format = Format::of_path(path)?;
     let bytes = read_bytes(path)?;
-    load_mesh_bytes(&bytes, format, &path.display().to_string())
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let beside = |library: &str| read_library(folder, library);
+    load_mesh_bytes(&bytes, format, &path.display().to_string(), options, &beside)
 }
 
-/// [`load_mesh`] on bytes already in memory.
+/// [`load_mesh`] on bytes already in memory; `libraries` reads the material libraries an OBJ
+/// names.
 pub fn load_mesh_bytes(
     bytes: &[u8],
     format: Format,
     name: &str,
-) -> Result<(Mesh, LoadNotes), IoError> {
-    match format {
-        Format::Obj => {
-            let (mesh, report) = parse_obj(bytes, name)?;
-            Ok((
-                mesh,
-                LoadNotes {
-                    non_finite_vertices: report.non_finite_vertices,
-                    first_non_finite_line: report.first_non_finite_line,
-                },
-            ))
-        }
-        Format::Ply => {
-            let mesh = parse_ply(bytes, name)?;
-            let non_finite = mesh.positions().iter().filter(|p| !p.is_finite()).count();
-            Ok((
-                mesh,
-                LoadNotes {
-                    non_finite_vertices: non_finite,
-                    first_non_finite_line: None,
-                },
-            ))
-        }
+    options: &ImportOptions,
+    libraries: LibraryReader<'_>,
+) -> Result<(Mesh, ImportReport), IoError> {
+    let parsed: Parsed = match format {
+        Format::Obj => obj::parse_obj(bytes, name, libraries)?,
+        Format::Ply => ply::parse_ply(bytes, name)?,
+    };
+    import::build(parsed, options, name)
+}
+
+/// A reader of material libraries for bytes that came from no folder.
+pub fn no_libraries(_: &str) -> Result<Vec<u8>, String> {
+    Err("the mesh was not read from a folder".into())
+}
+
+/// A material library named in an OBJ in `folder`: a relative path that stays in the folder
+/// (an OBJ must not make slayer read `/etc/passwd` or `../../secret`).
+fn read_library(folder: &Path, library: &str) -> Result<Vec<u8>, String> {
+    let relative = Path::new(library);
+    if !relative
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+    {
+        return Err("only a file in the OBJ's folder is read".into());
     }
+    crate::files::read_input(&folder.join(relative), crate::files::MAX_INPUT_BYTES)
+        .map_err(|e| e.to_string())
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {

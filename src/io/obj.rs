@@ -1,26 +1,32 @@
 //! Wavefront OBJ. tobj parses and triangulates; a pre-scan of our own finds what tobj would
 //! reject or mis-handle (bad numbers, indices out of range or zero, non-finite values) and names
-//! the line, since tobj's errors carry none. Each object or group becomes a layer, and vertices
-//! at identical positions within a layer are welded.
+//! the line, since tobj's errors carry none. Each object or group becomes a layer (an object
+//! tobj split at a material change is joined again), vertices at identical positions within a
+//! layer are welded, and faces take the BRDF of their material (`usemtl`, from the `mtllib`
+//! beside the file, [`super::mtl`]). What an OBJ holds that a mesh does not keep (texture
+//! coordinates, normals, lines) is counted in the import report.
 
+use std::cell::RefCell;
 use std::io::{self, BufRead, Write};
 
 use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use super::IoError;
+use super::import::{ImportReport, Parsed};
+use super::mtl::{material_brdf, material_not_kept, sanitize_name};
 use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh};
 
-/// What parsing found besides the mesh.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ObjReport {
-    pub non_finite_vertices: usize,
-    pub first_non_finite_line: Option<usize>,
-    pub welded_vertices: usize,
-}
+/// Reads a material library an OBJ names (`mtllib NAME`): its bytes, or why not.
+pub type LibraryReader<'a> = &'a dyn Fn(&str) -> Result<Vec<u8>, String>;
 
-/// Parses OBJ bytes into a mesh (`name` is used in messages).
-pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError> {
+/// Parses OBJ bytes (`name` is used in messages); `library` reads the material libraries the
+/// file names.
+pub(crate) fn parse_obj(
+    bytes: &[u8],
+    name: &str,
+    library: LibraryReader<'_>,
+) -> Result<Parsed, IoError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let line = 1 + bytes[..e.valid_up_to()]
             .iter()
@@ -28,8 +34,14 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
             .count();
         IoError::parse(name, Some(line), "not a text file (invalid UTF-8)")
     })?;
+    // Editors on Windows start UTF-8 files with a byte-order mark tobj would take as a word.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let (mut report, file_positions) = prescan(text, name)?;
-    let models = load_models(text, name)?;
+    let (models, materials) = load_models(text, name, library, &mut report)?;
+    let brdfs: Vec<Brdf> = materials.iter().map(material_brdf).collect();
+    for material in &materials {
+        report.not_kept.extend(material_not_kept(material));
+    }
 
     // tobj numbers each object's vertices in the order faces first use them; putting them back
     // in file order keeps vertex numbers stable across a write and a read.
@@ -40,39 +52,74 @@ pub fn parse_obj(bytes: &[u8], name: &str) -> Result<(Mesh, ObjReport), IoError>
         }
     }
 
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut faces: Vec<[u32; 3]> = Vec::new();
-    let mut face_layers: Vec<LayerId> = Vec::new();
-    let mut layer_names: Vec<String> = Vec::new();
-    for model in &models {
-        if model.mesh.indices.len() < 3 {
-            continue;
-        }
-        let layer = layer_names.len() as LayerId;
-        layer_names.push(if model.name.is_empty() || model.name == "unnamed_object" {
-            format!("layer{layer}")
-        } else {
-            model.name.clone()
-        });
-        let (points, local_to_global) =
-            weld(&model.mesh, &file_order, positions.len(), &mut report);
-        positions.extend(points);
-        for face in model_faces(model, &local_to_global, name)? {
-            faces.push(face);
-            face_layers.push(layer);
+    let mut parsed = Parsed::default();
+    let mut vertex_brdfs: Vec<Option<Brdf>> = Vec::new();
+    for (layer, (layer_name, models)) in layers_of(&models).into_iter().enumerate() {
+        parsed.layer_names.push(layer_name);
+        let base = parsed.soup.positions.len();
+        let mut welder = Welder::new(&file_order);
+        let per_model: Vec<Vec<u32>> = models
+            .iter()
+            .map(|m| welder.add(&m.mesh, &mut report))
+            .collect();
+        let (points, welded_to_global) = welder.finish(base);
+        parsed.soup.positions.extend(points);
+        vertex_brdfs.resize(parsed.soup.positions.len(), None);
+        for (model, local_to_welded) in models.iter().zip(per_model) {
+            let brdf = model.mesh.material_id.and_then(|m| brdfs.get(m).copied());
+            for face in model_faces(model, &local_to_welded, name)? {
+                let face = face.map(|v| welded_to_global[v as usize]);
+                for v in face {
+                    vertex_brdfs[v as usize] = vertex_brdfs[v as usize].or(brdf);
+                }
+                parsed.soup.faces.push(face);
+                parsed.soup.face_layers.push(layer as LayerId);
+            }
         }
     }
-    if faces.is_empty() {
-        return Err(IoError::parse(name, None, "no faces"));
+    if vertex_brdfs.iter().any(Option::is_some) {
+        parsed.brdfs = Some(
+            vertex_brdfs
+                .into_iter()
+                .map(|b| b.unwrap_or(Brdf::CLAY))
+                .collect(),
+        );
     }
-    let mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
-        .map_err(|e| IoError::building(name, e, &positions))?;
-    Ok((mesh, report))
+    parsed.report = report;
+    Ok(parsed)
 }
 
-/// The file's objects through tobj, triangulated (points and lines ignored); an error names
-/// the line tobj stopped at.
-fn load_models(text: &str, name: &str) -> Result<Vec<tobj::Model>, IoError> {
+/// The file's models grouped into layers by name, in order of first appearance; models with
+/// no triangle are left out. tobj starts a new model at every `usemtl` that changes the
+/// material, under the same name: those are one surface.
+fn layers_of(models: &[tobj::Model]) -> Vec<(String, Vec<&tobj::Model>)> {
+    let mut layers: Vec<(String, Vec<&tobj::Model>)> = Vec::new();
+    for model in models.iter().filter(|m| m.mesh.indices.len() >= 3) {
+        let name = if model.name.is_empty() || model.name == "unnamed_object" {
+            format!("layer{}", layers.len())
+        } else {
+            model.name.clone()
+        };
+        let named = (!model.name.is_empty() && model.name != "unnamed_object")
+            .then(|| layers.iter().position(|(n, _)| *n == model.name))
+            .flatten();
+        match named {
+            Some(layer) => layers[layer].1.push(model),
+            None => layers.push((name, vec![model])),
+        }
+    }
+    layers
+}
+
+/// The file's objects through tobj, triangulated (points and lines ignored), and the materials
+/// of the libraries it names; an error names the line tobj stopped at. A library that cannot
+/// be read is a note, not an error: the mesh is still whole.
+fn load_models(
+    text: &str,
+    name: &str,
+    library: LibraryReader<'_>,
+    report: &mut ImportReport,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>), IoError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -83,83 +130,107 @@ fn load_models(text: &str, name: &str) -> Result<Vec<tobj::Model>, IoError> {
         inner: io::BufReader::new(text.as_bytes()),
         lines: 0,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
-    Ok(models)
+    let notes = RefCell::new(Vec::new());
+    let read_library = |path: &std::path::Path| {
+        let shown = crate::files::escape(&path.to_string_lossy()).into_owned();
+        let bytes = library(&path.to_string_lossy()).map_err(|why| {
+            notes
+                .borrow_mut()
+                .push(format!("material library `{shown}` not read: {why}"));
+            tobj::LoadError::OpenFileFailed
+        })?;
+        tobj::load_mtl_buf(&mut io::BufReader::new(bytes.as_slice())).inspect_err(|e| {
+            notes
+                .borrow_mut()
+                .push(format!("material library `{shown}` not read: {e}"));
+        })
+    };
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, read_library)
+        .map_err(|e| IoError::parse(name, Some(reader.lines.max(1)), format!("{e}")))?;
+    report.notes.extend(notes.into_inner());
+    // A library that failed leaves no materials, which tobj reports as an error of its own.
+    Ok((models, materials.unwrap_or_default()))
 }
 
-/// One object's points welded by exact bit pattern (+0 and −0 are one point; NaN never welds),
-/// in file order (`file_order`: each point's first line); and each of tobj's vertices' number
-/// in the mesh, the welded points numbered from `base`.
-fn weld(
-    mesh: &tobj::Mesh,
-    file_order: &FxHashMap<[u32; 3], u32>,
-    base: usize,
-    report: &mut ObjReport,
-) -> (Vec<Vec3>, Vec<u32>) {
-    let mut welded: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-    let mut local_to_welded = Vec::with_capacity(mesh.positions.len() / 3);
-    let mut welded_points: Vec<(u64, Vec3)> = Vec::new();
-    for (i, p) in mesh.positions.chunks_exact(3).enumerate() {
-        let p = Vec3::new(p[0], p[1], p[2]);
-        let unmatched = (1u64 << 32) + i as u64;
-        let key = (!p.is_nan()).then(|| weld_key(p));
-        let order = key
-            .and_then(|k| file_order.get(&k))
-            .map_or(unmatched, |&o| o as u64);
-        let existing = key.and_then(|k| welded.get(&k).copied());
-        let id = existing.unwrap_or_else(|| {
-            welded_points.push((order, p));
-            let id = (welded_points.len() - 1) as u32;
-            if let Some(k) = key {
-                welded.insert(k, id);
-            }
-            id
-        });
-        if existing.is_some() {
-            report.welded_vertices += 1;
+/// Welds a layer's points by exact bit pattern (+0 and −0 are one point; NaN never welds),
+/// numbering them in file order (`file_order`: each point's first line).
+struct Welder<'a> {
+    file_order: &'a FxHashMap<[u32; 3], u32>,
+    ids: FxHashMap<[u32; 3], u32>,
+    /// Each welded point with its place in the file (points not found there after those that are).
+    points: Vec<(u64, Vec3)>,
+    unmatched: u64,
+}
+
+impl<'a> Welder<'a> {
+    fn new(file_order: &'a FxHashMap<[u32; 3], u32>) -> Welder<'a> {
+        Welder {
+            file_order,
+            ids: FxHashMap::default(),
+            points: Vec::new(),
+            unmatched: 1 << 32,
         }
-        local_to_welded.push(id);
     }
-    let mut by_order: Vec<u32> = (0..welded_points.len() as u32).collect();
-    by_order.sort_by_key(|&id| welded_points[id as usize].0);
-    let mut welded_to_global = vec![0u32; welded_points.len()];
-    let mut points = Vec::with_capacity(welded_points.len());
-    for &id in &by_order {
-        welded_to_global[id as usize] = (base + points.len()) as u32;
-        points.push(welded_points[id as usize].1);
+
+    /// Welds one tobj model's points; returns each one's welded id.
+    fn add(&mut self, mesh: &tobj::Mesh, report: &mut ImportReport) -> Vec<u32> {
+        let mut local_to_welded = Vec::with_capacity(mesh.positions.len() / 3);
+        for p in mesh.positions.chunks_exact(3) {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            let key = (!p.is_nan()).then(|| weld_key(p));
+            if let Some(&id) = key.and_then(|k| self.ids.get(&k)) {
+                report.welded_vertices += 1;
+                local_to_welded.push(id);
+                continue;
+            }
+            self.unmatched += 1;
+            let order = key
+                .and_then(|k| self.file_order.get(&k))
+                .map_or(self.unmatched, |&o| o as u64);
+            self.points.push((order, p));
+            let id = (self.points.len() - 1) as u32;
+            if let Some(k) = key {
+                self.ids.insert(k, id);
+            }
+            local_to_welded.push(id);
+        }
+        local_to_welded
     }
-    let local_to_global = local_to_welded
-        .iter()
-        .map(|&id| welded_to_global[id as usize])
-        .collect();
-    (points, local_to_global)
+
+    /// The welded points in file order, and each welded id's number in the soup, the points
+    /// numbered from `base`.
+    fn finish(self, base: usize) -> (Vec<Vec3>, Vec<u32>) {
+        let mut by_order: Vec<u32> = (0..self.points.len() as u32).collect();
+        by_order.sort_by_key(|&id| self.points[id as usize].0);
+        let mut welded_to_global = vec![0u32; self.points.len()];
+        let mut points = Vec::with_capacity(self.points.len());
+        for &id in &by_order {
+            welded_to_global[id as usize] = (base + points.len()) as u32;
+            points.push(self.points[id as usize].1);
+        }
+        (points, welded_to_global)
+    }
 }
 
-/// An object's triangles in the mesh's numbering; an index out of range or a corner used
-/// twice is an error naming the object and triangle.
+/// An object's triangles in welded ids; an index out of range is an error naming the object
+/// and triangle. Triangles that repeat a point are kept for the repair (or the strict refusal).
 fn model_faces(
     model: &tobj::Model,
-    local_to_global: &[u32],
+    local_to_welded: &[u32],
     name: &str,
 ) -> Result<Vec<[u32; 3]>, IoError> {
-    let fail = |message: String| Err(IoError::parse(name, None, message));
     let mut faces = Vec::with_capacity(model.mesh.indices.len() / 3);
     for (k, tri) in model.mesh.indices.chunks_exact(3).enumerate() {
         let face = [tri[0], tri[1], tri[2]]
-            .map(|i| local_to_global.get(i as usize).copied().unwrap_or(INVALID));
+            .map(|i| local_to_welded.get(i as usize).copied().unwrap_or(INVALID));
         if face.contains(&INVALID) {
-            return fail(format!(
-                "object `{}`: triangle {k} has a vertex index out of range",
-                model.name
-            ));
-        }
-        if face[0] == face[1] || face[1] == face[2] || face[0] == face[2] {
-            return fail(format!(
-                "object `{}`: triangle {k} uses the same point twice (coincident corners)",
-                model.name
+            return Err(IoError::parse(
+                name,
+                None,
+                format!(
+                    "object `{}`: triangle {k} has a vertex index out of range",
+                    crate::files::escape(&model.name)
+                ),
             ));
         }
         faces.push(face);
@@ -167,88 +238,118 @@ fn model_faces(
     Ok(faces)
 }
 
+/// What the pre-scan counts that a mesh does not keep.
+#[derive(Default)]
+struct Dropped {
+    texture_coordinates: usize,
+    normals: usize,
+    lines: usize,
+    points: usize,
+}
+
+impl Dropped {
+    fn items(&self) -> Vec<String> {
+        [
+            (self.texture_coordinates, "texture coordinates (`vt`)"),
+            (self.normals, "normals (`vn`; recomputed)"),
+            (self.lines, "line elements (`l`)"),
+            (self.points, "point elements (`p`)"),
+        ]
+        .into_iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect()
+    }
+}
+
 /// Checks every `v` and `f` line for what tobj would reject without a line number or accept
 /// wrongly: unparsable or missing numbers, index 0, indices past the vertices defined so far.
-fn prescan(text: &str, name: &str) -> Result<(ObjReport, Vec<Vec3>), IoError> {
-    let mut report = ObjReport::default();
+fn prescan(text: &str, name: &str) -> Result<(ImportReport, Vec<Vec3>), IoError> {
+    let mut report = ImportReport::default();
+    let mut dropped = Dropped::default();
     let mut file_positions = Vec::new();
-    let (mut positions, mut texcoords, mut normals) = (0usize, 0usize, 0usize);
     for (number, line) in text.lines().enumerate() {
         let number = number + 1;
-        let fail = |message: String| Err(IoError::parse(name, Some(number), message));
+        let error = |message: String| IoError::parse(name, Some(number), message);
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => {
-                let mut coordinates = [0f32; 3];
-                for (axis, slot) in coordinates.iter_mut().enumerate() {
-                    match words.next().map(str::parse::<f32>) {
-                        Some(Ok(value)) => *slot = value,
-                        Some(Err(_)) => {
-                            return fail(format!("vertex coordinate {axis} is not a number"));
-                        }
-                        None => return fail("vertex needs three coordinates".into()),
-                    }
-                }
-                if coordinates.iter().any(|c| !c.is_finite()) {
+                let p = vertex_line(words).map_err(error)?;
+                if !p.is_finite() {
                     report.non_finite_vertices += 1;
                     report.first_non_finite_line.get_or_insert(number);
-                } else if coordinates.iter().any(|c| c.abs() > MAX_COORDINATE) {
-                    return fail(format!(
+                } else if p.abs().max_element() > MAX_COORDINATE {
+                    return Err(error(format!(
                         "vertex coordinate beyond the supported range ±{MAX_COORDINATE:e}"
-                    ));
+                    )));
                 }
-                positions += 1;
-                file_positions.push(Vec3::from_array(coordinates));
+                file_positions.push(p);
             }
-            Some("vt") => texcoords += 1,
-            Some("vn") => normals += 1,
+            Some("vt") => dropped.texture_coordinates += 1,
+            Some("vn") => dropped.normals += 1,
+            Some("l") => dropped.lines += 1,
+            Some("p") => dropped.points += 1,
             Some("f") => {
-                let mut corners = 0;
-                for word in words {
-                    corners += 1;
-                    let counts = [
-                        ("vertex", positions),
-                        ("texture", texcoords),
-                        ("normal", normals),
-                    ];
-                    for (field, (what, defined)) in word.split('/').zip(counts) {
-                        if field.is_empty() && what != "vertex" {
-                            continue;
-                        }
-                        let index = match field.parse::<i64>() {
-                            Ok(i) => i,
-                            Err(_) => {
-                                return fail(format!(
-                                    "face {what} index `{field}` is not an integer"
-                                ));
-                            }
-                        };
-                        let in_range = if index > 0 {
-                            index as u64 <= defined as u64
-                        } else {
-                            index != 0 && index.unsigned_abs() <= defined as u64
-                        };
-                        if !in_range {
-                            return fail(format!(
-                                "face {what} index {index} is out of range ({defined} defined so far)"
-                            ));
-                        }
-                    }
-                    if word.split('/').count() > 3 {
-                        return fail(format!("face corner `{word}` has more than three indices"));
-                    }
-                }
-                if corners < 3 {
-                    return fail(format!("face has {corners} corners; at least 3 are needed"));
-                }
-            }
-            Some("o") | Some("g") if words.next().is_none() => {
-                return fail("object or group without a name".into());
+                let defined = [
+                    file_positions.len(),
+                    dropped.texture_coordinates,
+                    dropped.normals,
+                ];
+                face_line(words, defined).map_err(error)?;
             }
             _ => {}
         }
     }
+    report.not_kept = dropped.items();
     Ok((report, file_positions))
+}
+
+/// The point of a `v` line (after the `v`); colours or a weight after it are tobj's business.
+fn vertex_line<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<Vec3, String> {
+    let mut coordinates = [0f32; 3];
+    for (axis, slot) in coordinates.iter_mut().enumerate() {
+        match words.next().map(str::parse::<f32>) {
+            Some(Ok(value)) => *slot = value,
+            Some(Err(_)) => return Err(format!("vertex coordinate {axis} is not a number")),
+            None => return Err("vertex needs three coordinates".into()),
+        }
+    }
+    Ok(Vec3::from_array(coordinates))
+}
+
+/// Checks an `f` line's corners (after the `f`) against the `defined` positions, texture
+/// coordinates and normals so far.
+fn face_line<'a>(words: impl Iterator<Item = &'a str>, defined: [usize; 3]) -> Result<(), String> {
+    let mut corners = 0;
+    for word in words {
+        corners += 1;
+        let fields = ["vertex", "texture", "normal"].into_iter().zip(defined);
+        for (field, (what, defined)) in word.split('/').zip(fields) {
+            if field.is_empty() && what != "vertex" {
+                continue;
+            }
+            let Ok(index) = field.parse::<i64>() else {
+                return Err(format!("face {what} index `{field}` is not an integer"));
+            };
+            let in_range = if index > 0 {
+                index as u64 <= defined as u64
+            } else {
+                index != 0 && index.unsigned_abs() <= defined as u64
+            };
+            if !in_range {
+                return Err(format!(
+                    "face {what} index {index} is out of range ({defined} defined so far)"
+                ));
+            }
+        }
+        if word.split('/').count() > 3 {
+            return Err(format!("face corner `{word}` has more than three indices"));
+        }
+    }
+    if corners < 3 {
+        return Err(format!("face has {corners} corners; at least 3 are needed"));
+    }
+    Ok(())
 }
 
 /// Welding identity of a point: its bits, with -0 folded into +0.
@@ -341,79 +442,3 @@ pub fn write_obj_with_materials(
     Ok(())
 }
 
-/// Each layer with faces, with its material: the mean BRDF of its live vertices. The
-/// parametrization is linear, so the mean is the layer's average material; a layer nobody has
-/// painted gets exactly its default (generated scenes give each layer a preset).
-pub fn layer_materials(mesh: &Mesh) -> Vec<(LayerId, String, Brdf)> {
-    let mut sums = vec![[0f64; 7]; mesh.layer_count()];
-    let mut counts = vec![0usize; mesh.layer_count()];
-    let mut has_faces = vec![false; mesh.layer_count()];
-    for (t, &l) in mesh.faces().iter().zip(mesh.face_layers()) {
-        if t[0] != INVALID {
-            has_faces[l as usize] = true;
-        }
-    }
-    for (v, brdf) in mesh.brdfs().iter().enumerate() {
-        if !mesh.is_vertex_live(v as u32) {
-            continue;
-        }
-        let layer = mesh.vertex_layers()[v] as usize;
-        for (sum, value) in sums[layer].iter_mut().zip(brdf.as_array()) {
-            *sum += value as f64;
-        }
-        counts[layer] += 1;
-    }
-    (0..mesh.layer_count())
-        .filter(|&l| has_faces[l])
-        .map(|l| {
-            let n = counts[l].max(1) as f64;
-            let mean = Brdf::from_array(sums[l].map(|s| (s / n) as f32));
-            (l as LayerId, sanitize_name(&mesh.layer_names()[l]), mean)
-        })
-        .collect()
-}
-
-/// Writes a Wavefront material library with one `newmtl` per layer ([`layer_materials`]):
-/// `Kd` the diffuse albedo, `Ks` the specular albedo, `Ns` the Blinn–Phong exponent of the
-/// linearized roughness ([`crate::mesh::blinn_exponent`]).
-pub fn write_mtl(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
-    writeln!(out, "# slayer materials: one per layer")?;
-    for (_, name, brdf) in layer_materials(mesh) {
-        writeln!(out)?;
-        writeln!(out, "newmtl {name}")?;
-        if let Some(preset) = crate::material::PRESETS
-            .iter()
-            .find(|m| close(&m.brdf, &brdf))
-        {
-            writeln!(out, "# preset {}", preset.name)?;
-        }
-        writeln!(out, "# linearized roughness {}", brdf.roughness)?;
-        let [r, g, b] = brdf.diffuse;
-        writeln!(out, "Kd {r} {g} {b}")?;
-        let [r, g, b] = brdf.specular;
-        writeln!(out, "Ks {r} {g} {b}")?;
-        writeln!(out, "Ns {}", brdf.blinn_exponent())?;
-        writeln!(out, "illum 2")?;
-    }
-    Ok(())
-}
-
-fn close(a: &Brdf, b: &Brdf) -> bool {
-    a.as_array()
-        .iter()
-        .zip(b.as_array())
-        .all(|(x, y)| (x - y).abs() <= 1e-5)
-}
-
-/// OBJ names end at whitespace.
-fn sanitize_name(name: &str) -> String {
-    let cleaned: String = name
-        .chars()
-        .map(|c| if c.is_whitespace() { '_' } else { c })
-        .collect();
-    if cleaned.is_empty() {
-        "layer".into()
-    } else {
-        cleaned
-    }
-}

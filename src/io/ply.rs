@@ -9,7 +9,8 @@ use std::io::{self, Write};
 use glam::Vec3;
 
 use super::IoError;
-use crate::mesh::{Brdf, INVALID, LayerId, Mesh, VertexFlags};
+use super::import::{ImportReport, Parsed};
+use crate::mesh::{Brdf, INVALID, LayerId, Mesh, Soup, VertexFlags};
 
 /// Layer ids above this are treated as corrupt (a layer is a user-facing label, not an index
 /// space).
@@ -89,6 +90,9 @@ struct Element {
 
 struct Header {
     encoding: Encoding,
+    /// Written by slayer (`comment written by slayer`): only then are properties with common
+    /// names (`flags`, `layer`) read as ours. Another tool's `flags` is not our mask.
+    ours: bool,
     elements: Vec<Element>,
     layer_names: Vec<(u32, String)>,
     /// Byte offset of the body.
@@ -136,6 +140,7 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
     };
     Ok(Header {
         encoding,
+        ours: lines.ours,
         elements: lines.elements,
         layer_names: lines.layer_names,
         body: offset,
@@ -147,6 +152,7 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
 #[derive(Default)]
 struct HeaderLines {
     encoding: Option<Encoding>,
+    ours: bool,
     elements: Vec<Element>,
     layer_names: Vec<(u32, String)>,
 }
@@ -175,6 +181,7 @@ impl HeaderLines {
                     _ => return Err(Bad("unknown PLY format")),
                 })
             }
+            ["comment", "written", "by", "slayer"] => self.ours = true,
             ["comment", "slayer", "layer", id, rest @ ..] => {
                 if let Ok(id) = id.parse::<u32>() {
                     self.layer_names.push((id, rest.join(" ")));
@@ -328,7 +335,7 @@ fn as_index(value: f64) -> Option<u32> {
 }
 
 /// Parses PLY bytes (`name` is used in messages).
-pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
+pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Parsed, IoError> {
     let header = parse_header(bytes, name)?;
     let mut body = Body {
         bytes,
@@ -339,46 +346,130 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, IoError> {
         line: header.lines,
         name,
     };
-    let mut rows = Rows::default();
+    check_counts(&header, body.remaining(), name)?;
+    let mut rows = Rows {
+        ours: header.ours,
+        ..Rows::default()
+    };
     for element in &header.elements {
         rows.read_element(element, &mut body)?;
     }
-    if rows.faces.is_empty() {
-        return Err(IoError::parse(name, None, "no faces"));
-    }
+    let mut report = ImportReport {
+        not_kept: not_kept(&header),
+        ..ImportReport::default()
+    };
+    report.non_finite_vertices = rows.positions.iter().filter(|p| !p.is_finite()).count();
     let layer_names = layer_names(&header.layer_names, &rows.face_layers);
-    rows.drop_unused_vertices();
-    let Rows {
-        positions,
+    let brdfs = match (rows.has_brdf, rows.has_colour) {
+        (true, _) => Some(rows.brdfs),
+        (false, true) => Some(
+            rows.colours
+                .iter()
+                .map(|&diffuse| Brdf {
+                    diffuse,
+                    ..Brdf::CLAY
+                })
+                .collect(),
+        ),
+        (false, false) => None,
+    };
+    Ok(Parsed {
+        soup: Soup {
+            positions: rows.positions,
+            faces: rows.faces,
+            face_layers: rows.face_layers,
+        },
+        layer_names,
         brdfs,
-        masks,
-        has_brdf,
-        faces,
-        face_layers,
-        ..
-    } = rows;
-    let mut mesh = Mesh::new(positions.clone(), faces, face_layers, layer_names)
-        .map_err(|e| IoError::building(name, e, &positions))?;
-    if has_brdf {
-        mesh.set_brdfs(brdfs)
-            .map_err(|e| IoError::building(name, e, &positions))?;
+        flags: rows.ours.then_some(rows.masks),
+        report,
+    })
+}
+
+/// Refuses a header whose element counts the file cannot hold, before anything is allocated
+/// or read: every row takes at least one byte per property in binary, two in ASCII (a digit
+/// and a separator).
+fn check_counts(header: &Header, remaining: usize, name: &str) -> Result<(), IoError> {
+    let mut needed: u128 = 0;
+    for element in &header.elements {
+        let row: usize = element
+            .properties
+            .iter()
+            .map(|p| match (header.encoding, p.list) {
+                (Encoding::Ascii, _) => 2,
+                (Encoding::Binary { .. }, Some(count)) => count.size(),
+                (Encoding::Binary { .. }, None) => p.value.size(),
+            })
+            .sum();
+        needed += element.count as u128 * row as u128;
     }
-    if masks.iter().any(|m| !m.is_empty()) {
-        for (flag, m) in mesh.flags_mut().iter_mut().zip(masks) {
-            *flag |= m;
+    if needed > remaining as u128 {
+        return Err(IoError::parse(
+            name,
+            None,
+            format!(
+                "the header's element counts need at least {needed} bytes, but the file holds {remaining} after its header"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The vertex properties slayer reads under any name, and those it reads only from its own
+/// files.
+const VERTEX_PROPERTIES: [&str; 6] = ["x", "y", "z", "red", "green", "blue"];
+const OWN_VERTEX_PROPERTIES: [&str; 2] = ["flags", "layer"];
+
+/// What the file holds that the mesh does not keep: normals, other vertex and face properties,
+/// other elements.
+fn not_kept(header: &Header) -> Vec<String> {
+    let mut items = Vec::new();
+    for element in &header.elements {
+        let kept = |p: &Property| match element.name.as_str() {
+            "vertex" => {
+                VERTEX_PROPERTIES.contains(&p.name.as_str())
+                    || BRDF_PROPERTIES.contains(&p.name.as_str())
+                    || (header.ours && OWN_VERTEX_PROPERTIES.contains(&p.name.as_str()))
+                    || (header.ours && ["nx", "ny", "nz"].contains(&p.name.as_str()))
+            }
+            "face" => is_index_list(p) || (header.ours && p.name == "layer"),
+            _ => false,
+        };
+        if !matches!(element.name.as_str(), "vertex" | "face") {
+            items.push(format!(
+                "{} `{}` rows",
+                element.count,
+                crate::files::escape(&element.name)
+            ));
+            continue;
+        }
+        let dropped: Vec<String> = element
+            .properties
+            .iter()
+            .filter(|p| !kept(p))
+            .map(|p| format!("`{}`", crate::files::escape(&p.name)))
+            .collect();
+        if !dropped.is_empty() {
+            items.push(format!("{} properties {}", element.name, dropped.join(" ")));
         }
     }
-    Ok(mesh)
+    items
 }
 
 /// What the body's vertex and face rows gave.
 #[derive(Default)]
 struct Rows {
+    /// The file is slayer's: its `flags` and `layer` properties are ours.
+    ours: bool,
     positions: Vec<Vec3>,
     brdfs: Vec<Brdf>,
+    /// Linear diffuse albedo from `red`/`green`/`blue`.
+    colours: Vec<[f32; 3]>,
     masks: Vec<VertexFlags>,
     /// The vertex element has every BRDF property.
     has_brdf: bool,
+    /// The vertex element has `red`, `green` and `blue`.
+    has_colour: bool,
     faces: Vec<[u32; 3]>,
     face_layers: Vec<LayerId>,
     saw_vertices: bool,
@@ -389,6 +480,7 @@ struct Rows {
 struct Row {
     position: [f32; 3],
     brdf: [f32; 7],
+    colour: [f32; 3],
     flags: u32,
     polygon: Vec<u32>,
     layer: u32,
@@ -412,10 +504,11 @@ impl Rows {
         }
         for row in 0..element.count {
             body.start_row()?;
-            let read = read_row(element, row, body)?;
+            let read = read_row(element, (row, self.ours), body)?;
             if is_vertex {
                 self.positions.push(Vec3::from_array(read.position));
                 self.brdfs.push(Brdf::from_array(read.brdf));
+                self.colours.push(read.colour);
                 let mask = VertexFlags::from_bits_truncate(read.flags) & VertexFlags::PERSISTENT;
                 self.masks.push(mask);
             } else if is_face {
@@ -425,27 +518,23 @@ impl Rows {
         Ok(())
     }
 
-    /// Checks the one vertex element's properties and reserves what the file can hold.
+    /// Checks the one vertex element's properties.
     fn start_vertices(&mut self, element: &Element, body: &Body<'_>) -> Result<(), IoError> {
         if self.saw_vertices {
             return Err(body.error("more than one vertex element"));
         }
         self.saw_vertices = true;
-        for axis in ["x", "y", "z"] {
-            let found = element
+        let has = |name: &str| {
+            element
                 .properties
                 .iter()
-                .any(|p| p.name == axis && p.list.is_none());
-            if !found {
-                return Err(body.error(format!("vertex element has no `{axis}` property")));
-            }
+                .any(|p| p.name == name && p.list.is_none())
+        };
+        if let Some(axis) = ["x", "y", "z"].into_iter().find(|a| !has(a)) {
+            return Err(body.error(format!("vertex element has no `{axis}` property")));
         }
-        self.has_brdf = BRDF_PROPERTIES
-            .iter()
-            .all(|b| element.properties.iter().any(|p| p.name == *b));
-        // Never reserve more rows than the remaining bytes could hold.
-        self.positions
-            .reserve(element.count.min(body.remaining() + 1));
+        self.has_brdf = BRDF_PROPERTIES.iter().all(|b| has(b));
+        self.has_colour = ["red", "green", "blue"].iter().all(|c| has(c));
         Ok(())
     }
 
@@ -473,79 +562,28 @@ impl Rows {
         }
         Ok(())
     }
-
-    /// Drops vertices no face uses rather than rejecting them (PLY writers often leave them),
-    /// renumbering the faces.
-    fn drop_unused_vertices(&mut self) {
-        let mut used = vec![false; self.positions.len()];
-        for f in &self.faces {
-            for &v in f {
-                used[v as usize] = true;
-            }
-        }
-        let mut remap = vec![INVALID; self.positions.len()];
-        let mut kept = 0u32;
-        for (v, slot) in remap.iter_mut().enumerate() {
-            if used[v] {
-                *slot = kept;
-                kept += 1;
-            }
-        }
-        fn keep<T: Copy>(rows: &[T], used: &[bool]) -> Vec<T> {
-            rows.iter()
-                .zip(used)
-                .filter(|(_, u)| **u)
-                .map(|(r, _)| *r)
-                .collect()
-        }
-        self.positions = keep(&self.positions, &used);
-        self.brdfs = keep(&self.brdfs, &used);
-        self.masks = keep(&self.masks, &used);
-        for f in &mut self.faces {
-            *f = f.map(|v| remap[v as usize]);
-        }
-    }
 }
 
-/// Reads one row of `element` (its `row`th), keeping what slayer uses of it.
-fn read_row(element: &Element, row: usize, body: &mut Body<'_>) -> Result<Row, IoError> {
+/// Reads one row of `element` (its `row`th; `ours`: the file is slayer's), keeping what slayer
+/// uses of it.
+fn read_row(
+    element: &Element,
+    (row, ours): (usize, bool),
+    body: &mut Body<'_>,
+) -> Result<Row, IoError> {
     let is_vertex = element.name == "vertex";
     let is_face = element.name == "face";
     let mut read = Row::default();
     for property in &element.properties {
         if let Some(count_type) = property.list {
-            let count = body.read(count_type)?;
-            let Some(count) = as_index(count) else {
-                return Err(body.error(format!("{} {row}: bad list length", element.name)));
-            };
             let wanted = is_face && is_index_list(property);
-            for _ in 0..count {
-                let value = body.read(property.value)?;
-                if wanted {
-                    let Some(index) = as_index(value) else {
-                        return Err(body.error(format!(
-                            "face {row}: vertex index {value} is not a valid index"
-                        )));
-                    };
-                    read.polygon.push(index);
-                }
-            }
+            read_list(property, count_type, (row, wanted), body, &mut read)?;
             continue;
         }
         let value = body.read(property.value)?;
         if is_vertex {
-            match property.name.as_str() {
-                "x" => read.position[0] = value as f32,
-                "y" => read.position[1] = value as f32,
-                "z" => read.position[2] = value as f32,
-                "flags" => read.flags = as_index(value).unwrap_or(0),
-                other => {
-                    if let Some(k) = BRDF_PROPERTIES.iter().position(|b| *b == other) {
-                        read.brdf[k] = value as f32;
-                    }
-                }
-            }
-        } else if is_face && property.name == "layer" {
+            read_vertex_property(property, value, ours, &mut read);
+        } else if is_face && ours && property.name == "layer" {
             read.layer = match as_index(value) {
                 Some(l) if l < MAX_LAYERS => l,
                 _ => {
@@ -557,6 +595,81 @@ fn read_row(element: &Element, row: usize, body: &mut Body<'_>) -> Result<Row, I
         }
     }
     Ok(read)
+}
+
+/// A list property: read through, and kept as the polygon when `wanted`.
+fn read_list(
+    property: &Property,
+    count_type: Scalar,
+    (row, wanted): (usize, bool),
+    body: &mut Body<'_>,
+    read: &mut Row,
+) -> Result<(), IoError> {
+    let count = body.read(count_type)?;
+    let Some(count) = as_index(count) else {
+        return Err(body.error(format!("row {row}: bad list length")));
+    };
+    for _ in 0..count {
+        let value = body.read(property.value)?;
+        if wanted {
+            let Some(index) = as_index(value) else {
+                return Err(body.error(format!(
+                    "face {row}: vertex index {value} is not a valid index"
+                )));
+            };
+            read.polygon.push(index);
+        }
+    }
+    Ok(())
+}
+
+fn read_vertex_property(property: &Property, value: f64, ours: bool, read: &mut Row) {
+    match property.name.as_str() {
+        "x" => read.position[0] = value as f32,
+        "y" => read.position[1] = value as f32,
+        "z" => read.position[2] = value as f32,
+        "red" => read.colour[0] = colour_channel(value, property.value),
+        "green" => read.colour[1] = colour_channel(value, property.value),
+        "blue" => read.colour[2] = colour_channel(value, property.value),
+        "flags" if ours => read.flags = as_index(value).unwrap_or(0),
+        other => {
+            if let Some(k) = BRDF_PROPERTIES.iter().position(|b| *b == other) {
+                read.brdf[k] = value as f32;
+            }
+        }
+    }
+}
+
+/// A colour channel as linear albedo: integers scaled by their type's largest value, floats
+/// taken in [0, 1]; both read as sRGB, which is what scanners and paint tools store.
+fn colour_channel(value: f64, scalar: Scalar) -> f32 {
+    let encoded = match scalar {
+        Scalar::U8 | Scalar::I8 => value / 255.0,
+        Scalar::U16 | Scalar::I16 => value / 65535.0,
+        Scalar::U32 | Scalar::I32 => value / u32::MAX as f64,
+        Scalar::F32 | Scalar::F64 => value,
+    };
+    let c = if encoded.is_nan() { 0.0 } else { encoded.clamp(0.0, 1.0) } as f32;
+    srgb_to_linear(c)
+}
+
+/// The sRGB transfer function's inverse.
+pub(crate) fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function.
+pub(crate) fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// A name per layer: those the header's comments give, `layerN` for the rest. Named layers
@@ -606,6 +719,10 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     {
         writeln!(out, "property float {p}")?;
     }
+    // The diffuse albedo again as 8-bit sRGB, so other tools show the colours.
+    for channel in ["red", "green", "blue"] {
+        writeln!(out, "property uchar {channel}")?;
+    }
     writeln!(out, "property uint layer")?;
     writeln!(out, "property uint flags")?;
     writeln!(out, "element face {live_faces}")?;
@@ -621,6 +738,9 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
             .chain(mesh.brdfs()[v].as_array())
         {
             buffer.extend_from_slice(&value.to_le_bytes());
+        }
+        for channel in mesh.brdfs()[v].diffuse {
+            buffer.push((linear_to_srgb(channel) * 255.0).round() as u8);
         }
         buffer.extend_from_slice(&mesh.vertex_layers()[v].to_le_bytes());
         let persistent = mesh.flags()[v] & VertexFlags::PERSISTENT;

@@ -14,6 +14,7 @@ mod edit;
 mod error;
 mod measure;
 mod raw;
+mod repair;
 mod validate;
 mod vertex_faces;
 
@@ -24,6 +25,7 @@ pub use delta::{MeshDelta, RowsDelta};
 pub use error::MeshError;
 pub use measure::EdgeLengthStats;
 pub use raw::RawMeshError;
+pub use repair::{Repaired, Repairs, Soup, repair, without_unreferenced};
 pub use vertex_faces::VertexFaces;
 
 use glam::Vec3;

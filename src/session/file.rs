@@ -16,7 +16,7 @@ use thiserror::Error;
 use super::history::Entry;
 use super::{BrushSettings, History, LayerSettings, ProximityPolicy, Session};
 use crate::codec::{DecodeError, Reader, Writer};
-use crate::io::{AtomicBatch, IoError};
+use crate::io::{AtomicBatch, ImportOptions, ImportReport, IoError};
 use crate::mesh::{Brdf, Mesh, MeshDelta, RawMeshError};
 
 /// The first bytes of every session file: a high byte and a CR-LF/LF pair catch transfers
@@ -302,10 +302,21 @@ pub fn check_save_path(path: &Path) -> Result<(), IoError> {
     }
 }
 
-/// Opens a session file, or a mesh file (OBJ, PLY) as a new session.
+/// Opens a session file, or a mesh file (OBJ, PLY) as a new session, repaired where it needs
+/// it.
 pub fn open(path: &Path) -> Result<Session, SessionFileError> {
+    open_with(path, &ImportOptions::default()).map(|(session, _)| session)
+}
+
+/// [`open`] with import options for a mesh file, and the import's report (empty for a
+/// session file, which slayer wrote).
+pub fn open_with(
+    path: &Path,
+    options: &ImportOptions,
+) -> Result<(Session, ImportReport), SessionFileError> {
     if !is_session_path(path) {
-        return Ok(Session::new(crate::io::read_mesh(path)?));
+        let (mesh, report) = crate::io::import_mesh(path, options)?;
+        return Ok((Session::new(mesh), report));
     }
     let bytes =
         crate::files::read_input(path, crate::files::MAX_INPUT_BYTES).map_err(|source| {
@@ -314,7 +325,8 @@ pub fn open(path: &Path) -> Result<Session, SessionFileError> {
                 source,
             }
         })?;
-    read_session(&bytes, &path.display().to_string())
+    let session = read_session(&bytes, &path.display().to_string())?;
+    Ok((session, ImportReport::default()))
 }
 
 /// Saves a session atomically: a `.slayer` path gets the session file (with its history when

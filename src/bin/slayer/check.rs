@@ -2,16 +2,17 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use slayer::check::{CheckReport, check_mesh};
+use slayer::io::{ImportOptions, ImportReport};
 
 use crate::progress::Steps;
 
 /// Loads and checks `file` (against the file it was made from, if given); `Err` only for
 /// files that cannot be read as a mesh at all.
-pub fn report(file: &Path, against: Option<&Path>) -> anyhow::Result<CheckReport> {
+pub fn report(file: &Path, against: Option<&Path>, strict: bool) -> anyhow::Result<CheckReport> {
     let steps = Steps::new("check");
     steps.step("reading");
-    let (mesh, notes) = load(file)?;
-    let original = against.map(load).transpose()?;
+    let (mesh, notes) = load(file, strict)?;
+    let original = against.map(|path| load(path, strict)).transpose()?;
     let mut report = check_mesh(&mesh, &notes, &file.display().to_string(), |s| {
         steps.step(s)
     });
@@ -23,17 +24,24 @@ pub fn report(file: &Path, against: Option<&Path>) -> anyhow::Result<CheckReport
     Ok(report)
 }
 
-fn load(file: &Path) -> anyhow::Result<(slayer::mesh::Mesh, slayer::io::LoadNotes)> {
+/// The mesh, and what reading it repaired and left out (which the report shows, so it is not
+/// printed here).
+fn load(file: &Path, strict: bool) -> anyhow::Result<(slayer::mesh::Mesh, ImportReport)> {
     Ok(if slayer::session::is_session_path(file) {
         let session = slayer::session::open(file)?;
-        (session.into_mesh(), slayer::io::LoadNotes::default())
+        (session.into_mesh(), ImportReport::default())
     } else {
-        slayer::io::load_mesh(file)?
+        slayer::io::load_mesh(file, &ImportOptions { strict })?
     })
 }
 
-pub fn run(file: &Path, json: bool, against: Option<&Path>) -> anyhow::Result<ExitCode> {
-    let report = report(file, against)?;
+pub fn run(
+    file: &Path,
+    json: bool,
+    against: Option<&Path>,
+    strict: bool,
+) -> anyhow::Result<ExitCode> {
+    let report = report(file, against, strict)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

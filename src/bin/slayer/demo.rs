@@ -116,7 +116,7 @@ pub fn run(
         slayer::io::write_atomically(&both, &side_by_side.to_png()?)?;
         println!("  before and after side by side -> {}", both.display());
     }
-    let report = crate::check::report(&after, None)?;
+    let report = crate::check::report(&after, None, true)?;
     println!("{report}");
     Ok(if report.is_clean() {
         ExitCode::SUCCESS

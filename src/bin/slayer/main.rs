@@ -5,6 +5,7 @@ mod bench;
 mod check;
 mod demo;
 mod history;
+mod open;
 mod progress;
 mod remesh;
 mod render;
@@ -26,6 +27,10 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Refuse a mesh file that is not a clean manifold mesh (non-manifold, degenerate,
+    /// duplicate or inconsistently oriented faces) instead of repairing it
+    #[arg(long, global = true)]
+    strict: bool,
 }
 
 #[derive(Subcommand)]
@@ -246,7 +251,7 @@ fn main() -> ExitCode {
         cli.command,
         Command::Check { json: true, .. } | Command::Adapters { json: true }
     );
-    match dispatch(cli.command) {
+    match dispatch(cli.command, cli.strict) {
         Ok(code) => code,
         Err(error) => {
             let line = one_line(&error);
@@ -261,7 +266,7 @@ fn main() -> ExitCode {
 
 /// Runs a subcommand. A table more than a function: one arm per subcommand, each handing its
 /// arguments on, so it is as long as the list of subcommands.
-fn dispatch(command: Command) -> anyhow::Result<ExitCode> {
+fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
     match command {
         Command::Demo {
             out,
@@ -279,7 +284,7 @@ fn dispatch(command: Command) -> anyhow::Result<ExitCode> {
             file,
             json,
             against,
-        } => check::run(&file, json, against.as_deref()),
+        } => check::run(&file, json, against.as_deref(), strict),
         Command::Adapters { json } => adapters(json),
         Command::Sculpt {
             input,
@@ -301,8 +306,9 @@ fn dispatch(command: Command) -> anyhow::Result<ExitCode> {
             symmetry: symmetry.as_deref(),
             remeshing: remesh,
             backend,
+            strict,
         }),
-        Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output),
+        Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output, strict),
         Command::Undo {
             session,
             steps,
@@ -332,6 +338,7 @@ fn dispatch(command: Command) -> anyhow::Result<ExitCode> {
             false_colour,
             wireframe,
             antialias: !no_antialias,
+            strict,
         }),
         Command::Strokes {
             scene,

@@ -8,9 +8,14 @@ use slayer::remesh::{RemeshSettings, remesh_all};
 const MAX_FACES: usize = 50_000_000;
 
 /// Remeshes a whole mesh toward edge length `edge` (the mesh's mean edge length by default).
-pub fn run(input: &Path, edge: Option<f32>, output: &Path) -> anyhow::Result<ExitCode> {
+pub fn run(
+    input: &Path,
+    edge: Option<f32>,
+    output: &Path,
+    strict: bool,
+) -> anyhow::Result<ExitCode> {
     slayer::io::Format::of_path(output)?;
-    let mut mesh = slayer::session::open(input)?.into_mesh();
+    let mut mesh = crate::open::open(input, strict)?.into_mesh();
     let before = mesh.edge_length_stats();
     let edge = edge.unwrap_or(before.mean as f32);
     if !(edge.is_finite() && edge > 0.0) {

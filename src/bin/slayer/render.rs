@@ -85,6 +85,8 @@ pub struct Args<'a> {
     pub false_colour: bool,
     pub wireframe: bool,
     pub antialias: bool,
+    /// Refuse a mesh file that needs repairs.
+    pub strict: bool,
 }
 
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
@@ -96,7 +98,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         bail!("{}: the output must be a .png file", args.output.display());
     }
     let started = Instant::now();
-    let mesh = slayer::session::open(args.file)?.into_mesh();
+    let mesh = crate::open::open(args.file, args.strict)?.into_mesh();
     let load_ms = started.elapsed().as_secs_f64() * 1e3;
     let layers = if args.layers.is_empty() {
         None

@@ -23,6 +23,8 @@ pub struct Args<'a> {
     pub symmetry: Option<&'a str>,
     pub remeshing: Remeshing,
     pub backend: crate::backend::Backend,
+    /// Refuse an input mesh that needs repairs.
+    pub strict: bool,
 }
 
 /// Applies a stroke file to a mesh or session and writes the result (and the stats) as one
@@ -31,7 +33,7 @@ pub struct Args<'a> {
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     slayer::session::check_save_path(args.output)?;
     refuse_overwriting_input(args)?;
-    let mut session = slayer::session::open(args.input)?;
+    let mut session = crate::open::open(args.input, args.strict)?;
     let text = slayer::files::read_input_text(args.strokes, slayer::files::MAX_INPUT_BYTES)
         .with_context(|| format!("{}", args.strokes.display()))?;
     let name = args.strokes.display().to_string();
