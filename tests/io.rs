@@ -5,7 +5,8 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::io::{
-    Format, ImportOptions, encode_mesh, import_bytes, load_mesh_bytes, no_libraries, read_mesh_bytes,
+    Format, ImportOptions, encode_mesh, import_bytes, load_mesh_bytes, no_libraries,
+    read_mesh_bytes,
 };
 use slayer::mesh::{Brdf, Mesh, VertexFlags};
 use slayer::scene::{SceneKind, SceneSpec, generate, shapes};

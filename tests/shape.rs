@@ -144,7 +144,12 @@ fn check_reports_a_closed_component_of_four_faces() {
         report.defects
     );
     assert!(!report.is_clean());
-    let octahedron = check_mesh(&shapes::octahedron(), &ImportReport::default(), "octa", |_| {});
+    let octahedron = check_mesh(
+        &shapes::octahedron(),
+        &ImportReport::default(),
+        "octa",
+        |_| {},
+    );
     assert!(octahedron.is_clean(), "{:?}", octahedron.defects);
 }
 

@@ -55,6 +55,9 @@ pub(crate) struct Parsed {
     pub brdfs: Option<Vec<Brdf>>,
     pub flags: Option<Vec<VertexFlags>>,
     pub report: ImportReport,
+    /// Vertices the reader already left out because no face uses them (an OBJ's), counted
+    /// with the repair's.
+    pub unreferenced: usize,
 }
 
 /// Builds the mesh of `parsed`, repairing it unless `options` say strict.
@@ -69,6 +72,7 @@ pub(crate) fn build(
         brdfs,
         flags,
         mut report,
+        unreferenced,
     } = parsed;
     if soup.faces.is_empty() {
         return Err(IoError::parse(name, None, "no faces"));
@@ -81,6 +85,7 @@ pub(crate) fn build(
     }
     .map_err(|e| IoError::building(name, e, &unchecked))?;
     report.repairs = repaired.repairs;
+    report.repairs.unreferenced_vertices += unreferenced;
     let soup = repaired.soup;
     if soup.faces.is_empty() {
         let why = format!("no faces left after the repair ({})", report.repairs);

@@ -109,7 +109,13 @@ pub fn load_mesh(path: &Path, options: &ImportOptions) -> Result<(Mesh, ImportRe
     let bytes = read_bytes(path)?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let beside = |library: &str| read_library(folder, library);
-    load_mesh_bytes(&bytes, format, &path.display().to_string(), options, &beside)
+    load_mesh_bytes(
+        &bytes,
+        format,
+        &path.display().to_string(),
+        options,
+        &beside,
+    )
 }
 
 /// [`load_mesh`] on bytes already in memory; `libraries` reads the material libraries an OBJ

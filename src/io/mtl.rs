@@ -48,7 +48,12 @@ pub fn material_not_kept(material: &tobj::Material) -> Vec<String> {
     ]
     .into_iter()
     .flatten()
-    .map(|map| format!("texture map `{}` of material `{name}`", crate::files::escape(map)))
+    .map(|map| {
+        format!(
+            "texture map `{}` of material `{name}`",
+            crate::files::escape(map)
+        )
+    })
     .collect();
     if material.dissolve.is_some_and(|d| d < 1.0) {
         items.push(format!("opacity (`d`) of material `{name}`"));

@@ -36,7 +36,7 @@ pub(crate) fn parse_obj(
     })?;
     // Editors on Windows start UTF-8 files with a byte-order mark tobj would take as a word.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let (mut report, file_positions) = prescan(text, name)?;
+    let (mut report, file_positions, unreferenced) = prescan(text, name)?;
     let (models, materials) = load_models(text, name, library, &mut report)?;
     let brdfs: Vec<Brdf> = materials.iter().map(material_brdf).collect();
     for material in &materials {
@@ -86,6 +86,7 @@ pub(crate) fn parse_obj(
         );
     }
     parsed.report = report;
+    parsed.unreferenced = unreferenced;
     Ok(parsed)
 }
 
@@ -264,10 +265,12 @@ impl Dropped {
 
 /// Checks every `v` and `f` line for what tobj would reject without a line number or accept
 /// wrongly: unparsable or missing numbers, index 0, indices past the vertices defined so far.
-fn prescan(text: &str, name: &str) -> Result<(ImportReport, Vec<Vec3>), IoError> {
+/// Returns the report so far, the file's points, and how many of them no face uses.
+fn prescan(text: &str, name: &str) -> Result<(ImportReport, Vec<Vec3>, usize), IoError> {
     let mut report = ImportReport::default();
     let mut dropped = Dropped::default();
     let mut file_positions = Vec::new();
+    let mut used: Vec<bool> = Vec::new();
     for (number, line) in text.lines().enumerate() {
         let number = number + 1;
         let error = |message: String| IoError::parse(name, Some(number), message);
@@ -284,6 +287,7 @@ fn prescan(text: &str, name: &str) -> Result<(ImportReport, Vec<Vec3>), IoError>
                     )));
                 }
                 file_positions.push(p);
+                used.push(false);
             }
             Some("vt") => dropped.texture_coordinates += 1,
             Some("vn") => dropped.normals += 1,
@@ -295,13 +299,16 @@ fn prescan(text: &str, name: &str) -> Result<(ImportReport, Vec<Vec3>), IoError>
                     dropped.texture_coordinates,
                     dropped.normals,
                 ];
-                face_line(words, defined).map_err(error)?;
+                for v in face_line(words, defined).map_err(error)? {
+                    used[v] = true;
+                }
             }
             _ => {}
         }
     }
     report.not_kept = dropped.items();
-    Ok((report, file_positions))
+    let unused = used.iter().filter(|&&u| !u).count();
+    Ok((report, file_positions, unused))
 }
 
 /// The point of a `v` line (after the `v`); colours or a weight after it are tobj's business.
@@ -318,11 +325,13 @@ fn vertex_line<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<Vec3, Str
 }
 
 /// Checks an `f` line's corners (after the `f`) against the `defined` positions, texture
-/// coordinates and normals so far.
-fn face_line<'a>(words: impl Iterator<Item = &'a str>, defined: [usize; 3]) -> Result<(), String> {
-    let mut corners = 0;
+/// coordinates and normals so far; returns the positions it uses (from 0).
+fn face_line<'a>(
+    words: impl Iterator<Item = &'a str>,
+    defined: [usize; 3],
+) -> Result<Vec<usize>, String> {
+    let mut corners = Vec::new();
     for word in words {
-        corners += 1;
         let fields = ["vertex", "texture", "normal"].into_iter().zip(defined);
         for (field, (what, defined)) in word.split('/').zip(fields) {
             if field.is_empty() && what != "vertex" {
@@ -341,15 +350,26 @@ fn face_line<'a>(words: impl Iterator<Item = &'a str>, defined: [usize; 3]) -> R
                     "face {what} index {index} is out of range ({defined} defined so far)"
                 ));
             }
+            if what == "vertex" {
+                let from_end = index < 0;
+                corners.push(if from_end {
+                    defined - index.unsigned_abs() as usize
+                } else {
+                    index as usize - 1
+                });
+            }
         }
         if word.split('/').count() > 3 {
             return Err(format!("face corner `{word}` has more than three indices"));
         }
     }
-    if corners < 3 {
-        return Err(format!("face has {corners} corners; at least 3 are needed"));
+    if corners.len() < 3 {
+        return Err(format!(
+            "face has {} corners; at least 3 are needed",
+            corners.len()
+        ));
     }
-    Ok(())
+    Ok(corners)
 }
 
 /// Welding identity of a point: its bits, with -0 folded into +0.
@@ -441,4 +461,3 @@ pub fn write_obj_with_materials(
     }
     Ok(())
 }
-

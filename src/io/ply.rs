@@ -383,6 +383,7 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Parsed, IoError> {
         brdfs,
         flags: rows.ours.then_some(rows.masks),
         report,
+        unreferenced: 0,
     })
 }
 
@@ -649,7 +650,11 @@ fn colour_channel(value: f64, scalar: Scalar) -> f32 {
         Scalar::U32 | Scalar::I32 => value / u32::MAX as f64,
         Scalar::F32 | Scalar::F64 => value,
     };
-    let c = if encoded.is_nan() { 0.0 } else { encoded.clamp(0.0, 1.0) } as f32;
+    let c = if encoded.is_nan() {
+        0.0
+    } else {
+        encoded.clamp(0.0, 1.0)
+    } as f32;
     srgb_to_linear(c)
 }
 

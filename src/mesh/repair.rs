@@ -9,6 +9,7 @@
 use std::fmt;
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 use serde::Serialize;
 
@@ -54,21 +55,51 @@ impl fmt::Display for Repairs {
     /// `1 non-manifold vertex split, 3 degenerate faces dropped`, or `nothing`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let items = [
-            (self.non_manifold_vertices, "non-manifold vertex", "non-manifold vertices", "split"),
-            (self.non_manifold_edges, "non-manifold edge", "non-manifold edges", "split"),
-            (self.layer_shared_vertices, "vertex", "vertices", "shared by layers split"),
-            (self.degenerate_faces, "degenerate face", "degenerate faces", "dropped"),
-            (self.duplicate_faces, "duplicate face", "duplicate faces", "dropped"),
-            (self.flipped_faces, "face", "faces", "flipped to orient its part"),
-            (self.non_orientable_edges, "non-orientable edge", "non-orientable edges", "cut"),
-            (self.unreferenced_vertices, "unreferenced vertex", "unreferenced vertices", "dropped"),
+            (
+                self.non_manifold_vertices,
+                "non-manifold vertex split",
+                "non-manifold vertices split",
+            ),
+            (
+                self.non_manifold_edges,
+                "non-manifold edge split",
+                "non-manifold edges split",
+            ),
+            (
+                self.layer_shared_vertices,
+                "vertex shared by layers split",
+                "vertices shared by layers split",
+            ),
+            (
+                self.degenerate_faces,
+                "degenerate face dropped",
+                "degenerate faces dropped",
+            ),
+            (
+                self.duplicate_faces,
+                "duplicate face dropped",
+                "duplicate faces dropped",
+            ),
+            (
+                self.flipped_faces,
+                "face flipped to match its neighbours",
+                "faces flipped to match their neighbours",
+            ),
+            (
+                self.non_orientable_edges,
+                "non-orientable edge cut",
+                "non-orientable edges cut",
+            ),
+            (
+                self.unreferenced_vertices,
+                "unreferenced vertex dropped",
+                "unreferenced vertices dropped",
+            ),
         ];
         let parts: Vec<String> = items
             .iter()
             .filter(|(count, ..)| *count > 0)
-            .map(|&(count, one, many, done)| {
-                format!("{count} {} {done}", if count == 1 { one } else { many })
-            })
+            .map(|&(count, one, many)| format!("{count} {}", if count == 1 { one } else { many }))
             .collect();
         if parts.is_empty() {
             write!(f, "nothing")
@@ -101,12 +132,36 @@ pub fn repair(soup: Soup) -> Result<Repaired, MeshError> {
     check_indices(&faces, positions.len())?;
     let mut repairs = Repairs::default();
     let (mut faces, face_layers) = drop_bad_faces(&positions, faces, face_layers, &mut repairs);
-    orient(&mut faces, &mut repairs);
+    // Sorting the sides is most of the work on a clean mesh: done again only when the faces
+    // changed.
+    let mut sorted = sides(&faces);
+    let cut = orient(&mut faces, &sorted, &mut repairs);
+    if repairs.flipped_faces > 0 {
+        sorted = sides(&faces);
+    }
+    let crowded = crowded_edges(&sorted);
     let mut source: Vec<u32> = (0..positions.len() as u32).collect();
     let mut split = SplitMarks::new(positions.len());
+    repairs.non_manifold_edges = crowded.len();
+    let clean_edges = crowded.is_empty() && cut.is_empty();
+    // The ends of an edge split apart are split with it: counted as the edge's repair only.
+    for &(a, b) in cut.iter().chain(&crowded) {
+        split.edge_ends[a as usize] = true;
+        split.edge_ends[b as usize] = true;
+    }
     for round in 0..MAX_ROUNDS {
-        split_fans(&mut faces, &face_layers, &mut source, &mut split, round);
-        let loose = unpaired_sides_of_bad_edges(&faces, &face_layers);
+        if round > 0 {
+            sorted = sides(&faces);
+        }
+        let marks = (&mut source, &mut split);
+        let changed = split_fans(&mut faces, &sorted, &face_layers, marks, round);
+        if round == 0 && !changed && clean_edges {
+            break;
+        }
+        if changed {
+            sorted = sides(&faces);
+        }
+        let loose = unpaired_sides_of_bad_edges(&faces, &sorted, &face_layers);
         if loose.is_empty() {
             break;
         }
@@ -114,7 +169,9 @@ pub fn repair(soup: Soup) -> Result<Repaired, MeshError> {
             detach_side(&mut faces, &mut source, corner);
         }
     }
-    repairs.non_manifold_vertices = split.non_manifold.iter().filter(|&&s| s).count();
+    repairs.non_manifold_vertices = (0..positions.len())
+        .filter(|&v| split.non_manifold[v] && !split.edge_ends[v])
+        .count();
     repairs.layer_shared_vertices = split.layer_shared.iter().filter(|&&s| s).count();
     let (soup, source) = drop_unreferenced(&positions, faces, face_layers, source, &mut repairs);
     Ok(Repaired {
@@ -148,7 +205,10 @@ fn drop_bad_faces(
     repairs: &mut Repairs,
 ) -> (Vec<[u32; 3]>, Vec<LayerId>) {
     let mut seen: FxHashSet<(LayerId, [u32; 3])> = FxHashSet::default();
-    let mut kept = (Vec::with_capacity(faces.len()), Vec::with_capacity(faces.len()));
+    let mut kept = (
+        Vec::with_capacity(faces.len()),
+        Vec::with_capacity(faces.len()),
+    );
     for (tri, layer) in faces.into_iter().zip(face_layers) {
         let [a, b, c] = tri.map(|v| positions[v as usize].as_dvec3());
         let repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
@@ -173,12 +233,13 @@ fn drop_bad_faces(
 fn sides(faces: &[[u32; 3]]) -> Vec<(u64, u32)> {
     let vertex = |c: u32| faces[c as usize / 3][c as usize % 3];
     let mut keyed: Vec<(u64, u32)> = (0..faces.len() as u32 * 3)
+        .into_par_iter()
         .map(|c| {
             let (a, b) = (vertex(c), vertex(next(c)));
             (((a.min(b) as u64) << 32) | a.max(b) as u64, c)
         })
         .collect();
-    keyed.sort_unstable();
+    keyed.par_sort_unstable();
     keyed
 }
 
@@ -187,14 +248,21 @@ fn edge_groups(sides: &[(u64, u32)]) -> impl Iterator<Item = &[(u64, u32)]> {
     sides.chunk_by(|x, y| x.0 == y.0)
 }
 
+/// The edges (their two vertices) shared by more than two faces.
+fn crowded_edges(sides: &[(u64, u32)]) -> Vec<(u32, u32)> {
+    edge_groups(sides)
+        .filter(|group| group.len() > 2)
+        .map(|group| ((group[0].0 >> 32) as u32, group[0].0 as u32))
+        .collect()
+}
+
 /// Turns faces over so that each part joined by two-face edges is oriented one way, the way
-/// most of its faces already were; an edge no orientation can satisfy is counted (the fan
-/// splitting then cuts it open).
-fn orient(faces: &mut [[u32; 3]], repairs: &mut Repairs) {
-    let sides = sides(faces);
+/// most of its faces already were; returns the edges no orientation can satisfy (the fan
+/// splitting then cuts them open).
+fn orient(faces: &mut [[u32; 3]], sides: &[(u64, u32)], repairs: &mut Repairs) -> Vec<(u32, u32)> {
     let vertex = |c: u32| faces[c as usize / 3][c as usize % 3];
     let mut link = vec![INVALID; faces.len() * 3];
-    for group in edge_groups(&sides) {
+    for group in edge_groups(sides) {
         if let [(_, c), (_, d)] = *group {
             link[c as usize] = d;
             link[d as usize] = c;
@@ -235,7 +303,10 @@ fn orient(faces: &mut [[u32; 3]], repairs: &mut Repairs) {
                 }
             }
         }
-        let turned = part.iter().filter(|&&f| flip[f as usize] == Some(true)).count();
+        let turned = part
+            .iter()
+            .filter(|&&f| flip[f as usize] == Some(true))
+            .count();
         if turned * 2 > part.len() {
             for &f in &part {
                 flip[f as usize] = flip[f as usize].map(|t| !t);
@@ -243,18 +314,25 @@ fn orient(faces: &mut [[u32; 3]], repairs: &mut Repairs) {
         }
     }
     repairs.non_orientable_edges = conflicts.len();
+    let cut = conflicts
+        .into_iter()
+        .map(|(c, _)| (vertex(c), vertex(next(c))))
+        .collect();
     for (tri, flip) in faces.iter_mut().zip(flip) {
         if flip == Some(true) {
             tri.swap(1, 2);
             repairs.flipped_faces += 1;
         }
     }
+    cut
 }
 
 /// Which soup vertices were split, and why.
 struct SplitMarks {
     non_manifold: Vec<bool>,
     layer_shared: Vec<bool>,
+    /// Ends of edges split apart, whose splits are the edge's repair.
+    edge_ends: Vec<bool>,
 }
 
 impl SplitMarks {
@@ -262,6 +340,7 @@ impl SplitMarks {
         SplitMarks {
             non_manifold: vec![false; vertex_count],
             layer_shared: vec![false; vertex_count],
+            edge_ends: vec![false; vertex_count],
         }
     }
 }
@@ -293,16 +372,17 @@ fn pairs(group: &[(u64, u32)], faces: &[[u32; 3]], layers: &[LayerId]) -> Vec<(u
 }
 
 /// Gives each fan of faces around a vertex its own vertex: corners are joined across glued
-/// sides ([`pairs`]), and every class of corners at a vertex but its first gets a copy.
+/// sides ([`pairs`]; `sides` sorted from `faces`), and every class of corners at a vertex but
+/// its first gets a copy. Returns whether any vertex was split.
 fn split_fans(
     faces: &mut [[u32; 3]],
+    sides: &[(u64, u32)],
     layers: &[LayerId],
-    source: &mut Vec<u32>,
-    marks: &mut SplitMarks,
+    (source, marks): (&mut Vec<u32>, &mut SplitMarks),
     round: usize,
-) {
+) -> bool {
     let mut classes = UnionFind::new(faces.len() * 3);
-    for group in edge_groups(&sides(faces)) {
+    for group in edge_groups(sides) {
         for (c, d) in pairs(group, faces, layers) {
             // Side c runs a→b and side d b→a: c's corner at a meets d's next, and the other way.
             classes.join(c, next(d));
@@ -335,14 +415,19 @@ fn split_fans(
             }
         }
     }
+    !copies.is_empty()
 }
 
 /// Sides of edges that are still not manifold after the fans were split (more than two faces,
 /// or two running the same way): all but the glued pair, or all but the first where none is.
-fn unpaired_sides_of_bad_edges(faces: &[[u32; 3]], layers: &[LayerId]) -> Vec<u32> {
+fn unpaired_sides_of_bad_edges(
+    faces: &[[u32; 3]],
+    sides: &[(u64, u32)],
+    layers: &[LayerId],
+) -> Vec<u32> {
     let vertex = |c: u32| faces[c as usize / 3][c as usize % 3];
     let mut loose = Vec::new();
-    for group in edge_groups(&sides(faces)) {
+    for group in edge_groups(sides) {
         let bad = match *group {
             [_] => false,
             [(_, c), (_, d)] => vertex(c) == vertex(d),

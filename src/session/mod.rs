@@ -28,8 +28,8 @@ mod file;
 mod history;
 
 pub use file::{
-    SessionFileError, VERSION, check_save_path, is_session_path, open, open_with, read_session, save, stage,
-    write_session,
+    SessionFileError, VERSION, check_save_path, is_session_path, open, open_with, read_session,
+    save, stage, write_session,
 };
 pub use history::{DEFAULT_HISTORY_CAP_BYTES, Entry, History};
 

@@ -1,0 +1,265 @@
+//! Real-world files: the hand-written corpus in `tests/data/import/` (shapes other tools write)
+//! imports with the expected repairs and notes, `--strict` still refuses, colours and materials
+//! come in, and any triangle soup at all repairs into a valid mesh.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use proptest::prelude::*;
+use slayer::io::{Format, ImportOptions, ImportReport, import_bytes, import_mesh, write_mesh};
+use slayer::mesh::{Brdf, Mesh, Repairs, Soup, repair};
+
+fn corpus(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/import")
+        .join(name)
+}
+
+fn import(name: &str) -> (Mesh, ImportReport) {
+    import_mesh(&corpus(name), &ImportOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn strict(name: &str) -> String {
+    import_mesh(&corpus(name), &ImportOptions { strict: true })
+        .map(|_| ())
+        .expect_err("strict refuses a file that needs repairs")
+        .to_string()
+}
+
+fn close(a: [f32; 3], b: [f32; 3]) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6)
+}
+
+#[test]
+fn a_textured_obj_from_a_modelling_tool_loads_with_its_materials() {
+    let (mesh, report) = import("textured.obj");
+    assert_eq!(mesh.layer_names(), ["side"], "a bare `g` starts no layer");
+    assert_eq!(mesh.live_face_count(), 4, "two quads, triangulated");
+    assert_eq!(
+        mesh.live_vertex_count(),
+        6,
+        "the two materials' halves are one surface"
+    );
+    assert_eq!(mesh.components().count(), 1);
+    assert!(!report.repairs.any(), "{}", report.repairs);
+    assert_eq!(
+        report.not_kept,
+        [
+            "4 texture coordinates (`vt`)",
+            "1 normals (`vn`; recomputed)",
+            "1 line elements (`l`)",
+            "texture map `paint.png` of material `red_paint`",
+            "opacity (`d`) of material `blue_metal`",
+        ]
+    );
+    // Vertices keep the file's order; each takes the material of the first face using it.
+    let red = mesh.brdfs()[0];
+    assert!(close(red.diffuse, [0.8, 0.1, 0.1]) && close(red.specular, [0.04; 3]));
+    let from_ns = (2.0f32 / (10.0 + 2.0)).sqrt().sqrt();
+    assert!(
+        (red.roughness - from_ns).abs() < 1e-6,
+        "Ns 10 → {}",
+        red.roughness
+    );
+    assert_eq!(mesh.brdfs()[1], red, "v2 is first used by the red quad");
+    let blue = mesh.brdfs()[4];
+    assert!(close(blue.diffuse, [0.1, 0.1, 0.7]) && close(blue.specular, [0.9; 3]));
+    assert_eq!(blue.roughness, 0.25, "`Pr` is our roughness, read exactly");
+}
+
+#[test]
+fn a_material_library_that_cannot_be_read_is_a_note_not_an_error() {
+    let text = std::fs::read(corpus("textured.obj")).unwrap();
+    let (mesh, report) =
+        import_bytes(&text, Format::Obj, "t.obj", &ImportOptions::default()).unwrap();
+    assert_eq!(mesh.live_face_count(), 4);
+    assert!(mesh.brdfs().iter().all(|b| *b == Brdf::CLAY));
+    assert_eq!(report.notes.len(), 1, "{:?}", report.notes);
+    assert!(report.notes[0].starts_with("material library `box.mtl` not read"));
+}
+
+#[test]
+fn non_manifold_vertices_and_edges_are_split_and_strict_still_refuses() {
+    let (mesh, report) = import("bowtie.obj");
+    let expected = Repairs {
+        non_manifold_vertices: 1,
+        ..Repairs::default()
+    };
+    assert_eq!(report.repairs, expected);
+    assert_eq!(
+        (mesh.live_vertex_count(), mesh.components().count()),
+        (6, 2)
+    );
+    assert!(strict("bowtie.obj").contains("non-manifold vertex"));
+
+    let (mesh, report) = import("book.obj");
+    let expected = Repairs {
+        non_manifold_edges: 1,
+        ..Repairs::default()
+    };
+    assert_eq!(report.repairs, expected);
+    assert_eq!(mesh.live_face_count(), 3);
+    assert_eq!(
+        mesh.components().count(),
+        2,
+        "two pages stay glued, the third comes off"
+    );
+    assert!(strict("book.obj").contains("non-manifold edge"));
+    assert_eq!(
+        format!("repaired: {}", report.repairs),
+        "repaired: 1 non-manifold edge split"
+    );
+}
+
+#[test]
+fn degenerate_duplicate_flipped_and_unused_are_mended_and_counted() {
+    let (mesh, report) = import("untidy.obj");
+    let expected = Repairs {
+        degenerate_faces: 2,
+        duplicate_faces: 1,
+        flipped_faces: 1,
+        unreferenced_vertices: 1,
+        ..Repairs::default()
+    };
+    assert_eq!(report.repairs, expected);
+    assert_eq!(mesh.live_face_count(), 3);
+    // Every face now faces +z, as most of them did.
+    for f in 0..mesh.face_count() {
+        assert!(mesh.face_normal(f).z > 0.99, "face {f}");
+    }
+    assert_eq!(
+        report.lines(),
+        [
+            "repaired: 2 degenerate faces dropped, 1 duplicate face dropped, \
+          1 face flipped to match its neighbours, 1 unreferenced vertex dropped"
+        ]
+    );
+}
+
+#[test]
+fn a_moebius_band_is_cut_open_where_no_orientation_fits() {
+    let (mesh, report) = import("mobius.obj");
+    assert_eq!(report.repairs.non_orientable_edges, 1);
+    assert_eq!(mesh.live_face_count(), 16, "no face is lost");
+    assert_eq!(mesh.components().count(), 1);
+    assert!(strict("mobius.obj").contains("inconsistent orientation"));
+}
+
+#[test]
+fn ply_colours_become_the_diffuse_albedo() {
+    let (mesh, report) = import("colours.ply");
+    assert_eq!(report.not_kept, ["vertex properties `alpha` `confidence`"]);
+    let diffuse: Vec<[f32; 3]> = mesh.brdfs().iter().map(|b| b.diffuse).collect();
+    // 8-bit sRGB 255 and 0 are linear 1 and 0.
+    assert_eq!(
+        diffuse,
+        [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0]
+        ]
+    );
+    assert!(
+        mesh.brdfs()
+            .iter()
+            .all(|b| b.roughness == Brdf::CLAY.roughness)
+    );
+}
+
+#[test]
+fn another_tools_flags_are_not_our_mask() {
+    // Big-endian, float colours, a quad with ushort counts, and a `flags` property with bit
+    // 0x2 set on every vertex: a library's own flag, not slayer's mask.
+    let (mesh, report) = import("foreign_flags_be.ply");
+    assert_eq!(mesh.live_face_count(), 2);
+    assert!(mesh.flags().iter().all(|f| f.is_empty()), "nothing frozen");
+    assert_eq!(report.not_kept, ["vertex properties `flags`"]);
+    let half = mesh.brdfs()[0].diffuse[0];
+    assert!((half - 0.214_041).abs() < 1e-5, "sRGB 0.5 is linear {half}");
+    assert_eq!(mesh.brdfs()[1].diffuse, [1.0, 0.0, 0.0]);
+}
+
+/// Two layers with their own materials, one of them painted: what an artist exports.
+fn painted_scene() -> Mesh {
+    let quad =
+        |z: f32| [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|[x, y]| Vec3::new(x, y, z));
+    let positions: Vec<Vec3> = quad(0.0).into_iter().chain(quad(0.5)).collect();
+    let faces = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+    let mut mesh = Mesh::new(
+        positions,
+        faces,
+        vec![0, 0, 1, 1],
+        vec!["base".into(), "coat".into()],
+    )
+    .unwrap();
+    mesh.set_layer_brdf(0, Brdf::new([0.7, 0.6, 0.5], [0.04; 3], 0.8));
+    mesh.set_layer_brdf(1, Brdf::new([0.2, 0.3, 0.9], [0.5; 3], 0.1));
+    mesh
+}
+
+#[test]
+fn slayers_own_obj_comes_back_with_its_layers_and_materials() {
+    let dir = std::env::temp_dir().join(format!("slayer-import-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = painted_scene();
+    for name in ["scene.obj", "scene.ply"] {
+        let path = dir.join(name);
+        write_mesh(&mesh, &path).unwrap();
+        let (back, report) = import_mesh(&path, &ImportOptions { strict: true }).unwrap();
+        assert_eq!(back.layer_names(), mesh.layer_names(), "{name}");
+        assert_eq!(back.faces(), mesh.faces(), "{name}");
+        assert_eq!(back.positions(), mesh.positions(), "{name}");
+        // A roughness of 0.1 is below what `Ns` can say; `Pr` carries it exactly.
+        assert_eq!(back.brdfs(), mesh.brdfs(), "{name}");
+        assert_eq!(report, ImportReport::default(), "{name}: nothing to say");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Up to `faces` triangles over `points` random points (some shared, some repeated, some
+/// collinear), on up to two layers: soups as messy as a file can be.
+fn soup(points: usize, faces: usize) -> impl Strategy<Value = Soup> {
+    let point =
+        (0u8..4, 0u8..4, 0u8..2).prop_map(|(x, y, z)| Vec3::new(x as f32, y as f32, z as f32));
+    (
+        prop::collection::vec(point, 3..points),
+        prop::collection::vec((any::<[u32; 3]>(), 0u32..2), 1..faces),
+    )
+        .prop_map(|(positions, raw)| {
+            let n = positions.len() as u32;
+            let faces = raw.iter().map(|(f, _)| f.map(|v| v % n)).collect();
+            let face_layers = raw.iter().map(|&(_, l)| l).collect();
+            Soup {
+                positions,
+                faces,
+                face_layers,
+            }
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Whatever the soup, the repair gives a mesh that builds and validates, losing only the
+    /// faces it says it dropped.
+    #[test]
+    fn any_soup_repairs_into_a_valid_mesh(soup in soup(12, 24)) {
+        let input_faces = soup.faces.len();
+        let repaired = repair(soup).unwrap();
+        let r = repaired.repairs;
+        let kept = repaired.soup.faces.len();
+        prop_assert_eq!(kept + r.degenerate_faces + r.duplicate_faces, input_faces);
+        if kept == 0 {
+            return Ok(());
+        }
+        let mesh = Mesh::new(
+            repaired.soup.positions,
+            repaired.soup.faces,
+            repaired.soup.face_layers,
+            vec!["a".into(), "b".into()],
+        );
+        let mesh = mesh.map_err(|e| TestCaseError::fail(format!("{e} after {r}")))?;
+        prop_assert!(mesh.validate().is_ok());
+    }
+}
