@@ -180,6 +180,35 @@ fn another_tools_flags_are_not_our_mask() {
     assert_eq!(mesh.brdfs()[1].diffuse, [1.0, 0.0, 0.0]);
 }
 
+#[test]
+fn ascii_stl_solids_become_layers_and_points_weld() {
+    let (mesh, report) = import("two_solids.stl");
+    assert_eq!(mesh.layer_names(), ["base_plate", "lid"]);
+    assert_eq!(mesh.faces_per_layer(), [2, 1]);
+    assert_eq!(
+        mesh.live_vertex_count(),
+        7,
+        "the plate's two shared corners weld"
+    );
+    assert_eq!(report.welded_vertices, 2);
+    assert_eq!(report.not_kept, ["3 facet normals (recomputed)"]);
+}
+
+#[test]
+fn binary_stl_with_a_solid_header_is_read_as_binary() {
+    let (mesh, report) = import("cad_tetra.stl");
+    assert_eq!((mesh.live_vertex_count(), mesh.live_face_count()), (4, 4));
+    assert_eq!(mesh.closed_components().len(), 1, "a closed tetrahedron");
+    assert!(!report.repairs.any(), "{}", report.repairs);
+    assert_eq!(
+        report.not_kept,
+        [
+            "4 facet normals (recomputed)",
+            "1 triangles' attribute bytes (colour)"
+        ]
+    );
+}
+
 /// Two layers with their own materials, one of them painted: what an artist exports.
 fn painted_scene() -> Mesh {
     let quad =
@@ -203,16 +232,24 @@ fn slayers_own_obj_comes_back_with_its_layers_and_materials() {
     let dir = std::env::temp_dir().join(format!("slayer-import-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = painted_scene();
-    for name in ["scene.obj", "scene.ply"] {
+    for name in ["scene.obj", "scene.ply", "scene.stl"] {
         let path = dir.join(name);
         write_mesh(&mesh, &path).unwrap();
         let (back, report) = import_mesh(&path, &ImportOptions { strict: true }).unwrap();
         assert_eq!(back.layer_names(), mesh.layer_names(), "{name}");
         assert_eq!(back.faces(), mesh.faces(), "{name}");
         assert_eq!(back.positions(), mesh.positions(), "{name}");
-        // A roughness of 0.1 is below what `Ns` can say; `Pr` carries it exactly.
-        assert_eq!(back.brdfs(), mesh.brdfs(), "{name}");
-        assert_eq!(report, ImportReport::default(), "{name}: nothing to say");
+        if !name.ends_with(".stl") {
+            // A roughness of 0.1 is below what `Ns` can say; `Pr` carries it exactly. STL
+            // holds no material.
+            assert_eq!(back.brdfs(), mesh.brdfs(), "{name}");
+        }
+        let welded = if name.ends_with(".stl") { 4 } else { 0 };
+        let expected = ImportReport {
+            welded_vertices: welded,
+            ..ImportReport::default()
+        };
+        assert_eq!(report, expected, "{name}: nothing to say");
     }
     std::fs::remove_dir_all(dir).unwrap();
 }

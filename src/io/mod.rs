@@ -13,6 +13,7 @@ mod import;
 mod mtl;
 mod obj;
 mod ply;
+mod stl;
 
 pub use atomic::{AtomicBatch, sweep_stale_temporaries, write_atomically};
 pub use error::IoError;
@@ -20,6 +21,7 @@ pub use import::{ImportOptions, ImportReport};
 pub use mtl::{layer_materials, material_brdf, write_mtl};
 pub use obj::{LibraryReader, write_obj, write_obj_with_materials};
 pub use ply::write_ply;
+pub use stl::write_stl;
 
 use std::path::{Component, Path};
 
@@ -31,6 +33,7 @@ use import::Parsed;
 pub enum Format {
     Obj,
     Ply,
+    Stl,
 }
 
 impl Format {
@@ -43,6 +46,7 @@ impl Format {
         {
             Some("obj") => Ok(Format::Obj),
             Some("ply") => Ok(Format::Ply),
+            Some("stl") => Ok(Format::Stl),
             _ => Err(IoError::UnsupportedFormat {
                 path: path.display().to_string(),
             }),
@@ -130,6 +134,7 @@ pub fn load_mesh_bytes(
     let parsed: Parsed = match format {
         Format::Obj => obj::parse_obj(bytes, name, libraries)?,
         Format::Ply => ply::parse_ply(bytes, name)?,
+        Format::Stl => stl::parse_stl(bytes, name)?,
     };
     import::build(parsed, options, name)
 }
@@ -167,6 +172,7 @@ pub fn encode_mesh(mesh: &Mesh, format: Format) -> Vec<u8> {
     let _ = match format {
         Format::Obj => write_obj(mesh, &mut bytes),
         Format::Ply => write_ply(mesh, &mut bytes),
+        Format::Stl => write_stl(mesh, &mut bytes),
     };
     bytes
 }
@@ -184,7 +190,7 @@ pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
 /// one unit.
 pub fn stage_mesh(batch: &mut AtomicBatch, mesh: &Mesh, path: &Path) -> Result<(), IoError> {
     match Format::of_path(path)? {
-        Format::Ply => batch.stage(path, &encode_mesh(mesh, Format::Ply)),
+        format @ (Format::Ply | Format::Stl) => batch.stage(path, &encode_mesh(mesh, format)),
         Format::Obj => {
             let library = path.with_extension("mtl");
             let library_name = library

@@ -29,7 +29,7 @@ pub fn material_brdf(material: &tobj::Material) -> Brdf {
 /// The inverse of [`crate::mesh::blinn_exponent`] (`e = 2/α² − 2`, `α = r²`): exact above the
 /// smallest slope that mapping keeps.
 fn roughness_of_exponent(exponent: f32) -> f32 {
-    if !(exponent >= 0.0) {
+    if exponent.is_nan() || exponent < 0.0 {
         return 1.0;
     }
     (2.0 / (exponent + 2.0)).sqrt().sqrt()

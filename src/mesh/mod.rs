@@ -12,6 +12,7 @@ mod delta;
 mod digest;
 mod edit;
 mod error;
+mod extract;
 mod measure;
 mod raw;
 mod repair;

@@ -302,7 +302,7 @@ pub fn check_save_path(path: &Path) -> Result<(), IoError> {
     }
 }
 
-/// Opens a session file, or a mesh file (OBJ, PLY) as a new session, repaired where it needs
+/// Opens a session file, or a mesh file (OBJ, PLY, STL) as a new session, repaired where it needs
 /// it.
 pub fn open(path: &Path) -> Result<Session, SessionFileError> {
     open_with(path, &ImportOptions::default()).map(|(session, _)| session)
@@ -330,7 +330,7 @@ pub fn open_with(
 }
 
 /// Saves a session atomically: a `.slayer` path gets the session file (with its history when
-/// `with_history`), a mesh path (OBJ, PLY) the mesh alone.
+/// `with_history`), a mesh path (OBJ, PLY, STL) the mesh alone.
 pub fn save(session: &Session, path: &Path, with_history: bool) -> Result<(), IoError> {
     let mut batch = AtomicBatch::new();
     stage(&mut batch, session, path, with_history)?;

@@ -3,6 +3,7 @@
 mod backend;
 mod bench;
 mod check;
+mod convert;
 mod demo;
 mod history;
 mod open;
@@ -62,7 +63,7 @@ enum Command {
         /// 0.4): a deliberately irregular mesh, e.g. to try `slayer remesh` on.
         #[arg(long, default_value_t = 0.0)]
         jitter: f32,
-        /// Output file: a mesh (.obj, .ply) or a session (.slayer).
+        /// Output file: a mesh (.obj, .ply, .stl) or a session (.slayer).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -77,17 +78,28 @@ enum Command {
         #[arg(long, value_name = "ORIGINAL")]
         against: Option<PathBuf>,
     },
+    /// Convert a mesh or session between formats by extension (.obj, .ply, .stl, .slayer),
+    /// repairing it on the way unless --strict
+    Convert {
+        /// Mesh (.obj, .ply, .stl) or session (.slayer).
+        input: PathBuf,
+        /// Mesh (.obj with its .mtl, .ply, .stl) or session (.slayer).
+        output: PathBuf,
+        /// Keep only these layers (names or numbers, comma-separated), in this order.
+        #[arg(long, value_delimiter = ',')]
+        layers: Vec<String>,
+    },
     /// Apply a stroke file to a mesh or session and write the result (the input is never
     /// modified unless `--in-place` is given). A `.slayer` output keeps every stroke as an
     /// undoable history entry.
     Sculpt {
-        /// Mesh (.obj, .ply) or session (.slayer).
+        /// Mesh (.obj, .ply, .stl) or session (.slayer).
         #[arg(long)]
         input: PathBuf,
         /// Stroke file (JSON; see `slayer::brush` docs or README).
         #[arg(long)]
         strokes: PathBuf,
-        /// Mesh (.obj, .ply) or session (.slayer, with the history).
+        /// Mesh (.obj, .ply, .stl) or session (.slayer, with the history).
         #[arg(long)]
         output: PathBuf,
         /// Allow the output to be the input file itself (it is replaced only once the whole
@@ -286,6 +298,11 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             against,
         } => check::run(&file, json, against.as_deref(), strict),
         Command::Adapters { json } => adapters(json),
+        Command::Convert {
+            input,
+            output,
+            layers,
+        } => convert::run(&input, &output, &layers, strict),
         Command::Sculpt {
             input,
             strokes,

@@ -31,7 +31,7 @@ pub fn parse_camera(text: &str) -> Result<CameraSpec, String> {
 }
 
 /// Layer choices by index or name, checked against the mesh.
-fn resolve_layers(mesh: &Mesh, names: &[String]) -> anyhow::Result<Vec<LayerId>> {
+pub fn resolve_layers(mesh: &Mesh, names: &[String]) -> anyhow::Result<Vec<LayerId>> {
     names
         .iter()
         .map(|name| {
