@@ -2,8 +2,11 @@
 //! imports with the expected repairs and notes, `--strict` still refuses, colours and materials
 //! come in, and any triangle soup at all repairs into a valid mesh.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{arg, assert_one_line_error, scratch, slayer, text, write_scene};
 use glam::Vec3;
 use proptest::prelude::*;
 use slayer::io::{Format, ImportOptions, ImportReport, import_bytes, import_mesh, write_mesh};
@@ -299,4 +302,75 @@ proptest! {
         let mesh = mesh.map_err(|e| TestCaseError::fail(format!("{e} after {r}")))?;
         prop_assert!(mesh.validate().is_ok());
     }
+}
+
+#[test]
+fn the_cli_says_what_it_repaired_and_strict_refuses() {
+    let dir = scratch("import-cli");
+    let untidy = corpus("untidy.obj");
+    let stl = dir.join("untidy.stl");
+    let out = slayer(&["convert", arg(&untidy), arg(&stl)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let said = text(&out.stderr);
+    assert!(
+        said.contains("untidy.obj: repaired: 2 degenerate faces dropped, 1 duplicate face dropped"),
+        "{said}"
+    );
+    assert!(text(&out.stdout).ends_with("5 vertices, 3 faces, 1 layers\n"));
+    assert_one_line_error(
+        &slayer(&["convert", "--strict", arg(&untidy), arg(&stl)]),
+        &["untidy.obj", "degenerate"],
+    );
+
+    // `check --json` carries the repairs and what was not kept.
+    let out = slayer(&["check", "--json", arg(&corpus("textured.obj"))]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(report["repairs"]["degenerate_faces"], 0);
+    assert_eq!(report["not_kept"].as_array().unwrap().len(), 5);
+    let out = slayer(&["check", "--json", arg(&untidy)]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(report["repairs"]["duplicate_faces"], 1);
+    assert_eq!(report["repairs"]["flipped_faces"], 1);
+    assert_eq!(report["valid"], true);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn convert_keeps_the_layers_asked_for_in_every_format() {
+    let dir = scratch("convert");
+    let scene = dir.join("bark.ply");
+    write_scene("bark", 3000, &[], &scene);
+    let mut digests = Vec::new();
+    for ext in ["obj", "ply", "stl", "slayer"] {
+        let out = dir.join(format!("inner.{ext}"));
+        let done = slayer(&[
+            "convert",
+            arg(&scene),
+            arg(&out),
+            "--layers",
+            "2,inner-bark",
+        ]);
+        assert!(done.status.success(), "{ext}: {}", text(&done.stderr));
+        let check = slayer(&["check", "--json", arg(&out)]);
+        let report: serde_json::Value = serde_json::from_slice(&check.stdout).expect("JSON");
+        assert_eq!(report["layers"], 2, "{ext}");
+        assert_eq!(report["layer_names"][1], "inner-bark", "{ext}");
+        assert_eq!(report["intersections"], 0, "{ext}");
+        digests.push((ext, report["faces"].clone()));
+    }
+    assert!(
+        digests.iter().all(|(_, faces)| *faces == digests[0].1),
+        "{digests:?}"
+    );
+    assert_one_line_error(
+        &slayer(&[
+            "convert",
+            arg(&scene),
+            arg(&dir.join("x.ply")),
+            "--layers",
+            "moss",
+        ]),
+        &["no layer `moss`", "inner-bark"],
+    );
+    std::fs::remove_dir_all(dir).unwrap();
 }
