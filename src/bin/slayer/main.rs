@@ -221,7 +221,8 @@ enum Command {
     /// shadowing) under a key and a fill light. The camera orbits the mesh's bounding box with
     /// +z up and frames it whole.
     Render {
-        /// Mesh or session file (.ply and .slayer keep painted BRDFs; .obj renders in clay).
+        /// Mesh or session file (.ply and .slayer keep painted BRDFs, .obj its materials per layer,
+        /// .stl renders in clay).
         file: PathBuf,
         /// Output PNG.
         #[arg(short, long)]
