@@ -212,6 +212,93 @@ fn binary_stl_with_a_solid_header_is_read_as_binary() {
     );
 }
 
+#[test]
+fn another_tools_gltf_keeps_its_nodes_transforms_colours_and_materials() {
+    let (mesh, report) = import("two_nodes.gltf");
+    assert_eq!(
+        mesh.layer_names(),
+        ["floor", "gem"],
+        "one layer per node with a mesh"
+    );
+    assert_eq!(
+        mesh.faces_per_layer(),
+        [2, 4],
+        "a strip of two, a tetrahedron"
+    );
+    assert_eq!(
+        report.not_kept,
+        ["1 texture coordinate sets", "1 normal sets (recomputed)"]
+    );
+    // Y-up to Z-up, through the parent's translation (0, 2, 0) in glTF's frame.
+    assert_eq!(mesh.positions()[1], Vec3::new(1.0, 0.0, 2.0));
+    // The gem: mirrored in x, moved by 3, then by its parent.
+    assert_eq!(mesh.positions()[5], Vec3::new(2.0, 0.0, 2.0));
+    // The strip faces up (+Z), and the mirrored tetrahedron still winds outward.
+    assert!(mesh.face_normal(0).z > 0.99 && mesh.face_normal(1).z > 0.99);
+    let gem = &mesh.closed_components()[0];
+    assert!((gem.volume - 1.0 / 6.0).abs() < 1e-6, "{}", gem.volume);
+    // 8-bit linear colours with no material: paint-like, clay's roughness.
+    assert_eq!(mesh.brdfs()[0].diffuse, [1.0, 0.0, 0.0]);
+    assert_eq!(mesh.brdfs()[3].diffuse, [1.0, 1.0, 1.0]);
+    assert_eq!(mesh.brdfs()[0].roughness, Brdf::CLAY.roughness);
+    // The gold metal: no diffuse, its base colour as specular, its roughness.
+    let gold = mesh.brdfs()[4];
+    assert_eq!(gold.diffuse, [0.0; 3]);
+    assert!(close(gold.specular, [1.0, 0.8, 0.3]), "{gold:?}");
+    assert!((gold.roughness - 0.3).abs() < 1e-6);
+}
+
+/// Runs the Khronos glTF validator on `files` when `tools/test.sh` installed it
+/// (`SLAYER_GLTF_VALIDATOR` names its script); `None` when it is not set.
+fn khronos_validator(files: &[PathBuf]) -> Option<String> {
+    let script = std::env::var("SLAYER_GLTF_VALIDATOR").ok()?;
+    let out = std::process::Command::new("node")
+        .arg(&script)
+        .args(files)
+        .output()
+        .unwrap_or_else(|e| panic!("SLAYER_GLTF_VALIDATOR={script}, but node did not run: {e}"));
+    assert!(
+        out.status.success(),
+        "the validator found errors:\n{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    Some(text(&out.stdout))
+}
+
+#[test]
+fn gltf_exports_are_valid_for_the_khronos_validator() {
+    let dir = scratch("gltf-valid");
+    let scene = dir.join("metal.ply");
+    write_scene("metal", 2000, &[], &scene);
+    let mut files = Vec::new();
+    for ext in ["glb", "gltf"] {
+        let out = dir.join(format!("metal.{ext}"));
+        let done = slayer(&["convert", arg(&scene), arg(&out)]);
+        assert!(done.status.success(), "{}", text(&done.stderr));
+        // What our own reader checks whatever the machine has: the crate validates the
+        // document, and glTF → slayer → glTF gives the same bytes.
+        let (back, _) = import_mesh(&out, &ImportOptions { strict: true }).unwrap();
+        let again = dir.join(format!("again.{ext}"));
+        write_mesh(&back, &again).unwrap();
+        assert!(std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(), "{ext}");
+        files.push(out);
+    }
+    files.push(corpus("two_nodes.gltf"));
+    match khronos_validator(&files) {
+        Some(report) => {
+            assert_eq!(report.lines().count(), files.len(), "{report}");
+            assert!(
+                report.lines().all(|l| l.contains("\"errors\":0")),
+                "{report}"
+            );
+            eprintln!("Khronos glTF validator:\n{report}");
+        }
+        None => eprintln!("SLAYER_GLTF_VALIDATOR not set: tools/test.sh installs the validator"),
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// Two layers with their own materials, one of them painted: what an artist exports.
 fn painted_scene() -> Mesh {
     let quad =
@@ -235,7 +322,13 @@ fn slayers_own_obj_comes_back_with_its_layers_and_materials() {
     let dir = std::env::temp_dir().join(format!("slayer-import-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = painted_scene();
-    for name in ["scene.obj", "scene.ply", "scene.stl"] {
+    for name in [
+        "scene.obj",
+        "scene.ply",
+        "scene.stl",
+        "scene.glb",
+        "scene.gltf",
+    ] {
         let path = dir.join(name);
         write_mesh(&mesh, &path).unwrap();
         let (back, report) = import_mesh(&path, &ImportOptions { strict: true }).unwrap();

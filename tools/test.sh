@@ -36,6 +36,23 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     chmod 700 "$XDG_RUNTIME_DIR"
 fi
 
+# The Khronos glTF validator checks our glTF exports (tests/import.rs); it comes from npm, so it
+# is installed where Node.js is present (it is on our machines) and kept under target/.
+validator=target/gltf-validator/node_modules/gltf-validator
+if command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1; then
+    if [ ! -d "$validator" ]; then
+        echo "tools/test.sh: installing the Khronos glTF validator (npm gltf-validator)"
+        npm install --silent --no-audit --no-fund --prefix target/gltf-validator gltf-validator@2.0.0-dev.3.10 >/dev/null \
+            || echo "tools/test.sh: could not install gltf-validator; glTF exports are checked by our reader only" >&2
+    fi
+    if [ -d "$validator" ]; then
+        export SLAYER_GLTF_VALIDATOR="$PWD/tools/gltf-validate.js"
+        export GLTF_VALIDATOR_MODULE="$PWD/$validator"
+    fi
+else
+    echo "tools/test.sh: no Node.js; glTF exports are checked by our reader only (install nodejs and npm for the Khronos validator)" >&2
+fi
+
 echo "tools/test.sh: building (release)"
 cargo build --release --all-targets --quiet
 

@@ -12,7 +12,7 @@ pub enum IoError {
         source: std::io::Error,
     },
     #[error(
-        "{path}: unsupported file type (expected .obj, .ply, .stl or, where a session fits, .slayer)"
+        "{path}: unsupported file type (expected .obj, .ply, .stl, .glb, .gltf or, where a session fits, .slayer)"
     )]
     UnsupportedFormat { path: String },
     #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]

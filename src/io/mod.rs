@@ -9,14 +9,18 @@
 
 mod atomic;
 mod error;
+mod gltf;
+mod gltf_write;
 mod import;
 mod mtl;
 mod obj;
 mod ply;
 mod stl;
+mod weld;
 
 pub use atomic::{AtomicBatch, sweep_stale_temporaries, write_atomically};
 pub use error::IoError;
+pub use gltf_write::{write_glb, write_gltf};
 pub use import::{ImportOptions, ImportReport};
 pub use mtl::{layer_materials, material_brdf, write_mtl};
 pub use obj::{LibraryReader, write_obj, write_obj_with_materials};
@@ -34,6 +38,10 @@ pub enum Format {
     Obj,
     Ply,
     Stl,
+    /// Binary glTF 2.0.
+    Glb,
+    /// glTF 2.0 as JSON.
+    Gltf,
 }
 
 impl Format {
@@ -47,6 +55,8 @@ impl Format {
             Some("obj") => Ok(Format::Obj),
             Some("ply") => Ok(Format::Ply),
             Some("stl") => Ok(Format::Stl),
+            Some("glb") => Ok(Format::Glb),
+            Some("gltf") => Ok(Format::Gltf),
             _ => Err(IoError::UnsupportedFormat {
                 path: path.display().to_string(),
             }),
@@ -135,6 +145,7 @@ pub fn load_mesh_bytes(
         Format::Obj => obj::parse_obj(bytes, name, libraries)?,
         Format::Ply => ply::parse_ply(bytes, name)?,
         Format::Stl => stl::parse_stl(bytes, name)?,
+        Format::Glb | Format::Gltf => gltf::parse_gltf(bytes, name, libraries)?,
     };
     import::build(parsed, options, name)
 }
@@ -144,8 +155,9 @@ pub fn no_libraries(_: &str) -> Result<Vec<u8>, String> {
     Err("the mesh was not read from a folder".into())
 }
 
-/// A material library named in an OBJ in `folder`: a relative path that stays in the folder
-/// (an OBJ must not make slayer read `/etc/passwd` or `../../secret`).
+/// A file another names in `folder` (an OBJ's material library, a `.gltf`'s buffer): a relative
+/// path that stays in the folder (a file must not make slayer read `/etc/passwd` or
+/// `../../secret`).
 fn read_library(folder: &Path, library: &str) -> Result<Vec<u8>, String> {
     let relative = Path::new(library);
     if !relative
@@ -173,6 +185,8 @@ pub fn encode_mesh(mesh: &Mesh, format: Format) -> Vec<u8> {
         Format::Obj => write_obj(mesh, &mut bytes),
         Format::Ply => write_ply(mesh, &mut bytes),
         Format::Stl => write_stl(mesh, &mut bytes),
+        Format::Glb => write_glb(mesh, &mut bytes),
+        Format::Gltf => write_gltf(mesh, &mut bytes),
     };
     bytes
 }
@@ -190,7 +204,9 @@ pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
 /// one unit.
 pub fn stage_mesh(batch: &mut AtomicBatch, mesh: &Mesh, path: &Path) -> Result<(), IoError> {
     match Format::of_path(path)? {
-        format @ (Format::Ply | Format::Stl) => batch.stage(path, &encode_mesh(mesh, format)),
+        format @ (Format::Ply | Format::Stl | Format::Glb | Format::Gltf) => {
+            batch.stage(path, &encode_mesh(mesh, format))
+        }
         Format::Obj => {
             let library = path.with_extension("mtl");
             let library_name = library

@@ -6,11 +6,11 @@
 use std::io::{self, Write};
 
 use glam::Vec3;
-use rustc_hash::FxHashMap;
 
 use super::IoError;
-use super::import::{ImportReport, Parsed};
-use crate::mesh::{INVALID, LayerId, Mesh, Soup};
+use super::import::Parsed;
+use super::weld::SoupBuilder as Builder;
+use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// The start of the 80-byte header of a binary STL slayer wrote; the layer names follow,
 /// separated by `|`.
@@ -20,25 +20,11 @@ const TRIANGLE_BYTES: usize = 50;
 
 /// Parses STL bytes, binary or ASCII (`name` is used in messages).
 pub(crate) fn parse_stl(bytes: &[u8], name: &str) -> Result<Parsed, IoError> {
-    let mut builder = match binary_count(bytes) {
+    let builder = match binary_count(bytes) {
         Some(count) => read_binary(bytes, count),
         None => read_ascii(bytes, name)?,
     };
-    if builder.soup.faces.is_empty() {
-        return Err(IoError::parse(name, None, "no faces"));
-    }
-    builder.report.non_finite_vertices = builder
-        .soup
-        .positions
-        .iter()
-        .filter(|p| !p.is_finite())
-        .count();
-    Ok(Parsed {
-        soup: builder.soup,
-        layer_names: builder.layer_names,
-        report: builder.report,
-        ..Parsed::default()
-    })
+    Ok(builder.finish())
 }
 
 /// The triangle count of a binary STL: the one its header gives when the size matches it.
@@ -53,54 +39,6 @@ fn binary_count(bytes: &[u8]) -> Option<usize> {
             .take(4096)
             .any(|w| w.eq_ignore_ascii_case(b"facet"));
     (fits && !looks_ascii).then_some(count as usize)
-}
-
-/// Builds a soup from triangles, welding each layer's points.
-#[derive(Default)]
-struct Builder {
-    soup: Soup,
-    layer_names: Vec<String>,
-    report: ImportReport,
-    /// Each layer's points by bit pattern.
-    welds: Vec<FxHashMap<[u32; 3], u32>>,
-}
-
-impl Builder {
-    fn layer(&mut self, name: String) -> LayerId {
-        self.layer_names.push(name);
-        self.welds.push(FxHashMap::default());
-        (self.layer_names.len() - 1) as LayerId
-    }
-
-    fn triangle(&mut self, corners: [Vec3; 3], layer: LayerId) {
-        let face = corners.map(|p| self.point(p, layer));
-        self.soup.faces.push(face);
-        self.soup.face_layers.push(layer);
-    }
-
-    fn point(&mut self, p: Vec3, layer: LayerId) -> u32 {
-        let positions = &mut self.soup.positions;
-        let mut add = || {
-            positions.push(p);
-            (positions.len() - 1) as u32
-        };
-        if p.is_nan() {
-            return add();
-        }
-        // -0 and +0 are one point.
-        let key = (p + Vec3::ZERO).to_array().map(f32::to_bits);
-        match self.welds[layer as usize].get(&key) {
-            Some(&v) => {
-                self.report.welded_vertices += 1;
-                v
-            }
-            None => {
-                let v = add();
-                self.welds[layer as usize].insert(key, v);
-                v
-            }
-        }
-    }
 }
 
 fn read_binary(bytes: &[u8], count: usize) -> Builder {
