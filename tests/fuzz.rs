@@ -1,5 +1,5 @@
 //! A seeded mutation run over every file slayer reads: OBJ (with its `.mtl`), PLY (ASCII and
-//! binary), STL (ASCII and binary), `.slayer` sessions and stroke files. Each mangled file must
+//! binary), STL (ASCII and binary), glTF (`.glb`, `.gltf`), `.slayer` sessions and stroke files. Each mangled file must
 //! give an `Err` or a valid mesh (a session, strokes that resolve), never a panic; each case is
 //! timed (a case past [`CASE_LIMIT`] fails the run: a hang), and the run's peak memory is
 //! bounded. `tools/test.sh` runs a few thousand cases; `tools/fuzz.sh N` runs N (10⁵ takes a
@@ -43,7 +43,13 @@ fn sources() -> Vec<(Kind, Vec<u8>)> {
     let tiny = shapes::stacked_sheets(2, 3, 2, 1.0, 2.0);
     let mut sources = Vec::new();
     for mesh in [&tiny, &shapes::tetrahedron(), &shapes::fan(5)] {
-        for format in [Format::Obj, Format::Ply, Format::Stl] {
+        for format in [
+            Format::Obj,
+            Format::Ply,
+            Format::Stl,
+            Format::Glb,
+            Format::Gltf,
+        ] {
             sources.push((Kind::Mesh(format), encode_mesh(mesh, format)));
         }
         sources.push((
@@ -65,6 +71,7 @@ fn sources() -> Vec<(Kind, Vec<u8>)> {
         ("foreign_flags_be.ply", Format::Ply),
         ("two_solids.stl", Format::Stl),
         ("cad_tetra.stl", Format::Stl),
+        ("two_nodes.gltf", Format::Gltf),
     ] {
         sources.push((Kind::Mesh(format), data(name)));
     }
@@ -100,7 +107,7 @@ fn mangle(original: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
                 .collect()
         }
         3 => duplicate_lines(&mut bytes, rng),
-        4 => bytes = nested_json(rng.random_range(1..100_000)),
+        4 => bytes = nested_json(original, rng.random_range(1..100_000)),
         5 => {
             // A little-endian count anywhere made huge: binary headers that lie.
             if bytes.len() >= 4 {
@@ -127,8 +134,16 @@ fn duplicate_lines(bytes: &mut Vec<u8>, rng: &mut ChaCha8Rng) {
     *bytes = lines.join("\n").into_bytes();
 }
 
-fn nested_json(depth: usize) -> Vec<u8> {
-    let mut text = "{\"strokes\": ".to_string();
+/// JSON nested `depth` deep, in the shape of a stroke file or, for a glTF, of its nodes.
+fn nested_json(original: &[u8], depth: usize) -> Vec<u8> {
+    let is_gltf =
+        original.starts_with(b"glTF") || original.windows(7).take(64).any(|w| w == b"\"asset\"");
+    let key = if is_gltf {
+        "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": "
+    } else {
+        "{\"strokes\": "
+    };
+    let mut text = key.to_string();
     text.push_str(&"[".repeat(depth));
     text.push_str(&"]".repeat(depth));
     text.push('}');

@@ -149,6 +149,23 @@ fn a_moebius_band_is_cut_open_where_no_orientation_fits() {
 }
 
 #[test]
+fn obj_vertex_colours_become_the_diffuse_albedo() {
+    let (mesh, report) = import("coloured.obj");
+    assert!(report.not_kept.is_empty(), "{:?}", report.not_kept);
+    let diffuse: Vec<[f32; 3]> = mesh.brdfs().iter().map(|b| b.diffuse).collect();
+    assert_eq!(
+        diffuse[..3],
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    assert!(
+        (diffuse[3][0] - 0.214_041).abs() < 1e-5,
+        "sRGB 0.5 is linear {:?}",
+        diffuse[3]
+    );
+    assert_eq!(mesh.brdfs()[0].roughness, Brdf::CLAY.roughness);
+}
+
+#[test]
 fn ply_colours_become_the_diffuse_albedo() {
     let (mesh, report) = import("colours.ply");
     assert_eq!(report.not_kept, ["vertex properties `alpha` `confidence`"]);
@@ -281,7 +298,10 @@ fn gltf_exports_are_valid_for_the_khronos_validator() {
         let (back, _) = import_mesh(&out, &ImportOptions { strict: true }).unwrap();
         let again = dir.join(format!("again.{ext}"));
         write_mesh(&back, &again).unwrap();
-        assert!(std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(), "{ext}");
+        assert!(
+            std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(),
+            "{ext}"
+        );
         files.push(out);
     }
     files.push(corpus("two_nodes.gltf"));

@@ -15,6 +15,7 @@ use rustc_hash::FxHashMap;
 use super::IoError;
 use super::import::{ImportReport, Parsed};
 use super::mtl::{material_brdf, material_not_kept, sanitize_name};
+use super::ply::srgb_to_linear;
 use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh};
 
 /// Reads a material library an OBJ names (`mtllib NAME`): its bytes, or why not.
@@ -63,14 +64,21 @@ pub(crate) fn parse_obj(
             .map(|m| welder.add(&m.mesh, &mut report))
             .collect();
         let (points, welded_to_global) = welder.finish(base);
-        parsed.soup.positions.extend(points);
+        parsed.soup.positions.extend(points.iter().map(|(p, _)| *p));
         vertex_brdfs.resize(parsed.soup.positions.len(), None);
+        let mut colours: Vec<Option<[f32; 3]>> = vec![None; base];
+        colours.extend(points.iter().map(|(_, c)| *c));
         for (model, local_to_welded) in models.iter().zip(per_model) {
             let brdf = model.mesh.material_id.and_then(|m| brdfs.get(m).copied());
             for face in model_faces(model, &local_to_welded, name)? {
                 let face = face.map(|v| welded_to_global[v as usize]);
                 for v in face {
-                    vertex_brdfs[v as usize] = vertex_brdfs[v as usize].or(brdf);
+                    // A vertex colour is the diffuse albedo; the material gives the rest.
+                    let coloured = colours[v as usize].map(|diffuse| Brdf {
+                        diffuse,
+                        ..brdf.unwrap_or(Brdf::CLAY)
+                    });
+                    vertex_brdfs[v as usize] = vertex_brdfs[v as usize].or(coloured.or(brdf));
                 }
                 parsed.soup.faces.push(face);
                 parsed.soup.face_layers.push(layer as LayerId);
@@ -160,6 +168,8 @@ struct Welder<'a> {
     ids: FxHashMap<[u32; 3], u32>,
     /// Each welded point with its place in the file (points not found there after those that are).
     points: Vec<(u64, Vec3)>,
+    /// Each welded point's colour (`v x y z r g b`), linear, where the file gives one.
+    colours: Vec<Option<[f32; 3]>>,
     unmatched: u64,
 }
 
@@ -169,6 +179,7 @@ impl<'a> Welder<'a> {
             file_order,
             ids: FxHashMap::default(),
             points: Vec::new(),
+            colours: Vec::new(),
             unmatched: 1 << 32,
         }
     }
@@ -176,8 +187,13 @@ impl<'a> Welder<'a> {
     /// Welds one tobj model's points; returns each one's welded id.
     fn add(&mut self, mesh: &tobj::Mesh, report: &mut ImportReport) -> Vec<u32> {
         let mut local_to_welded = Vec::with_capacity(mesh.positions.len() / 3);
+        let mut colours = mesh.vertex_color.chunks_exact(3);
         for p in mesh.positions.chunks_exact(3) {
             let p = Vec3::new(p[0], p[1], p[2]);
+            // Colours are sRGB, as every tool that writes them means them.
+            let colour = colours
+                .next()
+                .map(|c| [c[0], c[1], c[2]].map(|c| srgb_to_linear(c.clamp(0.0, 1.0))));
             let key = (!p.is_nan()).then(|| weld_key(p));
             if let Some(&id) = key.and_then(|k| self.ids.get(&k)) {
                 report.welded_vertices += 1;
@@ -189,6 +205,7 @@ impl<'a> Welder<'a> {
                 .and_then(|k| self.file_order.get(&k))
                 .map_or(self.unmatched, |&o| o as u64);
             self.points.push((order, p));
+            self.colours.push(colour);
             let id = (self.points.len() - 1) as u32;
             if let Some(k) = key {
                 self.ids.insert(k, id);
@@ -198,16 +215,16 @@ impl<'a> Welder<'a> {
         local_to_welded
     }
 
-    /// The welded points in file order, and each welded id's number in the soup, the points
-    /// numbered from `base`.
-    fn finish(self, base: usize) -> (Vec<Vec3>, Vec<u32>) {
+    /// The welded points in file order with their colours, and each welded id's number in the
+    /// soup, the points numbered from `base`.
+    fn finish(self, base: usize) -> (Vec<(Vec3, Option<[f32; 3]>)>, Vec<u32>) {
         let mut by_order: Vec<u32> = (0..self.points.len() as u32).collect();
         by_order.sort_by_key(|&id| self.points[id as usize].0);
         let mut welded_to_global = vec![0u32; self.points.len()];
         let mut points = Vec::with_capacity(self.points.len());
         for &id in &by_order {
             welded_to_global[id as usize] = (base + points.len()) as u32;
-            points.push(self.points[id as usize].1);
+            points.push((self.points[id as usize].1, self.colours[id as usize]));
         }
         (points, welded_to_global)
     }
