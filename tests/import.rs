@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use common::{arg, assert_one_line_error, scratch, slayer, text, write_scene};
 use glam::Vec3;
 use proptest::prelude::*;
-use slayer::io::{Format, ImportOptions, ImportReport, import_bytes, import_mesh, write_mesh};
+use slayer::io::{
+    Format, ImportOptions, ImportReport, UpAxis, import_bytes, import_mesh, write_mesh,
+};
 use slayer::mesh::{Brdf, Mesh, Repairs, Soup, repair};
 
 fn corpus(name: &str) -> PathBuf {
@@ -486,4 +488,32 @@ fn convert_keeps_the_layers_asked_for_in_every_format() {
         &["no layer `moss`", "inner-bark"],
     );
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn the_up_axis_is_guessed_from_the_file_and_turned_exactly() {
+    for (name, up) in [
+        ("textured.obj", UpAxis::Y),
+        ("colours.ply", UpAxis::Y),
+        ("two_nodes.gltf", UpAxis::Z),
+        ("cad_tetra.stl", UpAxis::Z),
+    ] {
+        assert_eq!(UpAxis::guess(&corpus(name)), up, "{name}");
+    }
+    let dir = scratch("up-axis");
+    for name in ["own.obj", "own.ply"] {
+        let path = dir.join(name);
+        write_mesh(&painted_scene(), &path).unwrap();
+        assert_eq!(UpAxis::guess(&path), UpAxis::Z, "slayer's own {name}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+    // Y-up: the square in the XY plane stands up in XZ, facing -Y; a quarter turn, no rounding.
+    let (mut mesh, _) = import("coloured.obj");
+    UpAxis::Y.to_z_up(&mut mesh);
+    assert_eq!(mesh.positions()[2], Vec3::new(1.0, 0.0, 1.0));
+    assert!(
+        mesh.normals().iter().all(|n| (n.y + 1.0).abs() < 1e-6),
+        "{:?}",
+        mesh.normals()
+    );
 }

@@ -64,6 +64,48 @@ impl Format {
     }
 }
 
+/// Which way is up in a file: slayer works Z-up; many modelling tools write Y-up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UpAxis {
+    Y,
+    Z,
+}
+
+impl UpAxis {
+    /// What a file's format suggests: Z for slayer's own files, sessions, glTF (turned to Z-up
+    /// on import) and STL (3-D printing is Z-up); Y for other tools' OBJ and PLY (Blender,
+    /// ZBrush and Maya write OBJ Y-up, and so are the common PLY scans).
+    pub fn guess(path: &Path) -> UpAxis {
+        let Ok(format) = Format::of_path(path) else {
+            return UpAxis::Z;
+        };
+        if !matches!(format, Format::Obj | Format::Ply) {
+            return UpAxis::Z;
+        }
+        let mut head = [0u8; 4096];
+        let read = std::fs::File::open(path)
+            .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+            .unwrap_or(0);
+        let head = &head[..read];
+        let ours = head.starts_with(b"# slayer mesh")
+            || head
+                .windows(26)
+                .any(|w| w == b"comment written by slayer\n");
+        if ours { UpAxis::Z } else { UpAxis::Y }
+    }
+
+    /// Turns `mesh` so that this axis points along +Z (a quarter turn about X for Y-up, exact
+    /// in floats), with its normals.
+    pub fn to_z_up(self, mesh: &mut Mesh) {
+        if self == UpAxis::Y {
+            for p in mesh.positions_mut() {
+                *p = gltf::from_y_up(*p);
+            }
+            mesh.recompute_normals();
+        }
+    }
+}
+
 /// Reads a mesh, repaired where it needs it: malformed files, non-finite values and what no
 /// repair can mend are errors.
 pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {

@@ -248,6 +248,10 @@ enum Command {
         /// Turn off 4x multisampling.
         #[arg(long)]
         no_antialias: bool,
+        /// Which axis of the file points up: `y` (most modelling tools' OBJ and PLY), `z`
+        /// (slayer's own files, STL, glTF after import), or `auto` to guess from the file.
+        #[arg(long, default_value = "auto", value_parser = ["auto", "y", "z"])]
+        up: String,
     },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
@@ -347,6 +351,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             false_colour,
             wireframe,
             no_antialias,
+            up,
         } => render::run(&render::Args {
             file: &file,
             output: &output,
@@ -356,6 +361,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             false_colour,
             wireframe,
             antialias: !no_antialias,
+            up: &up,
             strict,
         }),
         Command::Strokes {

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use slayer::gpu::GpuContext;
+use slayer::io::UpAxis;
 use slayer::mesh::{LayerId, Mesh};
 use slayer::render::{CameraSpec, RenderOptions, Rendered, render};
 
@@ -85,6 +86,8 @@ pub struct Args<'a> {
     pub false_colour: bool,
     pub wireframe: bool,
     pub antialias: bool,
+    /// `auto`, `y` or `z`: which axis of the file points up.
+    pub up: &'a str,
     /// Refuse a mesh file that needs repairs.
     pub strict: bool,
 }
@@ -98,7 +101,13 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         bail!("{}: the output must be a .png file", args.output.display());
     }
     let started = Instant::now();
-    let mesh = crate::open::open(args.file, args.strict)?.into_mesh();
+    let mut mesh = crate::open::open(args.file, args.strict)?.into_mesh();
+    let up = match args.up {
+        "y" => UpAxis::Y,
+        "z" => UpAxis::Z,
+        _ => UpAxis::guess(args.file),
+    };
+    up.to_z_up(&mut mesh);
     let load_ms = started.elapsed().as_secs_f64() * 1e3;
     let layers = if args.layers.is_empty() {
         None
@@ -128,13 +137,14 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         );
     }
     println!(
-        "rendered {} faces in {} draw{} at {}×{} on {}: {render_ms:.0} ms \
+        "rendered {} faces in {} draw{} at {}×{}, {:?} up, on {}: {render_ms:.0} ms \
          including the PNG (reading the mesh {load_ms:.0} ms, opening the adapter {gpu_ms:.0} ms) -> {}",
         rendered.faces,
         rendered.draws,
         if rendered.draws == 1 { "" } else { "s" },
         options.width,
         options.height,
+        up,
         gpu.adapter,
         args.output.display()
     );
