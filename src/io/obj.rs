@@ -161,6 +161,9 @@ fn load_models(
     Ok((models, materials.unwrap_or_default()))
 }
 
+/// A welded point and its colour, where the file gives one.
+type ColouredPoint = (Vec3, Option<[f32; 3]>);
+
 /// Welds a layer's points by exact bit pattern (+0 and −0 are one point; NaN never welds),
 /// numbering them in file order (`file_order`: each point's first line).
 struct Welder<'a> {
@@ -217,7 +220,7 @@ impl<'a> Welder<'a> {
 
     /// The welded points in file order with their colours, and each welded id's number in the
     /// soup, the points numbered from `base`.
-    fn finish(self, base: usize) -> (Vec<(Vec3, Option<[f32; 3]>)>, Vec<u32>) {
+    fn finish(self, base: usize) -> (Vec<ColouredPoint>, Vec<u32>) {
         let mut by_order: Vec<u32> = (0..self.points.len() as u32).collect();
         by_order.sort_by_key(|&id| self.points[id as usize].0);
         let mut welded_to_global = vec![0u32; self.points.len()];

@@ -292,7 +292,7 @@ pub fn is_session_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("slayer"))
 }
 
-/// Checks that `path` names a file [`save`] can write (`.slayer`, `.obj`, `.ply`), before any
+/// Checks that `path` names a file [`save`] can write (`.slayer` or a mesh format), before any
 /// work is done for it.
 pub fn check_save_path(path: &Path) -> Result<(), IoError> {
     if is_session_path(path) {

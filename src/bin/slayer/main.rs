@@ -63,7 +63,7 @@ enum Command {
         /// 0.4): a deliberately irregular mesh, e.g. to try `slayer remesh` on.
         #[arg(long, default_value_t = 0.0)]
         jitter: f32,
-        /// Output file: a mesh (.obj, .ply, .stl) or a session (.slayer).
+        /// Output file: a mesh (.obj, .ply, .stl, .glb, .gltf) or a session (.slayer).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -78,12 +78,12 @@ enum Command {
         #[arg(long, value_name = "ORIGINAL")]
         against: Option<PathBuf>,
     },
-    /// Convert a mesh or session between formats by extension (.obj, .ply, .stl, .slayer),
-    /// repairing it on the way unless --strict
+    /// Convert a mesh or session between formats by extension (.obj, .ply, .stl, .glb, .gltf,
+    /// .slayer), repairing it on the way unless --strict
     Convert {
-        /// Mesh (.obj, .ply, .stl) or session (.slayer).
+        /// Mesh (.obj, .ply, .stl, .glb, .gltf) or session (.slayer).
         input: PathBuf,
-        /// Mesh (.obj with its .mtl, .ply, .stl) or session (.slayer).
+        /// Mesh (.obj with its .mtl, .ply, .stl, .glb, .gltf) or session (.slayer).
         output: PathBuf,
         /// Keep only these layers (names or numbers, comma-separated), in this order.
         #[arg(long, value_delimiter = ',')]
@@ -93,13 +93,13 @@ enum Command {
     /// modified unless `--in-place` is given). A `.slayer` output keeps every stroke as an
     /// undoable history entry.
     Sculpt {
-        /// Mesh (.obj, .ply, .stl) or session (.slayer).
+        /// Mesh (.obj, .ply, .stl, .glb, .gltf) or session (.slayer).
         #[arg(long)]
         input: PathBuf,
         /// Stroke file (JSON; see `slayer::brush` docs or README).
         #[arg(long)]
         strokes: PathBuf,
-        /// Mesh (.obj, .ply, .stl) or session (.slayer, with the history).
+        /// Mesh (.obj, .ply, .stl, .glb, .gltf) or session (.slayer, with the history).
         #[arg(long)]
         output: PathBuf,
         /// Allow the output to be the input file itself (it is replaced only once the whole
