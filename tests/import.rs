@@ -368,6 +368,13 @@ fn slayers_own_obj_comes_back_with_its_layers_and_materials() {
             ..ImportReport::default()
         };
         assert_eq!(report, expected, "{name}: nothing to say");
+        // Format → slayer → the same format: the same bytes.
+        // (The same name in another folder: an OBJ names its `.mtl` by file name.)
+        std::fs::create_dir_all(dir.join("again")).unwrap();
+        let again = dir.join("again").join(name);
+        write_mesh(&back, &again).unwrap();
+        let bytes = |p: &Path| std::fs::read(p).unwrap();
+        assert!(bytes(&again) == bytes(&path), "{name} written again differs");
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
