@@ -1,10 +1,11 @@
 //! A seeded mutation run over every file slayer reads: OBJ (with its `.mtl`), PLY (ASCII and
 //! binary), STL (ASCII and binary), glTF (`.glb`, `.gltf`), `.slayer` sessions and stroke files. Each mangled file must
-//! give an `Err` or a valid mesh (a session, strokes that resolve), never a panic; each case is
-//! timed (a case past [`CASE_LIMIT`] fails the run: a hang), and the run's peak memory is
-//! bounded. `tools/test.sh` runs a few thousand cases; `tools/fuzz.sh N` runs N (10⁵ takes a
+//! give an `Err` or a valid mesh (a session, strokes that resolve), never a panic; each case runs
+//! on a worker under a time box (a case past [`CASE_LIMIT`] fails the run: a hang), and the run's
+//! peak memory is bounded. `tools/test.sh` runs a few thousand cases; `tools/fuzz.sh N` runs N (10⁵ takes a
 //! few minutes) and prints the counts.
 
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use rand::{Rng, SeedableRng};
@@ -239,6 +240,42 @@ fn peak_rss_mib() -> Option<u64> {
     Some(kib / 1024)
 }
 
+/// Runs cases on a worker thread, so that a case that never ends is caught by a timeout
+/// instead of stalling the run: the test fails, naming and saving the case.
+struct Worker {
+    cases: mpsc::Sender<(Kind, Vec<u8>)>,
+    results: mpsc::Receiver<bool>,
+}
+
+impl Worker {
+    fn start() -> Worker {
+        let (cases, inbox) = mpsc::channel::<(Kind, Vec<u8>)>();
+        let (outbox, results) = mpsc::channel();
+        std::thread::spawn(move || {
+            let sheet = shapes::stacked_sheets(2, 3, 2, 1.0, 2.0);
+            for (kind, bytes) in inbox {
+                // A panic drops `outbox`, which the waiting side sees as a failed case.
+                let valid = try_case(kind, &bytes, &sheet);
+                if outbox.send(valid).is_err() {
+                    return;
+                }
+            }
+        });
+        Worker { cases, results }
+    }
+
+    /// The case's outcome, or why it has none: it panicked, or it ran past [`CASE_LIMIT`].
+    fn run(&self, kind: Kind, bytes: &[u8]) -> Result<bool, String> {
+        self.cases
+            .send((kind, bytes.to_vec()))
+            .map_err(|_| "the worker is gone (an earlier case panicked)".to_string())?;
+        self.results.recv_timeout(CASE_LIMIT).map_err(|e| match e {
+            mpsc::RecvTimeoutError::Timeout => format!("ran past {CASE_LIMIT:?} (a hang)"),
+            mpsc::RecvTimeoutError::Disconnected => "panicked".to_string(),
+        })
+    }
+}
+
 #[test]
 fn mangled_files_of_every_kind_give_an_error_or_a_valid_result() {
     let cases = std::env::var("SLAYER_FUZZ_CASES")
@@ -247,24 +284,19 @@ fn mangled_files_of_every_kind_give_an_error_or_a_valid_result() {
         .unwrap_or(DEFAULT_CASES);
     let mut rng = ChaCha8Rng::seed_from_u64(2024);
     let sources = sources();
-    let sheet = shapes::stacked_sheets(2, 3, 2, 1.0, 2.0);
+    let worker = Worker::start();
     let mut counts = Counts::default();
     for case in 0..cases {
         let (kind, original) = &sources[case % sources.len()];
         let bytes = mangle(original, &mut rng);
         let started = Instant::now();
-        let valid = try_case(*kind, &bytes, &sheet);
-        let took = started.elapsed();
-        if took > CASE_LIMIT {
-            let path = std::env::temp_dir().join(format!("slayer-fuzz-hang-{case}"));
+        let valid = worker.run(*kind, &bytes).unwrap_or_else(|why| {
+            let path = std::env::temp_dir().join(format!("slayer-fuzz-case-{case}"));
             std::fs::write(&path, &bytes).unwrap();
-            panic!(
-                "case {case} ({kind:?}) took {took:?}; saved in {}",
-                path.display()
-            );
-        }
+            panic!("case {case} ({kind:?}) {why}; saved in {}", path.display());
+        });
         counts.cases += 1;
-        counts.slowest = counts.slowest.max(took);
+        counts.slowest = counts.slowest.max(started.elapsed());
         if valid {
             counts.valid += 1;
         } else {

@@ -374,7 +374,10 @@ fn slayers_own_obj_comes_back_with_its_layers_and_materials() {
         let again = dir.join("again").join(name);
         write_mesh(&back, &again).unwrap();
         let bytes = |p: &Path| std::fs::read(p).unwrap();
-        assert!(bytes(&again) == bytes(&path), "{name} written again differs");
+        assert!(
+            bytes(&again) == bytes(&path),
+            "{name} written again differs"
+        );
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
