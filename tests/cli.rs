@@ -153,7 +153,7 @@ fn bad_arguments_are_clear() {
         &["--triangles 5 is out of range"],
     );
     assert_one_line_error(
-        &slayer(&["scene", "plane", "-o", "x.stl"]),
+        &slayer(&["scene", "plane", "-o", "x.dae"]),
         &["unsupported file type"],
     );
 }

@@ -42,7 +42,7 @@ validator=target/gltf-validator/node_modules/gltf-validator
 if command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1; then
     if [ ! -d "$validator" ]; then
         echo "tools/test.sh: installing the Khronos glTF validator (npm gltf-validator)"
-        npm install --silent --no-audit --no-fund --prefix target/gltf-validator gltf-validator@2.0.0-dev.3.10 >/dev/null \
+        timeout 300 npm install --silent --no-audit --no-fund --prefix target/gltf-validator gltf-validator@2.0.0-dev.3.10 >/dev/null \
             || echo "tools/test.sh: could not install gltf-validator; glTF exports are checked by our reader only" >&2
     fi
     if [ -d "$validator" ]; then

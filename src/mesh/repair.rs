@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 use serde::Serialize;
 
+use super::components::DisjointSets;
 use super::{INVALID, LayerId, MeshError, face_of, next};
 
 /// Faces and the positions they index, before any check: what a file reader builds.
@@ -381,12 +382,12 @@ fn split_fans(
     (source, marks): (&mut Vec<u32>, &mut SplitMarks),
     round: usize,
 ) -> bool {
-    let mut classes = UnionFind::new(faces.len() * 3);
+    let mut classes = DisjointSets::new(faces.len() * 3);
     for group in edge_groups(sides) {
         for (c, d) in pairs(group, faces, layers) {
             // Side c runs a→b and side d b→a: c's corner at a meets d's next, and the other way.
-            classes.join(c, next(d));
-            classes.join(next(c), d);
+            classes.union(c, next(d));
+            classes.union(next(c), d);
         }
     }
     let vertex_count = source.len();
@@ -489,36 +490,6 @@ fn drop_unreferenced(
         face_layers,
     };
     (soup, kept_source)
-}
-
-/// Disjoint sets of corners, with path halving.
-struct UnionFind {
-    parent: Vec<u32>,
-}
-
-impl UnionFind {
-    fn new(count: usize) -> UnionFind {
-        UnionFind {
-            parent: (0..count as u32).collect(),
-        }
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let grand = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grand;
-            x = grand;
-        }
-        x
-    }
-
-    /// Joins two sets; the smaller root becomes the root, so classes are named the same way
-    /// whatever order the joins came in.
-    fn join(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        let (low, high) = (a.min(b), a.max(b));
-        self.parent[high as usize] = low;
-    }
 }
 
 /// Only drops the vertices no face uses: what a strict import does, which refuses anything
