@@ -399,3 +399,87 @@ fn the_backstop_undoes_a_crossing_the_clamp_cannot_see() {
         "the hand-built case crosses"
     );
 }
+
+/// A flat sheet (layer 0, spacing 1) over a thin spike (layer 1) whose tip is 0.6 below the
+/// middle of one of the sheet's faces, far (horizontally) from every sheet vertex.
+fn sheet_over_a_spike() -> Mesh {
+    let n = 8;
+    let mut positions = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            positions.push(Vec3::new(x as f32, y as f32, 0.0));
+        }
+    }
+    let at = |x: u32, y: u32| y * (n + 1) + x;
+    let mut faces = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+            faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+        }
+    }
+    let tip = Vec3::new(4.0 + 2.0 / 3.0, 4.0 + 1.0 / 3.0, -0.6);
+    let base = tip - Vec3::Z * 3.0;
+    let s = positions.len() as u32;
+    positions.push(tip);
+    for k in 0..3 {
+        let angle = k as f32 * std::f32::consts::TAU / 3.0;
+        positions.push(base + 0.15 * Vec3::new(angle.cos(), angle.sin(), 0.0));
+    }
+    let mut layers = vec![0; faces.len()];
+    for tri in [
+        [s, s + 1, s + 2],
+        [s, s + 2, s + 3],
+        [s, s + 3, s + 1],
+        [s + 1, s + 3, s + 2],
+    ] {
+        faces.push(tri);
+        layers.push(1);
+    }
+    Mesh::new(
+        positions,
+        faces,
+        layers,
+        vec!["sheet".into(), "spike".into()],
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_face_pushed_onto_a_still_vertex_of_another_layer_keeps_its_distance() {
+    let mut mesh = sheet_over_a_spike();
+    let settings = PipelineSettings {
+        collision_distance: 0.25,
+        ..sculpt_only()
+    };
+    let tip = mesh.vertex_count() - 4;
+    let centre = Vec3::new(4.5, 4.5, 0.0);
+    let path: Vec<Vec3> = (0..24)
+        .map(|k| centre + Vec3::X * if k % 2 == 0 { 0.1 } else { -0.1 })
+        .collect();
+    let mut stroke = common::one_brush_stroke(BrushKind::Draw, 2.0, &path);
+    stroke.brush.invert = true;
+    let mut pipeline = Pipeline::new(settings);
+    let report = pipeline.apply_stroke(&mut mesh, &stroke).unwrap();
+    assert_sound(&mesh, "sheet over a spike");
+    let d = settings.collision_distance * pipeline.edge_length().unwrap();
+    let p = mesh.positions()[tip];
+    let gap = (0..mesh.face_count())
+        .filter(|&f| mesh.face_layers()[f] == 0)
+        .map(|f| {
+            let [a, b, c] = mesh.face_positions(f);
+            point_triangle_distance_squared(p, a, b, c).sqrt()
+        })
+        .fold(f32::MAX, f32::min);
+    let lowest = (0..tip)
+        .map(|v| mesh.positions()[v].z)
+        .fold(f32::MAX, f32::min);
+    assert!(
+        lowest < -0.5,
+        "the sheet came down to the tip ({lowest}): {report:?}"
+    );
+    assert!(
+        gap >= (1.0 - 1.0 / 1024.0) * d,
+        "the sheet came within {gap} of the spike's tip (d = {d}): {report:?}"
+    );
+}

@@ -4,11 +4,12 @@
 //! whole-mesh intersection count that `slayer check`, the bench and the tests use to prove that
 //! nothing passed through anything.
 //!
-//! Floors: `state` ← `region` ← `backstop` ← `response`; nothing here imports the pipeline or
+//! Floors: `state` ← `region` ← `gap_guard`, `backstop` ← `response`; nothing here imports the pipeline or
 //! the GPU, which both build on it.
 
 mod backstop;
 mod gap;
+mod gap_guard;
 mod intersections;
 mod local_grid;
 pub mod neighbourhood;

@@ -1,6 +1,7 @@
 //! sLayer's collision response on the CPU: every moving vertex tested at its target against
 //! the faces near its move and pulled back along it to the collision distance (the proximity
-//! clamp, [`clamp_moves`] over [`pull_back`]), then the exact backstop (`super::backstop`).
+//! clamp, [`clamp_moves`] over [`pull_back`]), then the gap guard for moving faces against still
+//! vertices (`super::gap_guard`), then the exact backstop (`super::backstop`).
 //! [`collide_with`] runs the two with the first phase given, which is where a GPU backend
 //! plugs in its own proximity passes.
 //!
@@ -11,6 +12,7 @@
 use glam::Vec3;
 
 use super::backstop::{Backstop, undo_crossings};
+use super::gap_guard::undo_gap_violations;
 use super::neighbourhood::ring_vertices;
 use super::region::{Region, Scratch, StepMoves, map_with_scratch, triangle};
 use super::state::StrokeState;
@@ -158,7 +160,25 @@ pub fn collide_with(
         .filter(|((v, _), q)| mesh.positions()[*v as usize] != **q)
         .count();
 
-    let reverted = undo_crossings(state, region, mesh, moves, &before, backstop);
+    // The gap guard and the backstop each undo moves, which can void what the other found
+    // clean: they take turns until the backstop undoes nothing (each move is undone at most
+    // once, so this ends).
+    let mut reverted = 0;
+    let mut backstop = Some(backstop);
+    loop {
+        let kept_apart = undo_gap_violations(state, mesh, moves, &before);
+        // Pairs a GPU filtered were filtered before those moves were undone: search instead.
+        let next = match backstop.take() {
+            Some(Backstop::Undecided(_)) if kept_apart > 0 => Backstop::Gather,
+            Some(first) => first,
+            None => Backstop::Search,
+        };
+        let uncrossed = undo_crossings(state, region, mesh, moves, &before, next);
+        reverted += kept_apart + uncrossed;
+        if uncrossed == 0 {
+            break;
+        }
+    }
     let positions = selection
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
