@@ -59,8 +59,8 @@ struct ProximityParams {
 
 // Bisection rounds when clamping a move: 2^-16 of a step (CLAMP_ROUNDS of the CPU).
 const CLAMP_ROUNDS: u32 = 16u;
-// CLAMP_SLACK of src/abi/moves.rs: 1/1024.
-const CLAMP_SLACK: f32 = 0.0009765625;
+// CLAMP_SLACK of src/abi/moves.rs: 1/65536.
+const CLAMP_SLACK: f32 = 0.0000152587890625;
 const WORKGROUP_SIZE: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> params: ProximityParams;
