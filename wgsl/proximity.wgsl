@@ -109,9 +109,10 @@ fn safe_fraction(entry: MovingVertex, f: u32, x: vec3<f32>) -> f32 {
     let c = topology(4u * f + 2u);
     let layer = topology(4u * f + 3u);
     let v = entry.vertex;
-    // Faces the last pass left alone, the vertex's own faces, and its own neighbourhood (near
-    // by construction, not by collision) do not constrain it.
-    let unchanged = params.all_faces == 0u && (marks[a] | marks[b] | marks[c]) == 0u;
+    // Faces the last pass left alone (unless it pulled this vertex back: short of its target
+    // it can be nearer a face its move passed by), the vertex's own faces, and its own
+    // neighbourhood (near by construction, not by collision) do not constrain it.
+    let unchanged = params.all_faces == 0u && (marks[a] | marks[b] | marks[c] | marks[v]) == 0u;
     let own = a == v || b == v || c == v;
     let pa = position(a);
     let pb = position(b);

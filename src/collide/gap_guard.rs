@@ -18,40 +18,50 @@ use crate::abi::CLAMP_SLACK;
 use crate::geom::{Aabb, closest_point_on_triangle};
 use crate::mesh::{INVALID, Mesh};
 
-/// Undoes the moves of every moved face that came closer than the collision distance to a
-/// vertex of another layer (`before`: each selected vertex's start). Returns how many vertex
-/// moves were undone.
+/// Undoes the moves of every face and vertex of different layers that came closer than the
+/// collision distance (`before`: each selected vertex's start). Returns how many vertex moves
+/// were undone.
 pub(super) fn undo_gap_violations(
     state: &StrokeState<'_>,
     mesh: &mut Mesh,
     (selection, _, target_of): StepMoves<'_>,
     before: &[Vec3],
 ) -> usize {
-    let mut changed: Vec<u32> = selection
-        .iter()
-        .zip(before)
-        .filter(|((v, _), p)| mesh.positions()[*v as usize] != **p)
-        .map(|((v, _), _)| *v)
-        .collect();
-    // Vertices are filed in the grid where they were at the step's start: a query reaches
-    // farther by the longest move.
+    // Vertices are filed in the grid where they were at the step's start: a query for moving
+    // ones reaches farther by the longest move.
     let drift = selection
         .iter()
         .zip(before)
         .map(|((v, _), p)| mesh.positions()[*v as usize].distance(*p))
         .fold(0.0f32, f32::max);
+    // The first round tests the faces around the whole selection: what moved, and what the
+    // clamp or the backstop stopped or put back (a face there may now be where a moving vertex
+    // was not clamped against). Later rounds test around what is still moved (an undo can
+    // leave a moved face nearer a vertex that went back) and what went back.
+    let mut went_back: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
     let mut undone = 0;
-    while !changed.is_empty() {
-        let mut faces: Vec<u32> = changed.iter().flat_map(|&v| mesh.faces_around(v)).collect();
+    loop {
+        let moved = selection
+            .iter()
+            .zip(before)
+            .filter(|((v, _), p)| mesh.positions()[*v as usize] != **p)
+            .map(|((v, _), _)| *v);
+        let view: &Mesh = mesh;
+        let mut faces: Vec<u32> = moved
+            .chain(went_back.iter().copied())
+            .flat_map(|v| view.faces_around(v))
+            .collect();
         faces.sort_unstable();
         faces.dedup();
-        let view: &Mesh = mesh;
-        let too_close: Vec<bool> = map_with_scratch(state.parallel, &faces, |_, &f| {
-            brings_a_vertex_too_close(state, view, (f, drift), (target_of, before))
+        let too_close: Vec<Option<u32>> = map_with_scratch(state.parallel, &faces, |_, &f| {
+            vertex_too_close(state, view, (f, drift), (target_of, before))
         });
+        // Each pair goes back to where both were at the step's start, where they were apart
+        // enough: the face's moved vertices, and the vertex if it moved.
         let mut back = Vec::new();
-        for (&f, _) in faces.iter().zip(&too_close).filter(|(_, c)| **c) {
-            for v in mesh.faces()[f as usize] {
+        for (&f, y) in faces.iter().zip(too_close) {
+            let Some(y) = y else { continue };
+            for v in mesh.faces()[f as usize].into_iter().chain([y]) {
                 let slot = target_of[v as usize];
                 if slot != INVALID && mesh.positions()[v as usize] != before[slot as usize] {
                     mesh.positions_mut()[v as usize] = before[slot as usize];
@@ -59,44 +69,47 @@ pub(super) fn undo_gap_violations(
                 }
             }
         }
+        if back.is_empty() {
+            return undone;
+        }
         undone += back.len();
-        changed = back;
+        went_back = back;
     }
-    undone
 }
 
-/// Whether moved face `f` is now closer than the collision distance to a vertex of another
-/// layer, and closer than the two were at the step's start. A still vertex is what the clamp
-/// cannot see; a moving one was clamped against the face where it was heading, which an undo
-/// since may have changed.
-fn brings_a_vertex_too_close(
+/// A vertex of another layer that face `f` (around a vertex that moved or went back) is now
+/// closer to than the collision distance, and than the two were at the step's start. A still
+/// vertex under a moving face is what the clamp cannot see; a moving one was clamped against
+/// the face where it was heading, which an undo since may have changed.
+fn vertex_too_close(
     state: &StrokeState<'_>,
     mesh: &Mesh,
     (f, drift): (u32, f32),
     (target_of, before): (&[u32], &[Vec3]),
-) -> bool {
+) -> Option<u32> {
     let d = state.collision_distance;
     let ids = mesh.faces()[f as usize];
     let start_of = |v: u32| match target_of[v as usize] {
         INVALID => mesh.positions()[v as usize],
         slot => before[slot as usize],
     };
-    if ids
+    let face_moved = ids
         .iter()
-        .all(|&v| mesh.positions()[v as usize] == start_of(v))
-    {
-        return false;
-    }
+        .any(|&v| mesh.positions()[v as usize] != start_of(v));
     let now = triangle(mesh, f);
     let then = ids.map(start_of);
     let layer = mesh.face_layers()[f as usize];
     let near = Aabb::of_points(&now).expanded(d);
-    let mut found = false;
+    let mut found = None;
     let mut test = |y: u32| {
-        if found || mesh.vertex_layers()[y as usize] == layer {
+        if found.is_some() || mesh.vertex_layers()[y as usize] == layer {
             return;
         }
         let p = mesh.positions()[y as usize];
+        // A still face and a still vertex are as far apart as they were.
+        if !face_moved && p == start_of(y) {
+            return;
+        }
         if !(p.cmpge(near.min).all() && p.cmple(near.max).all()) {
             return;
         }
@@ -104,7 +117,7 @@ fn brings_a_vertex_too_close(
             |p: Vec3, t: [Vec3; 3]| closest_point_on_triangle(p, t[0], t[1], t[2]).distance(p);
         let here = distance(p, now);
         if here < d && here < d.min(distance(start_of(y), then)) - CLAMP_SLACK * d {
-            found = true;
+            found = Some(y);
         }
     };
     match state.grid {

@@ -223,25 +223,32 @@ pub fn clamp_moves(
 
     // Per local face: changed by the last pass (the first pass tests every face).
     let mut changed: Option<Vec<bool>> = None;
+    // Per selected vertex: pulled back by the last pass. Such a vertex is tested against every
+    // face again: distance along a move is convex, so a point short of the target can be
+    // nearer a face than both ends were (the move passed by it), and that face has not changed.
+    let mut pulled_last = vec![false; selection.len()];
     for pass in 0..MAX_PASSES {
         let moving: Vec<usize> = (0..selection.len())
             .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
             .collect();
         let mesh_view: &Mesh = mesh;
         let changed_view = changed.as_deref();
+        let pulled_view = &pulled_last;
         let pulled: Vec<Option<Vec3>> = map_with_scratch(state.parallel, &moving, |scratch, &i| {
+            let faces = if pulled_view[i] { None } else { changed_view };
             pull_back(
                 state,
                 region,
                 mesh_view,
                 selection[i].0,
                 before[i],
-                changed_view,
+                faces,
                 scratch,
             )
         });
         let last_pass = pass + 1 == MAX_PASSES;
         let mut moved_back = Vec::new();
+        pulled_last.fill(false);
         {
             let positions = mesh.positions_mut();
             for (&i, x) in moving.iter().zip(pulled) {
@@ -249,6 +256,7 @@ pub fn clamp_moves(
                 let v = selection[i].0;
                 // Out of passes: what still collides goes back to where it was.
                 positions[v as usize] = if last_pass { before[i] } else { x };
+                pulled_last[i] = true;
                 moved_back.push(v);
             }
         }

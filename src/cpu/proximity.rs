@@ -92,12 +92,13 @@ fn safe_fraction(
     if !near {
         return 1.0;
     }
-    if params.all_faces == 0
-        && (inputs.marks[a as usize] | inputs.marks[b as usize] | inputs.marks[c as usize]) == 0
-    {
+    let v = entry.vertex;
+    // A face the last pass left alone, unless it pulled this vertex back (short of its target
+    // it can be nearer a face its move passed by).
+    let marks = |u: u32| inputs.marks[u as usize];
+    if params.all_faces == 0 && (marks(a) | marks(b) | marks(c) | marks(v)) == 0 {
         return 1.0;
     }
-    let v = entry.vertex;
     if a == v || b == v || c == v {
         return 1.0;
     }
