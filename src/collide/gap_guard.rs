@@ -102,7 +102,7 @@ fn vertex_too_close(
     let near = Aabb::of_points(&now).expanded(d);
     let mut found = None;
     let mut test = |y: u32| {
-        if found.is_some() || mesh.vertex_layers()[y as usize] == layer {
+        if mesh.vertex_layers()[y as usize] == layer {
             return;
         }
         let p = mesh.positions()[y as usize];
@@ -117,7 +117,8 @@ fn vertex_too_close(
             |p: Vec3, t: [Vec3; 3]| closest_point_on_triangle(p, t[0], t[1], t[2]).distance(p);
         let here = distance(p, now);
         if here < d && here < d.min(distance(start_of(y), then)) - CLAMP_SLACK * d {
-            found = Some(y);
+            // The lowest such vertex, whatever order the search met them in.
+            found = Some(found.map_or(y, |x: u32| x.min(y)));
         }
     };
     match state.grid {
