@@ -9,8 +9,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::bench::{BrushMix, ScriptSpec, generate_script};
 use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
-use slayer::collide::find_intersections;
 use slayer::collide::neighbourhood::{exclusion_ring, ring_vertices};
+use slayer::collide::{find_intersections, smallest_layer_gap};
 use slayer::geom::point_triangle_distance_squared;
 use slayer::grid::SpatialHash;
 use slayer::mesh::Mesh;
@@ -128,6 +128,13 @@ fn three_hundred_random_strokes_leave_no_intersection() {
         assert!(
             collisions > 100,
             "{kind}: the strokes must actually collide ({collisions})"
+        );
+        // The layers started more than 2·d apart, and keep d (the gap guard).
+        let d = sculpt_only().collision_distance * pipeline.edge_length().unwrap();
+        let gap = smallest_layer_gap(&mesh, 3.0 * d).unwrap();
+        assert!(
+            gap.is_some_and(|g| g >= 0.99 * d),
+            "{kind}: layers came {gap:?} apart (d = {d})"
         );
         total += strokes.len();
     }

@@ -228,7 +228,7 @@ fn writing_is_atomic_and_reports_unwritable_paths() {
     assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
     let e = slayer::io::write_mesh(&mesh, &dir.join("missing/m.obj")).unwrap_err();
     assert!(e.to_string().contains("missing/m.obj"));
-    let e = slayer::io::write_mesh(&mesh, &dir.join("m.stl")).unwrap_err();
+    let e = slayer::io::write_mesh(&mesh, &dir.join("m.dae")).unwrap_err();
     assert!(e.to_string().contains("unsupported"));
     std::fs::remove_dir_all(&dir).unwrap();
     let _ = Vec3::ZERO;

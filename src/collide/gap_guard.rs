@@ -53,15 +53,18 @@ pub(super) fn undo_gap_violations(
             .collect();
         faces.sort_unstable();
         faces.dedup();
-        let too_close: Vec<Option<u32>> = map_with_scratch(state.parallel, &faces, |_, &f| {
-            vertex_too_close(state, view, (f, drift), (target_of, before))
+        let too_close: Vec<Vec<u32>> = map_with_scratch(state.parallel, &faces, |_, &f| {
+            vertices_too_close(state, view, (f, drift), (target_of, before))
         });
         // Each pair goes back to where both were at the step's start, where they were apart
-        // enough: the face's moved vertices, and the vertex if it moved.
+        // enough: the face's moved vertices, and every vertex too close to it that moved (all
+        // of them: the face is not looked at again once it is back).
         let mut back = Vec::new();
-        for (&f, y) in faces.iter().zip(too_close) {
-            let Some(y) = y else { continue };
-            for v in mesh.faces()[f as usize].into_iter().chain([y]) {
+        for (&f, near) in faces.iter().zip(too_close) {
+            if near.is_empty() {
+                continue;
+            }
+            for v in mesh.faces()[f as usize].into_iter().chain(near) {
                 let slot = target_of[v as usize];
                 if slot != INVALID && mesh.positions()[v as usize] != before[slot as usize] {
                     mesh.positions_mut()[v as usize] = before[slot as usize];
@@ -77,16 +80,16 @@ pub(super) fn undo_gap_violations(
     }
 }
 
-/// A vertex of another layer that face `f` (around a vertex that moved or went back) is now
-/// closer to than the collision distance, and than the two were at the step's start. A still
+/// The vertices of other layers that face `f` (around a vertex that moved or went back) is now
+/// closer to than the collision distance, and than each was at the step's start. A still
 /// vertex under a moving face is what the clamp cannot see; a moving one was clamped against
 /// the face where it was heading, which an undo since may have changed.
-fn vertex_too_close(
+fn vertices_too_close(
     state: &StrokeState<'_>,
     mesh: &Mesh,
     (f, drift): (u32, f32),
     (target_of, before): (&[u32], &[Vec3]),
-) -> Option<u32> {
+) -> Vec<u32> {
     let d = state.collision_distance;
     let ids = mesh.faces()[f as usize];
     let start_of = |v: u32| match target_of[v as usize] {
@@ -100,7 +103,7 @@ fn vertex_too_close(
     let then = ids.map(start_of);
     let layer = mesh.face_layers()[f as usize];
     let near = Aabb::of_points(&now).expanded(d);
-    let mut found = None;
+    let mut found = Vec::new();
     let mut test = |y: u32| {
         if mesh.vertex_layers()[y as usize] == layer {
             return;
@@ -117,8 +120,7 @@ fn vertex_too_close(
             |p: Vec3, t: [Vec3; 3]| closest_point_on_triangle(p, t[0], t[1], t[2]).distance(p);
         let here = distance(p, now);
         if here < d && here < d.min(distance(start_of(y), then)) - CLAMP_SLACK * d {
-            // The lowest such vertex, whatever order the search met them in.
-            found = Some(found.map_or(y, |x: u32| x.min(y)));
+            found.push(y);
         }
     };
     match state.grid {
