@@ -60,3 +60,22 @@ pub const PRESETS: &[Material] = &[
 pub fn preset(name: &str) -> Option<Material> {
     PRESETS.iter().copied().find(|m| m.name == name)
 }
+
+/// The sRGB transfer function's inverse.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}

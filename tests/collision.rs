@@ -410,21 +410,7 @@ fn the_backstop_undoes_a_crossing_the_clamp_cannot_see() {
 /// A flat sheet (layer 0, spacing 1) over a thin spike (layer 1) whose tip is 0.6 below the
 /// middle of one of the sheet's faces, far (horizontally) from every sheet vertex.
 fn sheet_over_a_spike() -> Mesh {
-    let n = 8;
-    let mut positions = Vec::new();
-    for y in 0..=n {
-        for x in 0..=n {
-            positions.push(Vec3::new(x as f32, y as f32, 0.0));
-        }
-    }
-    let at = |x: u32, y: u32| y * (n + 1) + x;
-    let mut faces = Vec::new();
-    for y in 0..n {
-        for x in 0..n {
-            faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-            faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-        }
-    }
+    let (mut positions, mut faces) = shapes::grid_patch(8, 8, 1.0, 0.0, glam::Vec2::ZERO);
     let tip = Vec3::new(4.0 + 2.0 / 3.0, 4.0 + 1.0 / 3.0, -0.6);
     let base = tip - Vec3::Z * 3.0;
     let s = positions.len() as u32;

@@ -49,12 +49,7 @@ const PATTERN_RESOLUTION: usize = 32;
 
 /// sRGB-encoded 8-bit value to linear reflectance.
 fn srgb_to_linear(value: u8) -> f32 {
-    let c = value as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    crate::material::srgb_to_linear(value as f32 / 255.0)
 }
 
 impl Stencil {

@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use super::region::{Region, StepMoves, map_with_scratch, triangle};
+use super::region::{Region, StepMoves, map_with_scratch, start_position, triangle};
 use super::state::StrokeState;
 use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
 use crate::mesh::{INVALID, Mesh};
@@ -153,14 +153,7 @@ fn gather_from_start(
 /// (a fold within a fan, which twist and pinch can make) shares vertices with everything it
 /// overlaps, so no pair test sees it; its normal reversing does.
 fn turned_over(mesh: &Mesh, f: u32, target_of: &[u32], before: &[Vec3]) -> bool {
-    let old = mesh.faces()[f as usize].map(|w| {
-        let slot = target_of[w as usize];
-        if slot == INVALID {
-            mesh.positions()[w as usize]
-        } else {
-            before[slot as usize]
-        }
-    });
+    let old = mesh.faces()[f as usize].map(|w| start_position(mesh, w, target_of, before));
     let (n_old, n_new) = (face_normal(old), face_normal(triangle(mesh, f)));
     n_old.dot(n_new) <= 0.0 && n_old != Vec3::ZERO
 }

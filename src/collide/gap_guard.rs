@@ -12,7 +12,7 @@
 
 use glam::Vec3;
 
-use super::region::{StepMoves, map_with_scratch, triangle};
+use super::region::{StepMoves, map_with_scratch, start_position, triangle};
 use super::state::StrokeState;
 use crate::abi::CLAMP_SLACK;
 use crate::geom::{Aabb, closest_point_on_triangle};
@@ -92,10 +92,7 @@ fn vertices_too_close(
 ) -> Vec<u32> {
     let d = state.collision_distance;
     let ids = mesh.faces()[f as usize];
-    let start_of = |v: u32| match target_of[v as usize] {
-        INVALID => mesh.positions()[v as usize],
-        slot => before[slot as usize],
-    };
+    let start_of = |v: u32| start_position(mesh, v, target_of, before);
     let face_moved = ids
         .iter()
         .any(|&v| mesh.positions()[v as usize] != start_of(v));

@@ -156,6 +156,15 @@ impl Region {
 /// cells per axis and a proximity query a handful.
 const LOCAL_CELL_EDGES: f32 = 1.5;
 
+/// Where vertex `v` was at the step's start: `before` for a selected one (through
+/// `target_of`), its position for the others.
+pub(super) fn start_position(mesh: &Mesh, v: u32, target_of: &[u32], before: &[Vec3]) -> Vec3 {
+    match target_of[v as usize] {
+        INVALID => mesh.positions()[v as usize],
+        slot => before[slot as usize],
+    }
+}
+
 pub(super) fn triangle(mesh: &Mesh, f: u32) -> [Vec3; 3] {
     mesh.face_positions(f as usize)
 }

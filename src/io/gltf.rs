@@ -12,7 +12,7 @@ use base64::Engine;
 use glam::{Mat4, Vec3};
 
 use super::IoError;
-use super::import::Parsed;
+use super::import::{Parsed, counted};
 use super::obj::LibraryReader;
 use super::weld::SoupBuilder;
 use crate::mesh::{Brdf, LayerId};
@@ -298,7 +298,7 @@ impl NotKept {
     }
 
     fn items(&self) -> Vec<String> {
-        [
+        counted(&[
             (self.texture_coordinates, "texture coordinate sets"),
             (self.normals, "normal sets (recomputed)"),
             (self.tangents, "tangent sets"),
@@ -307,10 +307,6 @@ impl NotKept {
             (self.lines_and_points, "line or point primitives"),
             (self.textures, "textures"),
             (self.animations, "animations"),
-        ]
-        .into_iter()
-        .filter(|(n, _)| *n > 0)
-        .map(|(n, what)| format!("{n} {what}"))
-        .collect()
+        ])
     }
 }

@@ -47,6 +47,15 @@ impl ImportReport {
     }
 }
 
+/// `120 texture coordinates`-style items of the counts that are not zero.
+pub(super) fn counted(items: &[(usize, &str)]) -> Vec<String> {
+    items
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect()
+}
+
 /// What a reader got from a file: the soup and, per soup vertex, the attributes the file gave.
 #[derive(Debug, Default)]
 pub(crate) struct Parsed {

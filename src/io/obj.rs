@@ -13,9 +13,10 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use super::IoError;
-use super::import::{ImportReport, Parsed};
+use super::import::{ImportReport, Parsed, counted};
 use super::mtl::{material_brdf, material_not_kept, sanitize_name};
-use super::ply::srgb_to_linear;
+use super::weld::weld_key;
+use crate::material::srgb_to_linear;
 use crate::mesh::{Brdf, INVALID, LayerId, MAX_COORDINATE, Mesh};
 
 /// Reads a material library an OBJ names (`mtllib NAME`): its bytes, or why not.
@@ -270,16 +271,12 @@ struct Dropped {
 
 impl Dropped {
     fn items(&self) -> Vec<String> {
-        [
+        counted(&[
             (self.texture_coordinates, "texture coordinates (`vt`)"),
             (self.normals, "normals (`vn`; recomputed)"),
             (self.lines, "line elements (`l`)"),
             (self.points, "point elements (`p`)"),
-        ]
-        .into_iter()
-        .filter(|(n, _)| *n > 0)
-        .map(|(n, what)| format!("{n} {what}"))
-        .collect()
+        ])
     }
 }
 
@@ -390,11 +387,6 @@ fn face_line<'a>(
         ));
     }
     Ok(corners)
-}
-
-/// Welding identity of a point: its bits, with -0 folded into +0.
-fn weld_key(p: Vec3) -> [u32; 3] {
-    (p + Vec3::ZERO).to_array().map(f32::to_bits)
 }
 
 /// Counts lines as tobj reads them, to put a line number on tobj's errors.

@@ -10,6 +10,7 @@ use glam::Vec3;
 
 use super::IoError;
 use super::import::{ImportReport, Parsed};
+use crate::material::{linear_to_srgb, srgb_to_linear};
 use crate::mesh::{Brdf, INVALID, LayerId, Mesh, Soup, VertexFlags};
 
 /// Layer ids above this are treated as corrupt (a layer is a user-facing label, not an index
@@ -656,25 +657,6 @@ fn colour_channel(value: f64, scalar: Scalar) -> f32 {
         encoded.clamp(0.0, 1.0)
     } as f32;
     srgb_to_linear(c)
-}
-
-/// The sRGB transfer function's inverse.
-pub(crate) fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// The sRGB transfer function.
-pub(crate) fn linear_to_srgb(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.0031308 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 /// A name per layer: those the header's comments give, `layerN` for the rest. Named layers

@@ -8,6 +8,11 @@ use rustc_hash::FxHashMap;
 use super::import::{ImportReport, Parsed};
 use crate::mesh::{Brdf, LayerId, Soup};
 
+/// Welding identity of a point: its bits, with -0 folded into +0 (OBJ's welder uses it too).
+pub(super) fn weld_key(p: Vec3) -> [u32; 3] {
+    (p + Vec3::ZERO).to_array().map(f32::to_bits)
+}
+
 /// Builds a soup from triangles, welding each layer's points; each welded point keeps the BRDF
 /// of its first triangle, where the format gives one.
 #[derive(Default)]
@@ -42,8 +47,8 @@ impl SoupBuilder {
 
     /// A point of `layer` with its BRDF (the first one's where it welds): its number.
     pub fn point(&mut self, p: Vec3, brdf: Option<Brdf>, layer: LayerId) -> u32 {
-        // -0 and +0 are one point; NaN never welds.
-        let key = (!p.is_nan()).then(|| (p + Vec3::ZERO).to_array().map(f32::to_bits));
+        // NaN never welds.
+        let key = (!p.is_nan()).then(|| weld_key(p));
         if let Some(&v) = key.and_then(|k| self.welds[layer as usize].get(&k)) {
             self.report.welded_vertices += 1;
             return v;
