@@ -7,6 +7,7 @@
 //! Data flows one way: [`mesh`] ← [`grid`] ← [`collide`] ← the program.
 
 pub mod abi;
+pub mod app;
 pub mod bench;
 pub mod brush;
 pub mod check;

@@ -9,7 +9,8 @@ use rayon::prelude::*;
 use super::kernels::{CpuKernels, StepKernels};
 use super::stroke::StrokeInProgress;
 use super::{
-    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, StrokeReport, Uploads,
+    BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, Remeshing,
+    StrokeReport, Uploads,
 };
 use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::Region;
@@ -97,6 +98,11 @@ impl Pipeline {
 
     pub fn settings(&self) -> &PipelineSettings {
         &self.settings
+    }
+
+    /// When the next strokes remesh (the app's "remesh" switch).
+    pub fn set_remeshing(&mut self, remeshing: Remeshing) {
+        self.settings.remeshing = remeshing;
     }
 
     /// Starts a stroke on `mesh`: its samples come in with

@@ -92,18 +92,7 @@ impl Camera {
         let target = 0.5 * (lo + hi);
         // A box with no extent (one point) still gets a camera at a sane distance.
         let extent = (hi - lo).length().max(1e-3);
-        let (azimuth, elevation) = (spec.azimuth.to_radians(), spec.elevation.to_radians());
-        let toward = Vec3::new(
-            elevation.cos() * azimuth.sin(),
-            elevation.cos() * -azimuth.cos(),
-            elevation.sin(),
-        );
-        // The up vector in the plane of `toward` and z, continuous through a straight-down view.
-        let up = Vec3::new(
-            -elevation.sin() * azimuth.sin(),
-            elevation.sin() * azimuth.cos(),
-            elevation.cos(),
-        );
+        let (toward, up) = orbit_axes(spec.azimuth, spec.elevation);
         let right = up.cross(toward);
         let tan_y = (0.5 * FIELD_OF_VIEW_DEGREES.to_radians()).tan();
         let tan_x = tan_y * aspect.max(1e-3);
@@ -121,6 +110,27 @@ impl Camera {
             fitted = fitted.max(need_x).max(need_y);
         }
         let distance = fitted.max(0.5 * extent) * spec.distance;
+        Camera::orbit(
+            target,
+            (spec.azimuth, spec.elevation),
+            distance,
+            extent,
+            aspect,
+        )
+    }
+
+    /// The camera `distance` from `target`, at `azimuth` and `elevation` (degrees, as in
+    /// [`CameraSpec`]), its depth range wide enough for a scene of diameter `extent` around
+    /// the target.
+    pub fn orbit(
+        target: Vec3,
+        (azimuth, elevation): (f32, f32),
+        distance: f32,
+        extent: f32,
+        aspect: f32,
+    ) -> Camera {
+        let (toward, up) = orbit_axes(azimuth, elevation);
+        let right = up.cross(toward);
         let eye = target + toward * distance;
         let near = (distance - extent).max(distance * 1e-3);
         let far = distance + extent;
@@ -141,4 +151,22 @@ impl Camera {
             view_proj: proj * view,
         }
     }
+}
+
+/// The direction from the target to the eye, and the up vector, at `azimuth` and `elevation`
+/// in degrees.
+fn orbit_axes(azimuth: f32, elevation: f32) -> (Vec3, Vec3) {
+    let (azimuth, elevation) = (azimuth.to_radians(), elevation.to_radians());
+    let toward = Vec3::new(
+        elevation.cos() * azimuth.sin(),
+        elevation.cos() * -azimuth.cos(),
+        elevation.sin(),
+    );
+    // The up vector in the plane of `toward` and z, continuous through a straight-down view.
+    let up = Vec3::new(
+        -elevation.sin() * azimuth.sin(),
+        elevation.sin() * azimuth.cos(),
+        elevation.cos(),
+    );
+    (toward, up)
 }

@@ -15,3 +15,7 @@ pub use preview::{
     BACKGROUND, MAX_PIXELS, PALETTE, PreviewUniforms, RenderError, RenderOptions, RenderVertex,
     Rendered, render,
 };
+pub(crate) use preview::{
+    COLOUR_FORMAT, DEPTH_FORMAT, MSAA_SAMPLES, pipeline as preview_pipeline, render_vertex,
+    uniforms as preview_uniforms,
+};

@@ -15,10 +15,10 @@ use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// The colour target: 8-bit sRGB, so the shader writes linear radiance and the hardware
 /// encodes it.
-const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Samples per pixel when antialiasing (4 is what every WebGPU adapter supports).
-const MSAA_SAMPLES: u32 = 4;
+pub(crate) const MSAA_SAMPLES: u32 = 4;
 /// Above this many samples (pixels × samples) antialiasing is dropped: the multisampled colour
 /// and depth targets would take more than 2 × 256 MiB.
 const MAX_MSAA_SAMPLES_TOTAL: u64 = 64 << 20;
@@ -52,7 +52,8 @@ pub struct RenderVertex {
     pub normal: [f32; 3],
     pub roughness: f32,
     pub diffuse: [f32; 3],
-    pub _pad0: f32,
+    /// The sculpting mask (drawn only when [`PreviewUniforms::show_mask`] is 1).
+    pub mask: f32,
     pub specular: [f32; 3],
     pub _pad1: f32,
 }
@@ -72,7 +73,10 @@ pub struct PreviewUniforms {
     pub wireframe: u32,
     pub false_colour: u32,
     pub line_width: f32,
-    pub _pad: u32,
+    /// Bit `l`: layer `l` (< 32) is not drawn.
+    pub hidden_layers: u32,
+    pub show_mask: u32,
+    pub _pad: [u32; 3],
     pub palette: [[f32; 4]; 8],
 }
 
@@ -145,7 +149,7 @@ struct Chunk {
     globals: Vec<u32>,
 }
 
-fn render_vertex(mesh: &Mesh, v: usize) -> RenderVertex {
+pub(crate) fn render_vertex(mesh: &Mesh, v: usize) -> RenderVertex {
     let brdf = mesh.brdfs()[v];
     let normal = mesh.normals()[v];
     RenderVertex {
@@ -158,7 +162,7 @@ fn render_vertex(mesh: &Mesh, v: usize) -> RenderVertex {
         },
         roughness: brdf.roughness,
         diffuse: brdf.diffuse,
-        _pad0: 0.0,
+        mask: mesh.flags()[v].mask(),
         specular: brdf.specular,
         _pad1: 0.0,
     }
@@ -232,7 +236,7 @@ fn check_size(gpu: &GpuContext, width: u32, height: u32) -> Result<(), RenderErr
     Ok(())
 }
 
-fn uniforms(camera: &Camera, options: &RenderOptions) -> PreviewUniforms {
+pub(crate) fn uniforms(camera: &Camera, options: &RenderOptions) -> PreviewUniforms {
     let lighting = Lighting::for_view(camera.right, camera.up, camera.toward);
     let four = |v: Vec3| v.extend(0.0).to_array();
     PreviewUniforms {
@@ -247,55 +251,56 @@ fn uniforms(camera: &Camera, options: &RenderOptions) -> PreviewUniforms {
         wireframe: options.wireframe as u32,
         false_colour: options.false_colour as u32,
         line_width: LINE_WIDTH,
-        _pad: 0,
+        hidden_layers: 0,
+        show_mask: 0,
+        _pad: [0; 3],
         palette: PALETTE.map(|[r, g, b]| [r, g, b, 1.0]),
     }
 }
 
-fn pipeline(gpu: &GpuContext, samples: u32) -> Result<wgpu::RenderPipeline, GpuError> {
+pub(crate) fn pipeline(
+    device: &wgpu::Device,
+    samples: u32,
+) -> Result<wgpu::RenderPipeline, GpuError> {
     let source = render_source("preview")?;
     // naga's messages carry source locations; wgpu's would not.
     validate("render/preview", &source)?;
-    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = gpu
-        .device
-        .create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("preview"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-    let pipeline = gpu
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("preview"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(VERTEX_ENTRY),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            // Layers are open sheets seen from both sides: no culling.
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: samples,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(FRAGMENT_ENTRY),
-                compilation_options: Default::default(),
-                targets: &[Some(COLOUR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("preview"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("preview"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some(VERTEX_ENTRY),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        // Layers are open sheets seen from both sides: no culling.
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: samples,
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(FRAGMENT_ENTRY),
+            compilation_options: Default::default(),
+            targets: &[Some(COLOUR_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(GpuError::Validation(error.to_string()));
     }
@@ -351,7 +356,7 @@ pub fn render(
     } else {
         1
     };
-    let pipeline = pipeline(gpu, samples)?;
+    let pipeline = pipeline(&gpu.device, samples)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let uniform = gpu.uniform_buffer("preview uniforms", &uniforms(&camera, options));
     let draws = bind_chunks(gpu, &pipeline, &uniform, &chunks);

@@ -14,7 +14,8 @@ struct RenderVertex {
     normal: vec3<f32>,
     roughness: f32,
     diffuse: vec3<f32>,
-    _pad0: f32,
+    // The sculpting mask, 0..1 (shown as a dark tint when `show_mask` is 1).
+    mask: f32,
     specular: vec3<f32>,
     _pad1: f32,
 }
@@ -36,7 +37,13 @@ struct PreviewUniforms {
     false_colour: u32,
     // Edge line width in pixels.
     line_width: f32,
-    _pad: u32,
+    // Bit `l` set: layer `l` (< 32) is not drawn (the app's per-layer visibility).
+    hidden_layers: u32,
+    // 1 to darken masked vertices.
+    show_mask: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     palette: array<vec4<f32>, PALETTE_SIZE>,
 }
 
@@ -54,6 +61,7 @@ struct Varyings {
     @location(4) roughness: f32,
     @location(5) barycentric: vec3<f32>,
     @location(6) @interpolate(flat) layer: u32,
+    @location(7) mask: f32,
 }
 
 @vertex
@@ -69,6 +77,11 @@ fn vs_main(@builtin(vertex_index) index: u32) -> Varyings {
     let corner = index % 3u;
     out.barycentric = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
     out.layer = vertex.layer;
+    out.mask = vertex.mask;
+    if vertex.layer < 32u && (view.hidden_layers & (1u << vertex.layer)) != 0u {
+        // Behind the near plane: the whole triangle is clipped.
+        out.clip = vec4<f32>(0.0, 0.0, -1.0, 1.0);
+    }
     return out;
 }
 
@@ -95,6 +108,9 @@ fn fs_main(in: Varyings) -> @location(0) vec4<f32> {
     let fill = Light(view.fill_direction.xyz, view.fill_irradiance.xyz);
     let env = Environment(view.sky.xyz, view.ground.xyz);
     var colour = shade(brdf, n, v, key, fill, env);
+    if view.show_mask != 0u {
+        colour = mix(colour, vec3<f32>(0.03, 0.03, 0.04), 0.7 * clamp(in.mask, 0.0, 1.0));
+    }
     if view.wireframe != 0u {
         let distance_in_pixels = in.barycentric / max(edge_width, vec3<f32>(1e-6));
         let nearest = min(min(distance_in_pixels.x, distance_in_pixels.y), distance_in_pixels.z);

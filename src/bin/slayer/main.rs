@@ -5,6 +5,7 @@ mod bench;
 mod check;
 mod convert;
 mod demo;
+mod gui;
 mod history;
 mod open;
 mod progress;
@@ -253,6 +254,41 @@ enum Command {
         #[arg(long, default_value = "auto", value_parser = ["auto", "y", "z"])]
         up: String,
     },
+    /// Sculpt by hand: the app, in a window (OBJ, PLY, STL, glTF or .slayer; no file: the
+    /// default plaster).
+    ///
+    /// The headless hooks play a stroke file through the same path as the mouse, then save,
+    /// take a screenshot of the window and quit: `slayer gui --replay s.json --screenshot
+    /// out.png --exit-after-frames 5`.
+    Gui {
+        file: Option<PathBuf>,
+        /// Triangles of the default plaster (no FILE).
+        #[arg(long, default_value_t = 200_000)]
+        triangles: usize,
+        /// Stroke file to play through the pointer's path before the app is yours.
+        #[arg(long)]
+        replay: Option<PathBuf>,
+        /// After the replay, save the session here (.slayer keeps the history).
+        #[arg(long)]
+        save: Option<PathBuf>,
+        /// After the replay, turn the camera this many frames (a degree each).
+        #[arg(long, default_value_t = 0)]
+        spin_frames: u32,
+        /// After the replay (and spin), quit this many frames later.
+        #[arg(long)]
+        exit_after_frames: Option<u32>,
+        /// Write the window's pixels as PNG just before quitting (needs --exit-after-frames).
+        #[arg(long, requires = "exit_after_frames")]
+        screenshot: Option<PathBuf>,
+        /// Write frame rates, pointer-to-frame latency, uploads and peak memory (JSON) on exit.
+        #[arg(long)]
+        metrics: Option<PathBuf>,
+        /// Window size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x800", value_parser = render::parse_size)]
+        window: (u32, u32),
+        #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
+        backend: backend::Backend,
+    },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
         #[arg(long)]
@@ -362,6 +398,32 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             wireframe,
             antialias: !no_antialias,
             up: &up,
+            strict,
+        }),
+        Command::Gui {
+            file,
+            triangles,
+            replay,
+            save,
+            spin_frames,
+            exit_after_frames,
+            screenshot,
+            metrics,
+            window,
+            backend,
+        } => gui::run(gui::Args {
+            file: file.as_deref(),
+            triangles,
+            replay: replay.as_deref(),
+            plan: slayer::app::ExitPlan {
+                save,
+                spin_frames,
+                exit_after_frames,
+                screenshot,
+                metrics,
+            },
+            window,
+            backend,
             strict,
         }),
         Command::Strokes {

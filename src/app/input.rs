@@ -1,0 +1,379 @@
+//! Pointer and keyboard, in the conventions of Blender's sculpt mode: a drag on the mesh is a
+//! stroke (Ctrl inverts, Shift smooths), a drag on the background or with the middle button
+//! orbits (Shift+middle pans), the wheel zooms, F / Shift-F then a move sets the radius /
+//! strength. Every pointer event of a stroke becomes a sample, not only the frame's last.
+
+use std::time::Instant;
+
+use eframe::egui::{self, Event, Key, Modifiers, PointerButton, Pos2, Rect};
+use glam::Vec2;
+
+use super::SlayerApp;
+use super::worker::{Command, StrokePoint};
+use crate::brush::BrushKind;
+
+/// What a drag is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+enum Gesture {
+    #[default]
+    None,
+    Stroke,
+    Orbit,
+    Pan,
+    /// F or Shift-F: the pointer's horizontal travel sets the value until a click or release.
+    Adjust {
+        strength: bool,
+        origin: Pos2,
+        start: f32,
+    },
+}
+
+/// What the frame was busy with, for the frame measurements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Activity {
+    Idle,
+    Stroking,
+    Orbiting,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct PointerState {
+    gesture: Gesture,
+    last: Option<Pos2>,
+    /// Pen pressure of the last touch event (1 for a mouse).
+    pressure: Option<f32>,
+    /// The camera turned this frame.
+    moved_camera: bool,
+    /// The replay's orbit (counted as orbiting).
+    pub orbiting_by_replay: bool,
+}
+
+impl PointerState {
+    pub fn stroking(&self) -> bool {
+        self.gesture == Gesture::Stroke
+    }
+
+    /// What this frame did (`samples_pending`: the engine has stroke samples to run, the
+    /// replay's included); clears the per-frame marks.
+    pub fn activity(&mut self, samples_pending: bool) -> Activity {
+        let moved = std::mem::take(&mut self.moved_camera);
+        if self.gesture == Gesture::Stroke || samples_pending {
+            Activity::Stroking
+        } else if moved || self.orbiting_by_replay {
+            Activity::Orbiting
+        } else {
+            Activity::Idle
+        }
+    }
+}
+
+/// The frame's pointer events over the viewport `rect`.
+pub fn pointer(app: &mut SlayerApp, ui: &egui::Ui, rect: Rect, response: &egui::Response) {
+    let events = ui.input(|i| i.events.clone());
+    let mut points = Vec::new();
+    let arrived = Instant::now();
+    for event in events {
+        match event {
+            Event::Touch { force, .. } => app.pointer.pressure = force,
+            Event::PointerButton {
+                pos,
+                button,
+                pressed,
+                modifiers,
+            } => button_event(app, rect, pos, button, pressed, modifiers, &mut points),
+            Event::PointerMoved(pos) => {
+                moved(app, rect, pos, &mut points);
+                app.pointer.last = Some(pos);
+            }
+            Event::MouseWheel { delta, .. } if response.hovered() => {
+                if let Some(camera) = &mut app.camera {
+                    camera.zoom(delta.y.signum() * delta.y.abs().min(10.0));
+                    app.pointer.moved_camera = true;
+                }
+            }
+            _ => {}
+        }
+    }
+    if !points.is_empty() {
+        app.progress.sent += points.len();
+        app.send(Command::Points {
+            points,
+            sent: arrived,
+        });
+    }
+}
+
+fn button_event(
+    app: &mut SlayerApp,
+    rect: Rect,
+    pos: Pos2,
+    button: PointerButton,
+    pressed: bool,
+    modifiers: Modifiers,
+    points: &mut Vec<StrokePoint>,
+) {
+    let inside = rect.contains(pos);
+    match (button, pressed, app.pointer.gesture) {
+        (PointerButton::Primary, true, Gesture::Adjust { .. }) => {}
+        (PointerButton::Primary, true, _) if inside => {
+            app.pointer.gesture = if app.hover.is_some() {
+                begin_stroke(app, modifiers, rect, pos, points)
+            } else {
+                Gesture::Orbit
+            };
+        }
+        (PointerButton::Primary, false, gesture) => {
+            if gesture == Gesture::Stroke {
+                if !points.is_empty() {
+                    app.progress.sent += points.len();
+                    app.send(Command::Points {
+                        points: std::mem::take(points),
+                        sent: Instant::now(),
+                    });
+                }
+                app.send(Command::End);
+            }
+            app.pointer.gesture = Gesture::None;
+        }
+        (PointerButton::Middle, true, Gesture::None) if inside => {
+            app.pointer.gesture = if modifiers.shift {
+                Gesture::Pan
+            } else {
+                Gesture::Orbit
+            };
+        }
+        (PointerButton::Middle, false, Gesture::Orbit | Gesture::Pan) => {
+            app.pointer.gesture = Gesture::None;
+        }
+        (
+            PointerButton::Secondary,
+            true,
+            Gesture::Adjust {
+                strength, start, ..
+            },
+        ) => {
+            // Right click cancels, as in Blender.
+            set_adjusted(app, strength, start);
+            app.pointer.gesture = Gesture::None;
+        }
+        _ => {}
+    }
+}
+
+fn begin_stroke(
+    app: &mut SlayerApp,
+    modifiers: Modifiers,
+    rect: Rect,
+    pos: Pos2,
+    points: &mut Vec<StrokePoint>,
+) -> Gesture {
+    match app.stroke_settings(modifiers) {
+        Ok(settings) => {
+            app.progress = Default::default();
+            app.send(Command::Begin(settings));
+            if let Some(point) = ray_point(app, rect, pos) {
+                points.push(point);
+            }
+            Gesture::Stroke
+        }
+        Err(why) => {
+            app.notify(why);
+            Gesture::None
+        }
+    }
+}
+
+fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoint>) {
+    let delta = app
+        .pointer
+        .last
+        .map_or(Vec2::ZERO, |last| Vec2::new(pos.x - last.x, pos.y - last.y));
+    match app.pointer.gesture {
+        Gesture::Stroke => points.extend(ray_point(app, rect, pos)),
+        Gesture::Orbit => {
+            if let Some(camera) = &mut app.camera {
+                camera.orbit(delta);
+                app.pointer.moved_camera = true;
+            }
+        }
+        Gesture::Pan => {
+            if let Some(camera) = &mut app.camera {
+                camera.pan(delta, rect.height(), rect.aspect_ratio());
+                app.pointer.moved_camera = true;
+            }
+        }
+        Gesture::Adjust {
+            strength,
+            origin,
+            start,
+        } => {
+            let travel = pos.x - origin.x;
+            let value = if strength {
+                (start + travel / 300.0).clamp(0.0, 1.0)
+            } else {
+                // The radius follows the pointer: world units per point at the target depth.
+                let per_point = app
+                    .camera
+                    .map_or(0.0, |c| world_per_point(&c, rect.height()));
+                (start + travel * per_point).max(0.25 * app.status.edge_length.max(1e-6))
+            };
+            set_adjusted(app, strength, value);
+        }
+        Gesture::None => {
+            if rect.contains(pos)
+                && let Some(camera) = &app.camera
+            {
+                let ray = camera.ray(local(rect, pos), Vec2::new(rect.width(), rect.height()));
+                app.send(Command::Hover(ray));
+            } else {
+                app.hover = None;
+            }
+        }
+    }
+}
+
+fn world_per_point(camera: &super::OrbitCamera, height: f32) -> f32 {
+    2.0 * camera.distance * (0.5 * crate::render::FIELD_OF_VIEW_DEGREES.to_radians()).tan()
+        / height.max(1.0)
+}
+
+fn set_adjusted(app: &mut SlayerApp, strength: bool, value: f32) {
+    if strength {
+        app.tools.brush.strength = value;
+    } else {
+        app.tools.brush.radius = value;
+    }
+}
+
+fn local(rect: Rect, pos: Pos2) -> Vec2 {
+    Vec2::new(pos.x - rect.min.x, pos.y - rect.min.y)
+}
+
+fn ray_point(app: &SlayerApp, rect: Rect, pos: Pos2) -> Option<StrokePoint> {
+    let camera = app.camera.as_ref()?;
+    let ray = camera.ray(local(rect, pos), Vec2::new(rect.width(), rect.height()));
+    Some(StrokePoint::Ray {
+        ray,
+        pressure: app.pointer.pressure.unwrap_or(1.0),
+    })
+}
+
+/// The key map (ignored while a text field has the keyboard).
+pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
+    if ctx.egui_wants_keyboard_input() {
+        return;
+    }
+    let command = |key| (Modifiers::COMMAND, key);
+    let pressed =
+        |(modifiers, key): (Modifiers, Key)| ctx.input_mut(|i| i.consume_key(modifiers, key));
+    if pressed((Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)) || pressed(command(Key::Y)) {
+        app.send(Command::Redo);
+    } else if pressed(command(Key::Z)) {
+        app.send(Command::Undo);
+    }
+    if pressed(command(Key::S)) {
+        app.send(Command::Save(app.save_path.clone()));
+    }
+    if pressed(command(Key::O)) {
+        app.open_path = Some(String::new());
+    }
+    if pressed(command(Key::I)) {
+        app.send(Command::InvertMask);
+    }
+    if pressed((Modifiers::ALT, Key::M)) {
+        app.send(Command::ClearMask);
+    } else if pressed((Modifiers::NONE, Key::M)) {
+        app.tools.brush.kind = BrushKind::Mask;
+    }
+    let adjust = |strength: bool, app: &mut SlayerApp| {
+        let origin = app.pointer.last.unwrap_or_default();
+        let start = if strength {
+            app.tools.brush.strength
+        } else {
+            app.tools.brush.radius
+        };
+        app.pointer.gesture = Gesture::Adjust {
+            strength,
+            origin,
+            start,
+        };
+    };
+    if pressed((Modifiers::SHIFT, Key::F)) {
+        adjust(true, app);
+    } else if pressed((Modifiers::NONE, Key::F)) {
+        adjust(false, app);
+    }
+    if pressed((Modifiers::NONE, Key::OpenBracket)) {
+        app.tools.brush.radius *= 0.9;
+    }
+    if pressed((Modifiers::NONE, Key::CloseBracket)) {
+        app.tools.brush.radius /= 0.9;
+    }
+    if pressed((Modifiers::NONE, Key::X)) {
+        app.tools.symmetry_x = !app.tools.symmetry_x;
+    }
+    let numbers = [
+        Key::Num1,
+        Key::Num2,
+        Key::Num3,
+        Key::Num4,
+        Key::Num5,
+        Key::Num6,
+        Key::Num7,
+        Key::Num8,
+        Key::Num9,
+        Key::Num0,
+    ];
+    for (key, kind) in numbers.into_iter().zip(BrushKind::ALL) {
+        if pressed((Modifiers::NONE, key)) {
+            app.tools.brush.kind = kind;
+        }
+    }
+    if pressed((Modifiers::NONE, Key::Home)) || pressed((Modifiers::NONE, Key::Period)) {
+        if let Some(camera) = &mut app.camera {
+            camera.frame_all(1.5);
+        }
+    }
+    if pressed((Modifiers::NONE, Key::H)) || pressed((Modifiers::NONE, Key::F1)) {
+        app.help = !app.help;
+    }
+    if pressed((Modifiers::NONE, Key::Escape)) {
+        app.help = false;
+        if let Gesture::Adjust {
+            strength, start, ..
+        } = app.pointer.gesture
+        {
+            set_adjusted(app, strength, start);
+            app.pointer.gesture = Gesture::None;
+        }
+    }
+}
+
+/// The key map as the help overlay lists it.
+pub const KEY_MAP: &[(&str, &str)] = &[
+    ("drag on the mesh", "stroke with the current brush"),
+    ("Ctrl + drag", "stroke inverted"),
+    ("Shift + drag", "smooth"),
+    ("drag on the background, middle drag", "orbit"),
+    ("Shift + middle drag", "pan"),
+    ("wheel", "zoom"),
+    (
+        "F, then move",
+        "brush radius (click to set, right click / Esc to cancel)",
+    ),
+    ("Shift-F, then move", "brush strength"),
+    ("[  ]", "smaller / larger radius"),
+    (
+        "1 … 9, 0",
+        "draw, inflate, deflate, grab, smooth, flatten, pinch, crease, twist, paint",
+    ),
+    ("M", "mask brush"),
+    ("Alt-M", "clear the mask"),
+    ("Ctrl-I", "invert the mask"),
+    ("X", "X symmetry on / off"),
+    ("Ctrl-Z, Ctrl-Shift-Z (Ctrl-Y)", "undo, redo"),
+    ("Ctrl-S", "save the session (.slayer)"),
+    ("Ctrl-O", "open a file"),
+    ("Home or .", "frame everything"),
+    ("H or F1", "this help"),
+];

@@ -1,0 +1,379 @@
+//! `slayer gui`: the interactive sculpting app (eframe, on its wgpu backend).
+//!
+//! The UI thread draws and reads input; the engine runs on a worker thread ([`worker`]) that
+//! owns the session and the pipeline. Each pointer event of a stroke becomes a ray sent to the
+//! worker, which picks it onto the surface, runs the samples through the streaming stroke API
+//! and answers with the rows of the vertices that changed; the UI writes those rows into its
+//! GPU buffers ([`viewport`]) and redraws. Nothing on the UI thread waits for the engine.
+//!
+//! ```text
+//!   UI thread:  input ─► Command ──────────────► worker: Session + Pipeline + Picker
+//!               viewport ◄─ MeshUpdate, Status ◄─┘
+//! ```
+
+mod camera;
+mod input;
+mod panels;
+mod pick;
+mod replay;
+mod viewport;
+mod worker;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+pub use camera::OrbitCamera;
+pub use pick::{Hit, Picker, Ray};
+pub use replay::{ExitPlan, Metrics};
+pub use viewport::ViewOptions;
+pub use worker::{Command, MeshUpdate, Reply, Status, StrokePoint};
+
+use eframe::{egui, egui_wgpu};
+
+use crate::brush::{BrushKind, Stroke};
+use crate::mesh::Brdf;
+use crate::pipeline::{PhaseTimes, Pipeline};
+use crate::session::{BrushSettings, Session};
+use input::PointerState;
+use viewport::Viewport;
+
+/// Everything the app starts from.
+pub struct AppSetup {
+    pub session: Session,
+    pub pipeline: Pipeline,
+    /// Where Ctrl-S writes the session.
+    pub save_path: PathBuf,
+    /// Strokes to play through the pointer's path before handing over to the user.
+    pub replay: Vec<Stroke>,
+    pub plan: ExitPlan,
+}
+
+/// The brush and what it paints, as the panels set them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tools {
+    pub brush: BrushSettings,
+    /// Paint the material below while any brush deforms (the paint brush always paints).
+    pub paint_while_sculpting: bool,
+    pub material: Brdf,
+    pub material_name: String,
+    pub opacity: f32,
+    /// Mirror strokes across the plane x = the scene's centre.
+    pub symmetry_x: bool,
+    pub remesh: bool,
+    pub view: ViewOptions,
+}
+
+/// Samples sent and done in the current stroke, and the engine's last phase times.
+#[derive(Debug, Clone, Default)]
+pub struct Progress {
+    pub sent: usize,
+    pub done: usize,
+    pub phases: PhaseTimes,
+}
+
+pub struct SlayerApp {
+    commands: Sender<Command>,
+    replies: Receiver<Reply>,
+    worker: Option<JoinHandle<()>>,
+    viewport: Result<Viewport, String>,
+    renderer: Option<Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>>,
+    camera: Option<OrbitCamera>,
+    /// The document as the worker last reported it.
+    pub status: Status,
+    pub tools: Tools,
+    pointer: PointerState,
+    hover: Option<Hit>,
+    pub progress: Progress,
+    /// Errors and notices, newest last, with when they came.
+    messages: Vec<(String, Instant)>,
+    help: bool,
+    save_path: PathBuf,
+    replay: Option<replay::Replay>,
+    pub metrics: Metrics,
+    metrics_path: Option<PathBuf>,
+    open_path: Option<String>,
+    rename: Option<(u32, String)>,
+    started: Instant,
+}
+
+impl SlayerApp {
+    /// The app on eframe's wgpu device; the engine thread starts here.
+    pub fn new(cc: &eframe::CreationContext<'_>, setup: AppSetup) -> SlayerApp {
+        let (commands, worker_commands) = mpsc::channel();
+        let (worker_replies, replies) = mpsc::channel();
+        let ctx = cc.egui_ctx.clone();
+        let wake = Box::new(move || ctx.request_repaint());
+        let edge = setup.session.mesh().mean_edge_length();
+        let brush = setup.session.brush;
+        let worker = worker::Worker::new(
+            setup.session,
+            setup.pipeline,
+            worker_commands,
+            worker_replies,
+            wake,
+        );
+        let handle = std::thread::Builder::new()
+            .name("slayer engine".into())
+            .spawn(move || worker.run())
+            .expect("the engine thread starts");
+        let (viewport, renderer) = match &cc.wgpu_render_state {
+            Some(state) => (
+                Viewport::new(&state.device, &state.queue).map_err(|e| e.to_string()),
+                Some(state.renderer.clone()),
+            ),
+            None => (Err("eframe runs without wgpu: no viewport".into()), None),
+        };
+        let preset = crate::material::PAINT;
+        SlayerApp {
+            commands,
+            replies,
+            worker: Some(handle),
+            viewport,
+            renderer,
+            camera: None,
+            status: Status::default(),
+            tools: Tools {
+                brush: BrushSettings {
+                    radius: brush.radius.max(edge),
+                    ..brush
+                },
+                paint_while_sculpting: false,
+                material: preset.brdf,
+                material_name: preset.name.into(),
+                opacity: 1.0,
+                symmetry_x: false,
+                remesh: true,
+                view: ViewOptions::default(),
+            },
+            pointer: PointerState::default(),
+            hover: None,
+            progress: Progress::default(),
+            messages: Vec::new(),
+            help: false,
+            save_path: setup.save_path,
+            metrics_path: setup.plan.metrics.clone(),
+            replay: Some(replay::Replay::new(setup.replay, setup.plan)).filter(|r| !r.is_empty()),
+            metrics: Metrics::default(),
+            open_path: None,
+            rename: None,
+            started: Instant::now(),
+        }
+    }
+
+    pub(crate) fn send(&self, command: Command) {
+        // The worker only stops when the app does.
+        let _ = self.commands.send(command);
+    }
+
+    /// The mesh's digest once every command sent so far is done (blocks: tests and the
+    /// replay's end use it, never a frame of the user's).
+    pub fn digest(&self) -> String {
+        let (answer, wait) = mpsc::channel();
+        self.send(Command::Digest(answer));
+        wait.recv().unwrap_or_default()
+    }
+
+    /// Where the pointer last met the surface.
+    pub fn hover(&self) -> Option<Hit> {
+        self.hover
+    }
+
+    /// No stroke in progress and every sent sample done.
+    pub fn idle(&self) -> bool {
+        !self.pointer.stroking() && self.progress.done >= self.progress.sent
+    }
+
+    /// The replay (if any) and what follows it are done.
+    pub fn replay_finished(&self) -> bool {
+        self.replay.as_ref().is_none_or(|r| r.finished())
+    }
+
+    pub fn camera(&self) -> Option<&OrbitCamera> {
+        self.camera.as_ref()
+    }
+
+    pub(crate) fn notify(&mut self, message: String) {
+        self.messages.push((message, Instant::now()));
+    }
+
+    /// Takes every reply that arrived.
+    fn receive(&mut self) {
+        while let Ok(reply) = self.replies.try_recv() {
+            match reply {
+                Reply::Hover(hit) => self.hover = hit,
+                Reply::Mesh(update) => {
+                    if let MeshUpdate::Whole { bounds, .. } = &update {
+                        match &mut self.camera {
+                            Some(camera) => camera.set_bounds(*bounds),
+                            None => self.camera = Some(OrbitCamera::framing(*bounds, 1.5)),
+                        }
+                    }
+                    if let Ok(viewport) = &mut self.viewport {
+                        viewport.apply(&update);
+                    }
+                }
+                Reply::Progress {
+                    points,
+                    phases,
+                    sent,
+                } => {
+                    self.progress.done += points;
+                    self.progress.phases = phases;
+                    self.metrics.effect_arrived(sent);
+                }
+                Reply::Status(status) => self.status = status,
+                Reply::Saved(path) => self.notify(format!("saved {}", path.display())),
+                Reply::Opened(path) => {
+                    self.save_path = crate::app::save_path_for(&path);
+                    self.notify(format!("opened {}", path.display()));
+                }
+                Reply::Error(message) => self.notify(message),
+            }
+        }
+    }
+
+    /// The stroke the brush panel describes, with the modifiers held at its start.
+    fn stroke_settings(
+        &self,
+        modifiers: egui::Modifiers,
+    ) -> Result<crate::brush::StrokeSettings, String> {
+        let tools = &self.tools;
+        let mut kind = tools.brush.kind;
+        if modifiers.shift {
+            kind = BrushKind::Smooth;
+        }
+        let paints =
+            kind == BrushKind::Paint || (tools.paint_while_sculpting && kind != BrushKind::Mask);
+        let paint = paints.then(|| crate::brush::Paint {
+            opacity: tools.opacity,
+            ..crate::brush::Paint::material(tools.material)
+        });
+        let layers: Vec<u32> = (0..self.status.layers.len() as u32)
+            .filter(|&l| self.status.layers[l as usize].1.active)
+            .collect();
+        if layers.is_empty() {
+            return Err("no layer is active: tick one in the Layers panel".into());
+        }
+        let settings = crate::brush::StrokeSettings {
+            brush: crate::brush::Brush {
+                kind,
+                radius: tools.brush.radius,
+                strength: tools.brush.strength,
+                falloff: tools.brush.falloff,
+                invert: tools.brush.invert != modifiers.command,
+            },
+            paint,
+            layers,
+            spacing: tools.brush.spacing,
+            symmetry: tools
+                .symmetry_x
+                .then(|| crate::brush::Mirror::new(self.status.centre, glam::Vec3::X))
+                .flatten(),
+        };
+        settings.check(self.status.extent.max(1e-6))?;
+        Ok(settings)
+    }
+}
+
+impl eframe::App for SlayerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let frame_start = Instant::now();
+        self.receive();
+        input::keys(self, ui.ctx());
+        panels::status_bar(self, ui);
+        panels::tools_panel(self, ui);
+        panels::document_panel(self, ui);
+        egui::CentralPanel::default().show(ui, |ui| self.viewport_ui(ui));
+        panels::overlays(self, ui.ctx());
+        replay::step(self, ui.ctx());
+        let uploaded = self.viewport.as_mut().map_or(0, |v| v.take_uploaded());
+        let pending = self.progress.done < self.progress.sent;
+        let activity = self.pointer.activity(pending);
+        self.metrics.frame_done(frame_start, activity, uploaded);
+        if !self.idle() {
+            ui.ctx().request_repaint();
+        }
+    }
+
+    fn on_exit(&mut self) {
+        // Dropping the sender ends the worker's loop; wait so a save in flight completes.
+        let (closed, _) = mpsc::channel();
+        self.commands = closed;
+        if let Some(handle) = self.worker.take() {
+            let _ = handle.join();
+        }
+        self.metrics
+            .report(self.metrics_path.as_deref(), self.started);
+    }
+}
+
+impl SlayerApp {
+    fn viewport_ui(&mut self, ui: &mut egui::Ui) {
+        let rect = ui.available_rect_before_wrap();
+        let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        let size = (
+            (rect.width() * pixels_per_point).round() as u32,
+            (rect.height() * pixels_per_point).round() as u32,
+        );
+        input::pointer(self, ui, rect, &response);
+        let aspect = rect.width() / rect.height().max(1.0);
+        let (Ok(viewport), Some(renderer), Some(camera)) =
+            (&mut self.viewport, &self.renderer, &self.camera)
+        else {
+            let why = match &self.viewport {
+                Err(why) => why.clone(),
+                Ok(_) => "loading…".into(),
+            };
+            ui.painter().text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                why,
+                egui::FontId::proportional(16.0),
+                ui.visuals().text_color(),
+            );
+            return;
+        };
+        viewport.render(
+            &mut renderer.write(),
+            size,
+            &camera.view(aspect),
+            &self.tools.view,
+        );
+        if let Some(texture) = viewport.texture {
+            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+            ui.painter().image(texture, rect, uv, egui::Color32::WHITE);
+        }
+        panels::brush_circle(self, ui.painter(), rect);
+    }
+}
+
+/// Where Ctrl-S saves a document opened from `path`: the session itself, or a `.slayer` beside
+/// the mesh file (the mesh file is never overwritten).
+pub fn save_path_for(path: &std::path::Path) -> PathBuf {
+    if crate::session::is_session_path(path) {
+        path.to_path_buf()
+    } else {
+        path.with_extension("slayer")
+    }
+}
+
+/// Runs the app in a window until it is closed.
+pub fn run(setup: AppSetup, window: [f32; 2]) -> Result<(), String> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size(window)
+            .with_title("slayer"),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    eframe::run_native(
+        "slayer",
+        options,
+        Box::new(move |cc| Ok(Box::new(SlayerApp::new(cc, setup)))),
+    )
+    .map_err(|e| format!("the window could not open: {e}"))
+}

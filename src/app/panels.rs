@@ -1,0 +1,356 @@
+//! The panels around the viewport: brush and material on the left, layers and history on the
+//! right, the status bar below; the help overlay, the open dialog and the brush circle.
+
+use std::time::Duration;
+
+use eframe::egui::{self, Color32, Painter, Rect, RichText, Stroke as Line, Ui};
+use glam::Vec3;
+
+use super::SlayerApp;
+use super::worker::Command;
+use crate::brush::{BrushKind, Falloff};
+use crate::material::{PRESETS, linear_to_srgb, srgb_to_linear};
+use crate::mesh::Brdf;
+
+/// How long a message stays in the status bar.
+const MESSAGE_SECONDS: u64 = 8;
+
+pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
+    egui::Panel::bottom("status").show(ui, |ui| {
+        ui.horizontal(|ui| {
+            let status = &app.status;
+            ui.label(format!(
+                "{} · {} faces · {} vertices",
+                status.backend, status.faces, status.vertices
+            ));
+            ui.separator();
+            let progress = &app.progress;
+            if app.pointer.stroking() || progress.done < progress.sent {
+                ui.label(format!(
+                    "stroke: {} of {} samples done",
+                    progress.done, progress.sent
+                ));
+                ui.add(egui::Spinner::new());
+            } else {
+                ui.label("ready");
+            }
+            ui.separator();
+            let names = progress
+                .phases
+                .named()
+                .iter()
+                .map(|(name, ms)| format!("{name} {ms:.1}"))
+                .collect::<Vec<_>>()
+                .join(" · ");
+            ui.label(format!("last samples, ms: {names}"));
+            app.messages
+                .retain(|(_, at)| at.elapsed() < Duration::from_secs(MESSAGE_SECONDS));
+            if let Some((message, _)) = app.messages.last() {
+                ui.separator();
+                ui.label(RichText::new(message).color(Color32::from_rgb(240, 200, 90)));
+            }
+        });
+    });
+}
+
+pub fn tools_panel(app: &mut SlayerApp, ui: &mut Ui) {
+    egui::Panel::left("tools")
+        .default_size(230.0)
+        .show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                brush_section(app, ui);
+                ui.separator();
+                material_section(app, ui);
+                ui.separator();
+                view_section(app, ui);
+            });
+        });
+}
+
+fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.heading("Brush");
+    let brush = &mut app.tools.brush;
+    egui::ComboBox::from_label("kind")
+        .selected_text(brush.kind.name())
+        .show_ui(ui, |ui| {
+            for (i, kind) in BrushKind::ALL.into_iter().enumerate() {
+                let key = match i {
+                    0..=8 => format!("  {}", i + 1),
+                    9 => "  0".into(),
+                    _ => "  M".into(),
+                };
+                ui.selectable_value(&mut brush.kind, kind, format!("{}{key}", kind.name()));
+            }
+        });
+    let edge = app.status.edge_length.max(1e-6);
+    let extent = app.status.extent.max(edge);
+    ui.add(
+        egui::Slider::new(&mut brush.radius, 0.5 * edge..=0.5 * extent)
+            .logarithmic(true)
+            .text("radius"),
+    );
+    ui.add(egui::Slider::new(&mut brush.strength, 0.0..=1.0).text("strength"));
+    ui.add(egui::Slider::new(&mut brush.spacing, 0.05..=1.0).text("spacing"));
+    egui::ComboBox::from_label("falloff")
+        .selected_text(brush.falloff.name())
+        .show_ui(ui, |ui| {
+            for falloff in [
+                Falloff::default(),
+                Falloff::Smooth,
+                Falloff::Sphere,
+                Falloff::Linear,
+            ] {
+                ui.selectable_value(&mut brush.falloff, falloff, falloff.name());
+            }
+        });
+    ui.checkbox(&mut brush.invert, "invert (Ctrl)");
+    ui.checkbox(&mut app.tools.symmetry_x, "X symmetry (X)");
+    if ui
+        .checkbox(&mut app.tools.remesh, "remesh after strokes")
+        .changed()
+    {
+        app.send(Command::Remeshing(app.tools.remesh));
+    }
+}
+
+fn material_section(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.heading("Material");
+    let tools = &mut app.tools;
+    egui::ComboBox::from_label("preset")
+        .selected_text(tools.material_name.as_str())
+        .show_ui(ui, |ui| {
+            for preset in PRESETS {
+                if ui
+                    .selectable_label(tools.material_name == preset.name, preset.name)
+                    .clicked()
+                {
+                    tools.material = preset.brdf;
+                    tools.material_name = preset.name.into();
+                }
+            }
+        });
+    let before = tools.material;
+    brdf_editor(ui, &mut tools.material);
+    if tools.material != before {
+        tools.material_name = "custom".into();
+    }
+    ui.add(egui::Slider::new(&mut tools.opacity, 0.0..=1.0).text("opacity"));
+    ui.checkbox(&mut tools.paint_while_sculpting, "paint while sculpting");
+}
+
+/// Diffuse colour (shown in sRGB, kept linear), grey specular and roughness.
+fn brdf_editor(ui: &mut Ui, brdf: &mut Brdf) {
+    ui.horizontal(|ui| {
+        let mut srgb = brdf.diffuse.map(linear_to_srgb);
+        if ui.color_edit_button_rgb(&mut srgb).changed() {
+            brdf.diffuse = srgb.map(srgb_to_linear);
+        }
+        ui.label("diffuse");
+    });
+    let mut specular = brdf.specular[0];
+    if ui
+        .add(egui::Slider::new(&mut specular, 0.0..=1.0).text("specular"))
+        .changed()
+    {
+        brdf.specular = [specular; 3];
+    }
+    ui.add(egui::Slider::new(&mut brdf.roughness, 0.0..=1.0).text("roughness"));
+}
+
+fn view_section(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.heading("View");
+    let view = &mut app.tools.view;
+    ui.checkbox(&mut view.wireframe, "wireframe");
+    ui.checkbox(&mut view.false_colour, "layer colours");
+    ui.checkbox(&mut view.show_mask, "show the mask");
+    if ui.button("frame all (Home)").clicked()
+        && let Some(camera) = &mut app.camera
+    {
+        camera.frame_all(1.5);
+    }
+}
+
+pub fn document_panel(app: &mut SlayerApp, ui: &mut Ui) {
+    egui::Panel::right("document")
+        .default_size(240.0)
+        .show(ui, |ui| {
+            layers_section(app, ui);
+            ui.separator();
+            history_section(app, ui);
+        });
+}
+
+fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.heading("Layers");
+    let layers = app.status.layers.clone();
+    for (l, (name, settings)) in layers.iter().enumerate() {
+        let l = l as u32;
+        ui.horizontal(|ui| {
+            let mut changed = *settings;
+            ui.checkbox(&mut changed.visible, "")
+                .on_hover_text("visible");
+            ui.checkbox(&mut changed.active, "")
+                .on_hover_text("active: brushed by strokes");
+            let [r, g, b] = settings.material.diffuse.map(linear_to_srgb);
+            let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+            ui.painter().rect_filled(
+                rect,
+                2.0,
+                Color32::from_rgb((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8),
+            );
+            match &mut app.rename {
+                Some((editing, text)) if *editing == l => {
+                    let response = ui.text_edit_singleline(text);
+                    if response.lost_focus() {
+                        let text = std::mem::take(text);
+                        app.rename = None;
+                        if ui.input(|i| i.key_pressed(egui::Key::Enter)) && text != *name {
+                            app.send(Command::RenameLayer(l, text));
+                        }
+                    } else {
+                        response.request_focus();
+                    }
+                }
+                _ => {
+                    if ui.selectable_label(false, name).double_clicked() {
+                        app.rename = Some((l, name.clone()));
+                    }
+                }
+            }
+            ui.label(RichText::new("collide").weak())
+                .on_hover_text("contact stops motion: this layer never crosses another");
+            if changed != *settings {
+                app.send(Command::SetLayer(l, changed));
+            }
+        });
+    }
+    app.tools.view.hidden_layers = layers
+        .iter()
+        .enumerate()
+        .filter(|(l, (_, s))| *l < 32 && !s.visible)
+        .fold(0, |bits, (l, _)| bits | 1 << l);
+    ui.label(
+        RichText::new("double-click a name to rename it")
+            .weak()
+            .small(),
+    );
+}
+
+fn history_section(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.heading("History");
+    ui.horizontal(|ui| {
+        if ui.button("undo").clicked() {
+            app.send(Command::Undo);
+        }
+        if ui.button("redo").clicked() {
+            app.send(Command::Redo);
+        }
+    });
+    let done = app.status.done;
+    let labels = app.status.history.clone();
+    egui::ScrollArea::vertical()
+        .stick_to_bottom(true)
+        .show(ui, |ui| {
+            if ui.selectable_label(done == 0, "(opened)").clicked() {
+                (0..done).for_each(|_| app.send(Command::Undo));
+            }
+            for (i, label) in labels.iter().enumerate() {
+                let text = if i < done {
+                    RichText::new(label)
+                } else {
+                    RichText::new(label).weak().italics()
+                };
+                if ui.selectable_label(i + 1 == done, text).clicked() {
+                    let target = i + 1;
+                    (target..done).for_each(|_| app.send(Command::Undo));
+                    (done..target).for_each(|_| app.send(Command::Redo));
+                }
+            }
+        });
+}
+
+pub fn overlays(app: &mut SlayerApp, ctx: &egui::Context) {
+    if app.help {
+        egui::Window::new("Keys")
+            .collapsible(false)
+            .open(&mut app.help)
+            .show(ctx, |ui| {
+                egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                    for (keys, what) in super::input::KEY_MAP {
+                        ui.label(RichText::new(*keys).strong());
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+            });
+    }
+    let mut open = None;
+    if let Some(path) = &mut app.open_path {
+        let mut keep = true;
+        egui::Window::new("Open")
+            .collapsible(false)
+            .show(ctx, |ui| {
+                ui.label("OBJ, PLY, STL, glTF or .slayer file:");
+                let response = ui.text_edit_singleline(path);
+                response.request_focus();
+                ui.horizontal(|ui| {
+                    let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    if ui.button("open").clicked() || enter {
+                        open = Some(path.clone());
+                    }
+                    if ui.button("cancel").clicked()
+                        || ui.input(|i| i.key_pressed(egui::Key::Escape))
+                    {
+                        keep = false;
+                    }
+                });
+            });
+        if !keep || open.is_some() {
+            app.open_path = None;
+        }
+    }
+    if let Some(path) = open {
+        app.send(Command::Open(path.into()));
+        app.camera = None;
+    }
+}
+
+/// The brush's rim on the surface under the pointer, and its normal.
+pub fn brush_circle(app: &SlayerApp, painter: &Painter, rect: Rect) {
+    let (Some(hit), Some(camera)) = (app.hover, &app.camera) else {
+        return;
+    };
+    if app.pointer.stroking() {
+        return;
+    }
+    let size = glam::Vec2::new(rect.width(), rect.height());
+    let normal = hit.normal;
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let radius = app.tools.brush.radius;
+    let to_screen = |p: Vec3| {
+        camera
+            .project(p, size)
+            .map(|s| egui::pos2(rect.min.x + s.x, rect.min.y + s.y))
+    };
+    let rim: Option<Vec<egui::Pos2>> = (0..48)
+        .map(|k| {
+            let angle = k as f32 / 48.0 * std::f32::consts::TAU;
+            to_screen(hit.point + radius * (angle.cos() * u + angle.sin() * v))
+        })
+        .collect();
+    let colour = if app.tools.brush.kind == BrushKind::Mask {
+        Color32::from_rgb(120, 200, 255)
+    } else {
+        Color32::from_rgb(255, 160, 60)
+    };
+    if let Some(rim) = rim {
+        painter.add(egui::Shape::closed_line(rim, Line::new(1.5, colour)));
+    }
+    if let (Some(a), Some(b)) = (
+        to_screen(hit.point),
+        to_screen(hit.point + 0.5 * radius * normal),
+    ) {
+        painter.line_segment([a, b], Line::new(1.5, colour));
+    }
+}

@@ -1,0 +1,303 @@
+//! The viewport's GPU side: the mesh's render rows in one storage buffer (indexed by vertex
+//! number, so a stroke's changed vertices are written in place), the live faces' corners in
+//! another, drawn with the preview renderer's shader (`wgsl/render/preview.wgsl`) into a
+//! texture the app owns and egui shows. It renders only when the camera, the options or the
+//! mesh changed.
+
+use eframe::{egui, egui_wgpu};
+
+use super::worker::MeshUpdate;
+use crate::gpu::GpuError;
+use crate::render::{
+    COLOUR_FORMAT, Camera, DEPTH_FORMAT, MSAA_SAMPLES, PreviewUniforms, RenderOptions,
+    RenderVertex, preview_pipeline, preview_uniforms,
+};
+
+/// What the user toggles in the view.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ViewOptions {
+    pub wireframe: bool,
+    pub false_colour: bool,
+    pub show_mask: bool,
+    /// Bit `l`: layer `l` hidden.
+    pub hidden_layers: u32,
+}
+
+pub struct Viewport {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipeline: wgpu::RenderPipeline,
+    uniform: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    corners: wgpu::Buffer,
+    corner_count: u32,
+    bind_group: wgpu::BindGroup,
+    targets: Option<Targets>,
+    /// The texture egui shows.
+    pub texture: Option<egui::TextureId>,
+    /// Something changed since the last render.
+    pub dirty: bool,
+    /// Bytes written to GPU buffers since [`Viewport::take_uploaded`] last ran.
+    uploaded: u64,
+}
+
+struct Targets {
+    size: (u32, u32),
+    resolved: wgpu::TextureView,
+    multisampled: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+impl Viewport {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Viewport, GpuError> {
+        let pipeline = preview_pipeline(device, MSAA_SAMPLES)?;
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("viewport uniforms"),
+            size: std::mem::size_of::<PreviewUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let vertices = storage(device, "viewport vertices", 64);
+        let corners = storage(device, "viewport corners", 64);
+        let bind_group = bind(device, &pipeline, &uniform, &vertices, &corners);
+        Ok(Viewport {
+            device: device.clone(),
+            queue: queue.clone(),
+            pipeline,
+            uniform,
+            vertices,
+            corners,
+            corner_count: 0,
+            bind_group,
+            targets: None,
+            texture: None,
+            dirty: true,
+            uploaded: 0,
+        })
+    }
+
+    /// Writes what the engine changed into the buffers (growing them when the mesh grew).
+    pub fn apply(&mut self, update: &MeshUpdate) {
+        match update {
+            MeshUpdate::Whole {
+                vertices, corners, ..
+            } => {
+                let vertex_bytes: &[u8] = bytemuck::cast_slice(vertices);
+                let corner_bytes: &[u8] = bytemuck::cast_slice(corners);
+                let mut rebind = false;
+                if vertex_bytes.len() as u64 > self.vertices.size() {
+                    self.vertices =
+                        storage(&self.device, "viewport vertices", grown(vertex_bytes.len()));
+                    rebind = true;
+                }
+                if corner_bytes.len() as u64 > self.corners.size() {
+                    self.corners =
+                        storage(&self.device, "viewport corners", grown(corner_bytes.len()));
+                    rebind = true;
+                }
+                if rebind {
+                    self.bind_group = bind(
+                        &self.device,
+                        &self.pipeline,
+                        &self.uniform,
+                        &self.vertices,
+                        &self.corners,
+                    );
+                }
+                self.write(&self.vertices.clone(), 0, vertex_bytes);
+                self.write(&self.corners.clone(), 0, corner_bytes);
+                self.corner_count = corners.len() as u32;
+            }
+            MeshUpdate::Rows(runs) => {
+                let row = std::mem::size_of::<RenderVertex>() as u64;
+                for (first, rows) in runs {
+                    let offset = *first as u64 * row;
+                    let bytes: &[u8] = bytemuck::cast_slice(rows);
+                    // Rows of vertices the last whole upload did not have cannot be placed;
+                    // a whole upload follows every change of topology.
+                    if offset + bytes.len() as u64 <= self.vertices.size() {
+                        self.write(&self.vertices.clone(), offset, bytes);
+                    }
+                }
+            }
+        }
+        self.dirty = true;
+    }
+
+    fn write(&mut self, buffer: &wgpu::Buffer, offset: u64, bytes: &[u8]) {
+        // Buffer writes must be whole multiples of 4 bytes; every row and corner is.
+        if !bytes.is_empty() {
+            self.queue.write_buffer(buffer, offset, bytes);
+            self.uploaded += bytes.len() as u64;
+        }
+    }
+
+    /// Bytes uploaded since the last call.
+    pub fn take_uploaded(&mut self) -> u64 {
+        std::mem::take(&mut self.uploaded)
+    }
+
+    /// Renders when dirty or resized; registers (or re-points) the egui texture.
+    pub fn render(
+        &mut self,
+        renderer: &mut egui_wgpu::Renderer,
+        size: (u32, u32),
+        camera: &Camera,
+        view: &ViewOptions,
+    ) {
+        let size = (size.0.max(1), size.1.max(1));
+        if self.targets.as_ref().is_none_or(|t| t.size != size) {
+            let targets = Targets::new(&self.device, size);
+            match self.texture {
+                Some(id) => renderer.update_egui_texture_from_wgpu_texture(
+                    &self.device,
+                    &targets.resolved,
+                    wgpu::FilterMode::Linear,
+                    id,
+                ),
+                None => {
+                    self.texture = Some(renderer.register_native_texture(
+                        &self.device,
+                        &targets.resolved,
+                        wgpu::FilterMode::Linear,
+                    ))
+                }
+            }
+            self.targets = Some(targets);
+            self.dirty = true;
+        }
+        if !self.dirty {
+            return;
+        }
+        self.dirty = false;
+        let options = RenderOptions {
+            wireframe: view.wireframe,
+            false_colour: view.false_colour,
+            ..RenderOptions::default()
+        };
+        let mut uniforms = preview_uniforms(camera, &options);
+        uniforms.hidden_layers = view.hidden_layers;
+        uniforms.show_mask = view.show_mask as u32;
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniforms));
+        let targets = self.targets.as_ref().expect("made above");
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("viewport"),
+            });
+        {
+            let background = crate::render::BACKGROUND;
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("viewport"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &targets.multisampled,
+                    depth_slice: None,
+                    resolve_target: Some(&targets.resolved),
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: background[0],
+                            g: background[1],
+                            b: background[2],
+                            a: 1.0,
+                        }),
+                        store: wgpu::StoreOp::Discard,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &targets.depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if self.corner_count > 0 {
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.bind_group, &[]);
+                pass.draw(0..self.corner_count, 0..1);
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+    }
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, size: (u32, u32)) -> Targets {
+        let texture = |label, samples, format, usage| {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width: size.0,
+                        height: size.1,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        Targets {
+            size,
+            resolved: texture(
+                "viewport image",
+                1,
+                COLOUR_FORMAT,
+                attachment | wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+            multisampled: texture("viewport samples", MSAA_SAMPLES, COLOUR_FORMAT, attachment),
+            depth: texture("viewport depth", MSAA_SAMPLES, DEPTH_FORMAT, attachment),
+        }
+    }
+}
+
+/// Room for `bytes` and half as much again, so a growing mesh is not re-allocated every stroke.
+fn grown(bytes: usize) -> u64 {
+    (bytes as u64 * 3 / 2).next_multiple_of(256)
+}
+
+fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+fn bind(
+    device: &wgpu::Device,
+    pipeline: &wgpu::RenderPipeline,
+    uniform: &wgpu::Buffer,
+    vertices: &wgpu::Buffer,
+    corners: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("viewport"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: vertices.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: corners.as_entire_binding(),
+            },
+        ],
+    })
+}

@@ -1,0 +1,505 @@
+//! The engine thread: it owns the [`Session`] and the [`Pipeline`], takes the UI's commands
+//! from a channel and answers with what changed, so the UI never waits for a stroke.
+//!
+//! A stroke is `Begin`, any number of `Points` (each pointer event's ray, or a replayed 3-D
+//! sample), then `End`. Points that queued while a call ran go into the next
+//! `add_samples` call together: the engine resamples across calls, so how the points were
+//! batched changes nothing in the mesh, only how often the UI hears about it.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, Sender};
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::pick::{Hit, Picker, Ray};
+use crate::brush::{BrushKind, Sample, StrokeSettings};
+use crate::mesh::{INVALID, LayerId, Mesh};
+use crate::pipeline::{PhaseTimes, Pipeline, Remeshing};
+use crate::render::{RenderVertex, render_vertex};
+use crate::session::{LayerSettings, Session};
+
+/// Rows closer than this are sent as one run with those between them: one buffer write
+/// instead of several small ones.
+const RUN_GAP: u32 = 8;
+
+/// One pointer event of a stroke.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StrokePoint {
+    /// The pointer's ray; the engine picks it onto the surface as the mesh is then.
+    Ray { ray: Ray, pressure: f32 },
+    /// A sample given in 3-D (a replayed stroke file).
+    Sample(Sample),
+}
+
+pub enum Command {
+    /// Pick under the pointer (answered with [`Reply::Hover`]).
+    Hover(Ray),
+    Begin(StrokeSettings),
+    /// `sent` is when the oldest of the points arrived: it comes back with their effect.
+    Points {
+        points: Vec<StrokePoint>,
+        sent: Instant,
+    },
+    End,
+    Undo,
+    Redo,
+    SetLayer(LayerId, LayerSettings),
+    RenameLayer(LayerId, String),
+    ClearMask,
+    InvertMask,
+    Save(PathBuf),
+    /// Replaces the session with a file's (the mesh is repaired as `slayer check` would).
+    Open(PathBuf),
+    /// Remesh after each stroke, or not.
+    Remeshing(bool),
+    /// Answers with the mesh's digest once every earlier command is done.
+    Digest(Sender<String>),
+}
+
+/// What the UI uploads.
+#[derive(Debug, Clone)]
+pub enum MeshUpdate {
+    /// Every vertex, and three vertex numbers per live face.
+    Whole {
+        vertices: Vec<RenderVertex>,
+        corners: Vec<u32>,
+        bounds: Option<(Vec3, Vec3)>,
+    },
+    /// Runs of consecutive rows: (first vertex, rows).
+    Rows(Vec<(u32, Vec<RenderVertex>)>),
+}
+
+/// The document as the panels show it.
+#[derive(Debug, Clone, Default)]
+pub struct Status {
+    pub faces: usize,
+    pub vertices: usize,
+    pub layers: Vec<(String, LayerSettings)>,
+    pub history: Vec<String>,
+    /// Entries of `history` that are done (the rest can be redone).
+    pub done: usize,
+    pub edge_length: f32,
+    pub extent: f32,
+    pub centre: Vec3,
+    pub backend: String,
+}
+
+pub enum Reply {
+    Hover(Option<Hit>),
+    Mesh(MeshUpdate),
+    /// Points done, the engine's phase times for them, and when the oldest was sent.
+    Progress {
+        points: usize,
+        phases: PhaseTimes,
+        sent: Instant,
+    },
+    Status(Status),
+    Saved(PathBuf),
+    Opened(PathBuf),
+    /// A refused command or a failed stroke: the mesh is as the last good step left it.
+    Error(String),
+}
+
+/// The engine thread's state.
+pub struct Worker {
+    session: Session,
+    pipeline: Pipeline,
+    picker: Picker,
+    link: Link,
+}
+
+impl Worker {
+    pub fn new(
+        session: Session,
+        pipeline: Pipeline,
+        commands: Receiver<Command>,
+        replies: Sender<Reply>,
+        wake: Box<dyn Fn() + Send>,
+    ) -> Worker {
+        Worker {
+            picker: Picker::default(),
+            session,
+            pipeline,
+            link: Link {
+                commands,
+                pending: VecDeque::new(),
+                replies,
+                wake,
+            },
+        }
+    }
+
+    /// Serves commands until the UI hangs up.
+    pub fn run(mut self) {
+        self.rebuild_picker();
+        self.send_whole();
+        self.send_status();
+        while let Some(command) = self.link.next() {
+            self.serve(command);
+        }
+    }
+
+    fn serve(&mut self, command: Command) {
+        match command {
+            Command::Hover(ray) => {
+                let ray = self.link.latest_hover(ray);
+                let hit = self.picker.pick(self.session.mesh(), &ray);
+                self.link.reply(Reply::Hover(hit));
+            }
+            Command::Begin(settings) => self.stroke(settings),
+            // Points or an end without a begin: a stroke that was refused.
+            Command::Points { .. } | Command::End => {}
+            Command::Undo => {
+                let stepped = self.session.undo().is_some();
+                self.after_edit(stepped);
+            }
+            Command::Redo => {
+                let stepped = self.session.redo().is_some();
+                self.after_edit(stepped);
+            }
+            Command::SetLayer(layer, settings) => {
+                let result = self.session.set_layer(layer, settings);
+                self.rebuild_picker();
+                self.after_refusable(result.map(|_| ()).map_err(|e| e.to_string()));
+            }
+            Command::RenameLayer(layer, name) => {
+                let result = self.session.rename_layer(layer, &name);
+                self.after_refusable(result.map(|_| ()).map_err(|e| e.to_string()));
+            }
+            Command::ClearMask => {
+                self.session.clear_mask();
+                self.after_edit(true);
+            }
+            Command::InvertMask => {
+                self.session.invert_mask();
+                self.after_edit(true);
+            }
+            Command::Save(path) => match crate::session::save(&self.session, &path, true) {
+                Ok(()) => self.link.reply(Reply::Saved(path)),
+                Err(e) => self
+                    .link
+                    .reply(Reply::Error(format!("{}: {e}", path.display()))),
+            },
+            Command::Open(path) => self.open(path),
+            Command::Remeshing(on) => self.pipeline.set_remeshing(if on {
+                Remeshing::AfterStroke
+            } else {
+                Remeshing::Off
+            }),
+            Command::Digest(answer) => {
+                // The asker may have given up waiting: nothing to do then.
+                let _ = answer.send(self.session.mesh().digest());
+            }
+        }
+    }
+
+    fn open(&mut self, path: PathBuf) {
+        match crate::session::open_with(&path, &Default::default()) {
+            Ok((session, report)) => {
+                self.session = session;
+                for line in report.lines() {
+                    self.link
+                        .reply(Reply::Error(format!("{}: {line}", path.display())));
+                }
+                self.link.reply(Reply::Opened(path));
+                self.after_edit(true);
+            }
+            Err(e) => self
+                .link
+                .reply(Reply::Error(format!("{}: {e}", path.display()))),
+        }
+    }
+
+    fn after_edit(&mut self, changed: bool) {
+        if changed {
+            self.rebuild_picker();
+            self.send_whole();
+        }
+        self.send_status();
+    }
+
+    fn after_refusable(&mut self, result: Result<(), String>) {
+        if let Err(why) = result {
+            self.link.reply(Reply::Error(why));
+        }
+        self.send_status();
+    }
+
+    /// One stroke, from its settings to its `End`.
+    fn stroke(&mut self, settings: StrokeSettings) {
+        let grab = settings.brush.kind == BrushKind::Grab;
+        let label = format!("{} stroke", settings.brush.kind.name());
+        let visible = self.visible();
+        let Worker {
+            session,
+            pipeline,
+            picker,
+            link,
+        } = self;
+        let mut edit = session.edit(&label);
+        // A refused stroke still reads its points up to its end, running none.
+        let (mut stroke, mut failure) = match pipeline.begin_stroke(edit.mesh(), settings) {
+            Ok(stroke) => (Some(stroke), None),
+            Err(e) => (None, Some(format!("stroke refused: {e}"))),
+        };
+        let mut projector = Projector::default();
+        let mut deferred = Vec::new();
+        loop {
+            let (points, sent) = match link.next() {
+                Some(Command::Points { points, sent }) => (link.take_queued_points(points), sent),
+                Some(Command::End) | None => break,
+                Some(Command::Hover(_)) => continue,
+                Some(other) => {
+                    // Undo, saving and the like wait for the stroke to end.
+                    deferred.push(other);
+                    continue;
+                }
+            };
+            let Some(stroke) = stroke.as_mut().filter(|_| failure.is_none()) else {
+                continue;
+            };
+            let samples: Vec<Sample> = points
+                .iter()
+                .filter_map(|point| projector.sample(point, stroke.mesh(), picker, grab))
+                .collect();
+            if samples.is_empty() {
+                continue;
+            }
+            match stroke.add_samples(&samples) {
+                Ok(report) => {
+                    let mesh = stroke.mesh();
+                    if report.topology_changed {
+                        *picker = Picker::build(mesh, &visible);
+                        link.reply(Reply::Mesh(whole(mesh)));
+                    } else {
+                        picker.refit(mesh, &report.changed);
+                        link.reply(Reply::Mesh(rows(mesh, &report.changed)));
+                    }
+                    link.reply(Reply::Progress {
+                        points: points.len(),
+                        phases: report.phases,
+                        sent,
+                    });
+                }
+                Err(e) => failure = Some(format!("stroke stopped: {e}")),
+            }
+        }
+        if let Some(Err(e)) = stroke.map(|s| s.finish()) {
+            failure.get_or_insert(format!("stroke stopped: {e}"));
+        }
+        drop(edit);
+        if let Some(why) = failure {
+            link.reply(Reply::Error(why));
+        }
+        link.pending.extend(deferred);
+        self.fall_back_if_the_gpu_failed();
+        self.after_edit(true);
+    }
+
+    /// A GPU that failed (lost device, out of memory) leaves its pipeline unusable: the next
+    /// strokes run on the CPU, on the mesh as it is.
+    fn fall_back_if_the_gpu_failed(&mut self) {
+        if let Some(why) = self.pipeline.kernel_failure() {
+            self.pipeline = Pipeline::new(self.pipeline.settings().clone());
+            self.link.reply(Reply::Error(format!(
+                "the GPU failed ({why}); sculpting goes on on the CPU"
+            )));
+        }
+    }
+
+    fn visible(&self) -> Vec<bool> {
+        self.session.layers().iter().map(|l| l.visible).collect()
+    }
+
+    fn rebuild_picker(&mut self) {
+        self.picker = Picker::build(self.session.mesh(), &self.visible());
+    }
+
+    fn send_whole(&self) {
+        self.link.reply(Reply::Mesh(whole(self.session.mesh())));
+    }
+
+    fn send_status(&self) {
+        let mesh = self.session.mesh();
+        let history = self.session.history();
+        let bounds = mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
+        let status = Status {
+            faces: mesh.live_face_count(),
+            vertices: mesh.vertex_count(),
+            layers: mesh
+                .layer_names()
+                .iter()
+                .cloned()
+                .zip(self.session.layers().iter().copied())
+                .collect(),
+            history: history.entries().iter().map(|e| e.label.clone()).collect(),
+            done: history.done(),
+            edge_length: mesh.mean_edge_length(),
+            extent: (bounds.1 - bounds.0).length(),
+            centre: 0.5 * (bounds.0 + bounds.1),
+            backend: self.pipeline.name(),
+        };
+        self.link.reply(Reply::Status(status));
+    }
+}
+
+/// The channels to and from the UI.
+struct Link {
+    commands: Receiver<Command>,
+    /// Commands taken from the channel early (looking for more points) and not yet served.
+    pending: VecDeque<Command>,
+    replies: Sender<Reply>,
+    /// Wakes the UI when a reply is sent.
+    wake: Box<dyn Fn() + Send>,
+}
+
+impl Link {
+    fn next(&mut self) -> Option<Command> {
+        self.pending
+            .pop_front()
+            .or_else(|| self.commands.recv().ok())
+    }
+
+    fn reply(&self, reply: Reply) {
+        // The UI hung up: nothing left to tell.
+        if self.replies.send(reply).is_ok() {
+            (self.wake)();
+        }
+    }
+
+    /// Skips hovers that queued behind this one: only where the pointer is now matters.
+    fn latest_hover(&mut self, mut ray: Ray) -> Ray {
+        while self.pending.is_empty()
+            && let Ok(command) = self.commands.try_recv()
+        {
+            match command {
+                Command::Hover(later) => ray = later,
+                other => self.pending.push_back(other),
+            }
+        }
+        ray
+    }
+
+    /// Joins the points of `Points` commands queued right behind the first.
+    fn take_queued_points(&mut self, mut points: Vec<StrokePoint>) -> Vec<StrokePoint> {
+        while self.pending.is_empty()
+            && let Ok(command) = self.commands.try_recv()
+        {
+            match command {
+                Command::Points { points: more, .. } => points.extend(more),
+                other => self.pending.push_back(other),
+            }
+        }
+        points
+    }
+}
+
+/// Turns pointer events into samples: a ray that meets the surface gives the hit; one that
+/// misses (the pointer left the mesh), or any ray of a grab, gives the point on the plane
+/// facing the eye through the stroke's first hit, as a sculptor's hand expects.
+#[derive(Default)]
+struct Projector {
+    /// The first hit's point and the plane's normal.
+    plane: Option<(Vec3, Vec3)>,
+}
+
+impl Projector {
+    fn sample(
+        &mut self,
+        point: &StrokePoint,
+        mesh: &Mesh,
+        picker: &Picker,
+        grab: bool,
+    ) -> Option<Sample> {
+        let (ray, pressure) = match *point {
+            StrokePoint::Sample(sample) => return Some(sample),
+            StrokePoint::Ray { ray, pressure } => (ray, pressure),
+        };
+        let on_plane = |(origin, normal): (Vec3, Vec3)| {
+            let denominator = ray.direction.dot(normal);
+            (denominator.abs() > 1e-6)
+                .then(|| ray.at((origin - ray.origin).dot(normal) / denominator))
+        };
+        let position = match (self.plane, grab) {
+            (Some(plane), true) => on_plane(plane)?,
+            (plane, _) => match picker.pick(mesh, &ray) {
+                Some(hit) => {
+                    self.plane.get_or_insert((hit.point, -ray.direction));
+                    hit.point
+                }
+                None => on_plane(plane?)?,
+            },
+        };
+        Some(Sample {
+            position,
+            pressure: pressure.clamp(0.0, 1.0),
+            normal: None,
+        })
+    }
+}
+
+/// Every vertex's render row and the live faces' corners.
+pub fn whole(mesh: &Mesh) -> MeshUpdate {
+    let vertices = (0..mesh.vertex_count())
+        .map(|v| render_vertex(mesh, v))
+        .collect();
+    let corners = mesh
+        .faces()
+        .iter()
+        .enumerate()
+        .filter(|&(f, face)| face[0] != INVALID && !mesh.is_face_dead(f))
+        .flat_map(|(_, face)| *face)
+        .collect();
+    MeshUpdate::Whole {
+        vertices,
+        corners,
+        bounds: mesh.bounds(),
+    }
+}
+
+/// The rows of `changed` (ascending), in runs.
+fn rows(mesh: &Mesh, changed: &[u32]) -> MeshUpdate {
+    let mut runs: Vec<(u32, Vec<RenderVertex>)> = Vec::new();
+    for &v in changed {
+        match runs.last_mut() {
+            Some((first, rows))
+                if v >= *first + rows.len() as u32 && v <= *first + rows.len() as u32 + RUN_GAP =>
+            {
+                let next = *first + rows.len() as u32;
+                rows.extend((next..=v).map(|u| render_vertex(mesh, u as usize)));
+            }
+            _ => runs.push((v, vec![render_vertex(mesh, v as usize)])),
+        }
+    }
+    MeshUpdate::Rows(runs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{SceneKind, SceneSpec, generate};
+
+    #[test]
+    fn rows_cover_every_changed_vertex_in_few_runs() {
+        let mesh = generate(&SceneSpec {
+            kind: SceneKind::Plaster,
+            triangles: 500,
+            seed: 1,
+        })
+        .unwrap();
+        let changed = [3, 4, 5, 9, 40, 41, 200];
+        let MeshUpdate::Rows(runs) = rows(&mesh, &changed) else {
+            unreachable!()
+        };
+        assert_eq!(runs.len(), 3, "3..=9, 40..=41, 200");
+        for &v in &changed {
+            let (first, rows) = runs
+                .iter()
+                .find(|(first, rows)| (*first..*first + rows.len() as u32).contains(&v))
+                .expect("covered");
+            assert_eq!(rows[(v - first) as usize], render_vertex(&mesh, v as usize));
+        }
+    }
+}
