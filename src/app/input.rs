@@ -330,8 +330,9 @@ pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
         }
     }
     if pressed((Modifiers::NONE, Key::Home)) || pressed((Modifiers::NONE, Key::Period)) {
+        let aspect = app.aspect();
         if let Some(camera) = &mut app.camera {
-            camera.frame_all(1.5);
+            camera.frame_all(aspect);
         }
     }
     if pressed((Modifiers::NONE, Key::H)) || pressed((Modifiers::NONE, Key::F1)) {

@@ -36,7 +36,7 @@ use eframe::{egui, egui_wgpu};
 use crate::brush::{BrushKind, Stroke};
 use crate::mesh::Brdf;
 use crate::pipeline::{PhaseTimes, Pipeline};
-use crate::session::{BrushSettings, Session};
+use crate::session::{BrushSettings, LayerSettings, Session};
 use input::PointerState;
 use viewport::Viewport;
 
@@ -49,6 +49,8 @@ pub struct AppSetup {
     /// Strokes to play through the pointer's path before handing over to the user.
     pub replay: Vec<Stroke>,
     pub plan: ExitPlan,
+    /// Draw the viewport with 4× multisampling.
+    pub antialias: bool,
 }
 
 /// The brush and what it paints, as the panels set them.
@@ -64,6 +66,9 @@ pub struct Tools {
     pub symmetry_x: bool,
     pub remesh: bool,
     pub view: ViewOptions,
+    /// The engine's phase times in the status bar (off for pictures that must not change
+    /// from run to run).
+    pub phase_times: bool,
 }
 
 /// Samples sent and done in the current stroke, and the engine's last phase times.
@@ -96,6 +101,10 @@ pub struct SlayerApp {
     metrics_path: Option<PathBuf>,
     open_path: Option<String>,
     rename: Option<(u32, String)>,
+    /// Where the viewport was drawn last frame, in points.
+    viewport_rect: Option<egui::Rect>,
+    /// The mesh's box as of the last whole upload (`Some(None)`: an empty mesh).
+    scene_bounds: Option<Option<(glam::Vec3, glam::Vec3)>>,
     started: Instant,
 }
 
@@ -121,7 +130,8 @@ impl SlayerApp {
             .expect("the engine thread starts");
         let (viewport, renderer) = match &cc.wgpu_render_state {
             Some(state) => (
-                Viewport::new(&state.device, &state.queue).map_err(|e| e.to_string()),
+                Viewport::new(&state.device, &state.queue, setup.antialias)
+                    .map_err(|e| e.to_string()),
                 Some(state.renderer.clone()),
             ),
             None => (Err("eframe runs without wgpu: no viewport".into()), None),
@@ -147,6 +157,7 @@ impl SlayerApp {
                 symmetry_x: false,
                 remesh: true,
                 view: ViewOptions::default(),
+                phase_times: true,
             },
             pointer: PointerState::default(),
             hover: None,
@@ -159,6 +170,8 @@ impl SlayerApp {
             metrics: Metrics::default(),
             open_path: None,
             rename: None,
+            viewport_rect: None,
+            scene_bounds: None,
             started: Instant::now(),
         }
     }
@@ -168,12 +181,31 @@ impl SlayerApp {
         let _ = self.commands.send(command);
     }
 
-    /// The mesh's digest once every command sent so far is done (blocks: tests and the
-    /// replay's end use it, never a frame of the user's).
-    pub fn digest(&self) -> String {
+    /// What `question` says of the session once every command sent so far is done. Blocks
+    /// until then: for tests, never in a frame of the user's.
+    pub fn query<T: Send + 'static>(
+        &self,
+        question: impl FnOnce(&Session) -> T + Send + 'static,
+    ) -> Option<T> {
         let (answer, wait) = mpsc::channel();
-        self.send(Command::Digest(answer));
-        wait.recv().unwrap_or_default()
+        self.send(Command::Query(Box::new(move |session| {
+            // The asker may have given up waiting: nothing to do then.
+            let _ = answer.send(question(session));
+        })));
+        wait.recv().ok()
+    }
+
+    /// Shows or hides a layer (the Layers panel's eye), as one history entry.
+    pub fn set_layer_visible(&self, layer: u32, visible: bool) {
+        if let Some((_, settings)) = self.status.layers.get(layer as usize) {
+            self.send(Command::SetLayer(
+                layer,
+                LayerSettings {
+                    visible,
+                    ..*settings
+                },
+            ));
+        }
     }
 
     /// Where the pointer last met the surface.
@@ -191,6 +223,17 @@ impl SlayerApp {
         self.replay.as_ref().is_none_or(|r| r.finished())
     }
 
+    /// Where the viewport was drawn last frame, in points.
+    pub fn viewport_rect(&self) -> Option<egui::Rect> {
+        self.viewport_rect
+    }
+
+    /// The viewport's width over its height (the window's shape before the first frame).
+    pub(crate) fn aspect(&self) -> f32 {
+        self.viewport_rect
+            .map_or(1.5, |r| r.width() / r.height().max(1.0))
+    }
+
     pub fn camera(&self) -> Option<&OrbitCamera> {
         self.camera.as_ref()
     }
@@ -206,9 +249,9 @@ impl SlayerApp {
                 Reply::Hover(hit) => self.hover = hit,
                 Reply::Mesh(update) => {
                     if let MeshUpdate::Whole { bounds, .. } = &update {
-                        match &mut self.camera {
-                            Some(camera) => camera.set_bounds(*bounds),
-                            None => self.camera = Some(OrbitCamera::framing(*bounds, 1.5)),
+                        self.scene_bounds = Some(*bounds);
+                        if let Some(camera) = &mut self.camera {
+                            camera.set_bounds(*bounds);
                         }
                     }
                     if let Ok(viewport) = &mut self.viewport {
@@ -284,8 +327,11 @@ impl eframe::App for SlayerApp {
         self.receive();
         input::keys(self, ui.ctx());
         panels::status_bar(self, ui);
-        panels::tools_panel(self, ui);
-        panels::document_panel(self, ui);
+        // The panels' ranges come from the mesh: they wait for the engine's first report.
+        if self.status.faces > 0 {
+            panels::tools_panel(self, ui);
+            panels::document_panel(self, ui);
+        }
         egui::CentralPanel::default().show(ui, |ui| self.viewport_ui(ui));
         panels::overlays(self, ui.ctx());
         replay::step(self, ui.ctx());
@@ -314,6 +360,15 @@ impl SlayerApp {
     fn viewport_ui(&mut self, ui: &mut egui::Ui) {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
+        self.viewport_rect = Some(rect);
+        // Framed once the panels are laid out (they wait for the status): the viewport's shape
+        // is then final.
+        if self.camera.is_none()
+            && self.status.faces > 0
+            && let Some(bounds) = self.scene_bounds
+        {
+            self.camera = Some(OrbitCamera::framing(bounds, self.aspect()));
+        }
         let pixels_per_point = ui.ctx().pixels_per_point();
         let size = (
             (rect.width() * pixels_per_point).round() as u32,

@@ -34,15 +34,17 @@ pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
             } else {
                 ui.label("ready");
             }
-            ui.separator();
-            let names = progress
-                .phases
-                .named()
-                .iter()
-                .map(|(name, ms)| format!("{name} {ms:.1}"))
-                .collect::<Vec<_>>()
-                .join(" · ");
-            ui.label(format!("last samples, ms: {names}"));
+            if app.tools.phase_times {
+                ui.separator();
+                let names = progress
+                    .phases
+                    .named()
+                    .iter()
+                    .map(|(name, ms)| format!("{name} {ms:.1}"))
+                    .collect::<Vec<_>>()
+                    .join(" · ");
+                ui.label(format!("last samples, ms: {names}"));
+            }
             app.messages
                 .retain(|(_, at)| at.elapsed() < Duration::from_secs(MESSAGE_SECONDS));
             if let Some((message, _)) = app.messages.last() {
@@ -84,9 +86,11 @@ fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
         });
     let edge = app.status.edge_length.max(1e-6);
     let extent = app.status.extent.max(edge);
+    // Not clamped: a radius typed in or set with F stays what the user chose.
     ui.add(
         egui::Slider::new(&mut brush.radius, 0.5 * edge..=0.5 * extent)
             .logarithmic(true)
+            .clamping(egui::SliderClamping::Never)
             .text("radius"),
     );
     ui.add(egui::Slider::new(&mut brush.strength, 0.0..=1.0).text("strength"));
@@ -163,10 +167,11 @@ fn view_section(app: &mut SlayerApp, ui: &mut Ui) {
     ui.checkbox(&mut view.wireframe, "wireframe");
     ui.checkbox(&mut view.false_colour, "layer colours");
     ui.checkbox(&mut view.show_mask, "show the mask");
+    let aspect = app.aspect();
     if ui.button("frame all (Home)").clicked()
         && let Some(camera) = &mut app.camera
     {
-        camera.frame_all(1.5);
+        camera.frame_all(aspect);
     }
 }
 

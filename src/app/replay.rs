@@ -14,8 +14,9 @@ use super::input::Activity;
 use super::worker::{Command, StrokePoint};
 use crate::brush::Stroke;
 
-/// Replayed samples fed per frame: a few pointer events' worth, as a hand would.
-const SAMPLES_PER_FRAME: usize = 4;
+/// Replayed samples per second: the rate of a hand's pointer events as egui delivers them
+/// (one a frame at 60 Hz), whatever the frame rate, so the latency measured is a user's.
+const SAMPLES_PER_SECOND: f64 = 60.0;
 
 /// What the app does after its replay, and where it reports.
 #[derive(Debug, Clone, Default)]
@@ -39,7 +40,7 @@ enum Phase {
         sample: usize,
     },
     /// Waiting for the engine to finish what was sent.
-    Settling(Receiver<String>),
+    Settling(Receiver<()>),
     Spinning(u32),
     Waiting(u32),
     Screenshot(Receiver<Result<(), String>>),
@@ -50,6 +51,8 @@ pub struct Replay {
     strokes: Vec<Stroke>,
     plan: ExitPlan,
     phase: Phase,
+    /// When feeding began, and how many samples were fed since.
+    clock: Option<(Instant, usize)>,
 }
 
 impl Replay {
@@ -61,6 +64,7 @@ impl Replay {
                 stroke: 0,
                 sample: 0,
             },
+            clock: None,
         }
     }
 
@@ -101,7 +105,10 @@ fn advance(app: &mut SlayerApp, ctx: &egui::Context, replay: &mut Replay) -> Pha
                     app.progress = Default::default();
                     app.send(Command::Begin(current.settings()));
                 }
-                let end = (sample + SAMPLES_PER_FRAME).min(current.samples.len());
+                let (start, fed) = *replay.clock.get_or_insert((Instant::now(), 0));
+                let due = (start.elapsed().as_secs_f64() * SAMPLES_PER_SECOND) as usize;
+                let end = (sample + due.saturating_sub(fed).max(1)).min(current.samples.len());
+                replay.clock = Some((start, fed + end - sample));
                 let points: Vec<StrokePoint> = current.samples[sample..end]
                     .iter()
                     .map(|&s| StrokePoint::Sample(s))
@@ -129,7 +136,9 @@ fn advance(app: &mut SlayerApp, ctx: &egui::Context, replay: &mut Replay) -> Pha
                     app.send(Command::Save(path.clone()));
                 }
                 let (answer, wait) = mpsc::channel();
-                app.send(Command::Digest(answer));
+                app.send(Command::Query(Box::new(move |_| {
+                    let _ = answer.send(());
+                })));
                 Phase::Settling(wait)
             }
         },

@@ -39,18 +39,29 @@ pub struct Viewport {
     pub dirty: bool,
     /// Bytes written to GPU buffers since [`Viewport::take_uploaded`] last ran.
     uploaded: u64,
+    /// What the last render drew with: a camera or view change differs from it.
+    drawn_with: Option<PreviewUniforms>,
+    samples: u32,
 }
 
 struct Targets {
     size: (u32, u32),
     resolved: wgpu::TextureView,
-    multisampled: wgpu::TextureView,
+    /// `None` without antialiasing: the pass draws straight into `resolved`.
+    multisampled: Option<wgpu::TextureView>,
     depth: wgpu::TextureView,
 }
 
 impl Viewport {
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Viewport, GpuError> {
-        let pipeline = preview_pipeline(device, MSAA_SAMPLES)?;
+    /// `antialias`: 4 samples a pixel (costly on a software rasterizer: lavapipe draws a
+    /// 1280×800 viewport ~2× faster without).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        antialias: bool,
+    ) -> Result<Viewport, GpuError> {
+        let samples = if antialias { MSAA_SAMPLES } else { 1 };
+        let pipeline = preview_pipeline(device, samples)?;
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("viewport uniforms"),
             size: std::mem::size_of::<PreviewUniforms>() as u64,
@@ -73,6 +84,8 @@ impl Viewport {
             texture: None,
             dirty: true,
             uploaded: 0,
+            drawn_with: None,
+            samples,
         })
     }
 
@@ -147,7 +160,7 @@ impl Viewport {
     ) {
         let size = (size.0.max(1), size.1.max(1));
         if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            let targets = Targets::new(&self.device, size);
+            let targets = Targets::new(&self.device, size, self.samples);
             match self.texture {
                 Some(id) => renderer.update_egui_texture_from_wgpu_texture(
                     &self.device,
@@ -166,10 +179,6 @@ impl Viewport {
             self.targets = Some(targets);
             self.dirty = true;
         }
-        if !self.dirty {
-            return;
-        }
-        self.dirty = false;
         let options = RenderOptions {
             wireframe: view.wireframe,
             false_colour: view.false_colour,
@@ -178,6 +187,11 @@ impl Viewport {
         let mut uniforms = preview_uniforms(camera, &options);
         uniforms.hidden_layers = view.hidden_layers;
         uniforms.show_mask = view.show_mask as u32;
+        if !self.dirty && self.drawn_with == Some(uniforms) {
+            return;
+        }
+        self.dirty = false;
+        self.drawn_with = Some(uniforms);
         self.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniforms));
         let targets = self.targets.as_ref().expect("made above");
@@ -191,9 +205,9 @@ impl Viewport {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("viewport"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.multisampled,
+                    view: targets.multisampled.as_ref().unwrap_or(&targets.resolved),
                     depth_slice: None,
-                    resolve_target: Some(&targets.resolved),
+                    resolve_target: targets.multisampled.as_ref().map(|_| &targets.resolved),
                     ops: wgpu::Operations {
                         load: wgpu::LoadOp::Clear(wgpu::Color {
                             r: background[0],
@@ -201,7 +215,12 @@ impl Viewport {
                             b: background[2],
                             a: 1.0,
                         }),
-                        store: wgpu::StoreOp::Discard,
+                        // Multisampled, only the resolved image is kept.
+                        store: if targets.multisampled.is_some() {
+                            wgpu::StoreOp::Discard
+                        } else {
+                            wgpu::StoreOp::Store
+                        },
                     },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -227,7 +246,7 @@ impl Viewport {
 }
 
 impl Targets {
-    fn new(device: &wgpu::Device, size: (u32, u32)) -> Targets {
+    fn new(device: &wgpu::Device, size: (u32, u32), samples: u32) -> Targets {
         let texture = |label, samples, format, usage| {
             device
                 .create_texture(&wgpu::TextureDescriptor {
@@ -255,8 +274,9 @@ impl Targets {
                 COLOUR_FORMAT,
                 attachment | wgpu::TextureUsages::TEXTURE_BINDING,
             ),
-            multisampled: texture("viewport samples", MSAA_SAMPLES, COLOUR_FORMAT, attachment),
-            depth: texture("viewport depth", MSAA_SAMPLES, DEPTH_FORMAT, attachment),
+            multisampled: (samples > 1)
+                .then(|| texture("viewport samples", samples, COLOUR_FORMAT, attachment)),
+            depth: texture("viewport depth", samples, DEPTH_FORMAT, attachment),
         }
     }
 }

@@ -16,13 +16,16 @@ use glam::Vec3;
 use super::pick::{Hit, Picker, Ray};
 use crate::brush::{BrushKind, Sample, StrokeSettings};
 use crate::mesh::{INVALID, LayerId, Mesh};
-use crate::pipeline::{PhaseTimes, Pipeline, Remeshing};
+use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress};
 use crate::render::{RenderVertex, render_vertex};
 use crate::session::{LayerSettings, Session};
 
 /// Rows closer than this are sent as one run with those between them: one buffer write
 /// instead of several small ones.
 const RUN_GAP: u32 = 8;
+/// While a batch of points runs, the UI hears what changed at least this often, so the
+/// picture follows the stroke even when the engine is behind the pointer.
+const FLUSH_INTERVAL: std::time::Duration = std::time::Duration::from_millis(30);
 
 /// One pointer event of a stroke.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,8 +57,9 @@ pub enum Command {
     Open(PathBuf),
     /// Remesh after each stroke, or not.
     Remeshing(bool),
-    /// Answers with the mesh's digest once every earlier command is done.
-    Digest(Sender<String>),
+    /// Runs once every earlier command is done, on the session as they left it (tests, the
+    /// replay's end).
+    Query(Box<dyn FnOnce(&Session) + Send>),
 }
 
 /// What the UI uploads.
@@ -188,10 +192,7 @@ impl Worker {
             } else {
                 Remeshing::Off
             }),
-            Command::Digest(answer) => {
-                // The asker may have given up waiting: nothing to do then.
-                let _ = answer.send(self.session.mesh().digest());
-            }
+            Command::Query(question) => question(&self.session),
         }
     }
 
@@ -247,8 +248,8 @@ impl Worker {
         let mut projector = Projector::default();
         let mut deferred = Vec::new();
         loop {
-            let (points, sent) = match link.next() {
-                Some(Command::Points { points, sent }) => (link.take_queued_points(points), sent),
+            let points = match link.next() {
+                Some(Command::Points { points, sent }) => link.take_queued_points(points, sent),
                 Some(Command::End) | None => break,
                 Some(Command::Hover(_)) => continue,
                 Some(other) => {
@@ -257,33 +258,16 @@ impl Worker {
                     continue;
                 }
             };
-            let Some(stroke) = stroke.as_mut().filter(|_| failure.is_none()) else {
-                continue;
+            let stroke = stroke.as_mut().filter(|_| failure.is_none());
+            let mut batch = Batch {
+                stroke,
+                picker,
+                projector: &mut projector,
+                visible: &visible,
+                grab,
             };
-            let samples: Vec<Sample> = points
-                .iter()
-                .filter_map(|point| projector.sample(point, stroke.mesh(), picker, grab))
-                .collect();
-            if samples.is_empty() {
-                continue;
-            }
-            match stroke.add_samples(&samples) {
-                Ok(report) => {
-                    let mesh = stroke.mesh();
-                    if report.topology_changed {
-                        *picker = Picker::build(mesh, &visible);
-                        link.reply(Reply::Mesh(whole(mesh)));
-                    } else {
-                        picker.refit(mesh, &report.changed);
-                        link.reply(Reply::Mesh(rows(mesh, &report.changed)));
-                    }
-                    link.reply(Reply::Progress {
-                        points: points.len(),
-                        phases: report.phases,
-                        sent,
-                    });
-                }
-                Err(e) => failure = Some(format!("stroke stopped: {e}")),
+            if let Err(why) = batch.run(&points, link) {
+                failure = Some(why);
             }
         }
         if let Some(Err(e)) = stroke.map(|s| s.finish()) {
@@ -382,17 +366,119 @@ impl Link {
         ray
     }
 
-    /// Joins the points of `Points` commands queued right behind the first.
-    fn take_queued_points(&mut self, mut points: Vec<StrokePoint>) -> Vec<StrokePoint> {
+    /// The points of `Points` commands queued right behind the first, each with when its
+    /// command was sent.
+    fn take_queued_points(
+        &mut self,
+        points: Vec<StrokePoint>,
+        sent: Instant,
+    ) -> Vec<(StrokePoint, Instant)> {
+        let mut all: Vec<(StrokePoint, Instant)> = points.into_iter().map(|p| (p, sent)).collect();
         while self.pending.is_empty()
             && let Ok(command) = self.commands.try_recv()
         {
             match command {
-                Command::Points { points: more, .. } => points.extend(more),
+                Command::Points { points, sent } => {
+                    all.extend(points.into_iter().map(|p| (p, sent)))
+                }
                 other => self.pending.push_back(other),
             }
         }
-        points
+        all
+    }
+}
+
+/// A stroke's points that arrived together.
+struct Batch<'s, 'm> {
+    /// `None`: the stroke was refused or stopped; its points run nothing.
+    stroke: Option<&'s mut StrokeInProgress<'m>>,
+    picker: &'s mut Picker,
+    projector: &'s mut Projector,
+    visible: &'s [bool],
+    grab: bool,
+}
+
+/// What ran since the UI last heard.
+#[derive(Default)]
+struct Unsent {
+    points: usize,
+    oldest: Option<Instant>,
+    changed: Vec<u32>,
+    topology_changed: bool,
+    phases: PhaseTimes,
+}
+
+impl Batch<'_, '_> {
+    /// Runs the points one `add_samples` call each, picking every ray on the mesh as the
+    /// points before it left it: the stroke is then the same however the points were
+    /// batched (by the frame rate, by the engine's speed), as a replay needs. The UI hears
+    /// what changed every [`FLUSH_INTERVAL`] and at the end; every point is reported done,
+    /// those of a stopped stroke too.
+    fn run(&mut self, points: &[(StrokePoint, Instant)], link: &Link) -> Result<(), String> {
+        let mut unsent = Unsent::default();
+        let mut flushed = Instant::now();
+        let mut result = Ok(());
+        for (k, (point, sent)) in points.iter().enumerate() {
+            unsent.points += 1;
+            unsent.oldest.get_or_insert(*sent);
+            if result.is_ok()
+                && let Err(why) = self.step(point, &mut unsent)
+            {
+                result = Err(why);
+            }
+            if flushed.elapsed() >= FLUSH_INTERVAL || k + 1 == points.len() {
+                self.flush(std::mem::take(&mut unsent), link);
+                flushed = Instant::now();
+            }
+        }
+        result
+    }
+
+    fn step(&mut self, point: &StrokePoint, unsent: &mut Unsent) -> Result<(), String> {
+        let Some(stroke) = self.stroke.as_mut() else {
+            return Ok(());
+        };
+        let Some(sample) = self
+            .projector
+            .sample(point, stroke.mesh(), self.picker, self.grab)
+        else {
+            return Ok(());
+        };
+        let report = match stroke.add_samples(&[sample]) {
+            Ok(report) => report,
+            Err(e) => {
+                self.stroke = None;
+                return Err(format!("stroke stopped: {e}"));
+            }
+        };
+        unsent.phases.add(&report.phases);
+        let mesh = stroke.mesh();
+        if report.topology_changed {
+            unsent.topology_changed = true;
+            *self.picker = Picker::build(mesh, self.visible);
+        } else {
+            self.picker.refit(mesh, &report.changed);
+        }
+        unsent.changed.extend(report.changed);
+        Ok(())
+    }
+
+    fn flush(&self, mut unsent: Unsent, link: &Link) {
+        if let Some(stroke) = &self.stroke {
+            let mesh = stroke.mesh();
+            if unsent.topology_changed {
+                link.reply(Reply::Mesh(whole(mesh)));
+            } else if !unsent.changed.is_empty() {
+                unsent.changed.sort_unstable();
+                unsent.changed.dedup();
+                link.reply(Reply::Mesh(rows(mesh, &unsent.changed)));
+            }
+        }
+        link.reply(Reply::Progress {
+            points: unsent.points,
+            phases: unsent.phases,
+            sent: unsent.oldest.unwrap_or_else(Instant::now),
+        });
     }
 }
 

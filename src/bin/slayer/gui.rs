@@ -18,6 +18,7 @@ pub struct Args<'a> {
     pub replay: Option<&'a Path>,
     pub plan: ExitPlan,
     pub window: (u32, u32),
+    pub antialias: bool,
     pub backend: crate::backend::Backend,
     pub strict: bool,
 }
@@ -58,6 +59,7 @@ pub fn run(args: Args<'_>) -> anyhow::Result<ExitCode> {
         save_path,
         replay,
         plan: args.plan,
+        antialias: args.antialias,
     };
     let (width, height) = args.window;
     slayer::app::run(setup, [width as f32, height as f32]).map_err(anyhow::Error::msg)?;

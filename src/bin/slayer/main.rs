@@ -286,6 +286,12 @@ enum Command {
         /// Window size, WIDTHxHEIGHT.
         #[arg(long, default_value = "1280x800", value_parser = render::parse_size)]
         window: (u32, u32),
+        /// Draw the viewport without 4x multisampling (twice the frame rate on a software
+        /// rasterizer such as lavapipe).
+        #[arg(long)]
+        no_antialias: bool,
+        /// auto (a hardware GPU if there is one, else the CPU), cpu, or gpu (any adapter,
+        /// lavapipe included).
         #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
         backend: backend::Backend,
     },
@@ -410,6 +416,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             screenshot,
             metrics,
             window,
+            no_antialias,
             backend,
         } => gui::run(gui::Args {
             file: file.as_deref(),
@@ -423,6 +430,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
                 metrics,
             },
             window,
+            antialias: !no_antialias,
             backend,
             strict,
         }),

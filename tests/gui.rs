@@ -1,0 +1,287 @@
+//! The app driven as a user would: pointer and key events through egui_kittest, rendered with
+//! wgpu (lavapipe in CI), the engine on its own thread as in a window.
+
+use std::time::{Duration, Instant};
+
+use eframe::egui::{self, Event, Key, Modifiers, PointerButton, Pos2};
+use egui_kittest::{Harness, SnapshotOptions};
+use glam::Vec3;
+use slayer::app::{AppSetup, SlayerApp};
+use slayer::pipeline::{Pipeline, PipelineSettings};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+use slayer::session::Session;
+
+const SIZE: [f32; 2] = [1100.0, 700.0];
+
+fn plaster() -> Session {
+    Session::new(
+        generate(&SceneSpec {
+            triangles: 6_000,
+            ..SceneSpec::new(SceneKind::Plaster)
+        })
+        .unwrap(),
+    )
+}
+
+fn app(session: Session) -> Harness<'static, SlayerApp> {
+    let save_path =
+        std::env::temp_dir().join(format!("slayer-gui-test-{}.slayer", std::process::id()));
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .wgpu()
+        .build_eframe(move |cc| {
+            SlayerApp::new(
+                cc,
+                AppSetup {
+                    session,
+                    pipeline: Pipeline::new(PipelineSettings::default()),
+                    save_path,
+                    replay: Vec::new(),
+                    plan: Default::default(),
+                    antialias: true,
+                },
+            )
+        });
+    settle(&mut harness, "the mesh arrives", |app| {
+        app.camera().is_some() && app.status.faces > 0 && app.viewport_rect().is_some()
+    });
+    harness
+}
+
+/// Steps frames until `done` holds (the engine answers on its own thread).
+fn settle(harness: &mut Harness<'_, SlayerApp>, what: &str, done: impl Fn(&SlayerApp) -> bool) {
+    let start = Instant::now();
+    while !done(harness.state()) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "timed out waiting until {what}"
+        );
+        harness.step();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // One more frame draws what arrived.
+    harness.step();
+}
+
+fn centre(harness: &Harness<'_, SlayerApp>) -> Pos2 {
+    harness.state().viewport_rect().unwrap().center()
+}
+
+/// Hovers at `from` until the pointer is over the mesh, then drags to `to` in steps, holding
+/// `modifiers`, and waits until the stroke is done.
+fn drag(harness: &mut Harness<'_, SlayerApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
+    let strokes_before = harness.state().status.history.len();
+    harness.hover_at(from);
+    settle(harness, "the pointer is over the mesh", |app| {
+        app.hover().is_some()
+    });
+    let button = |pos, pressed| Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers,
+    };
+    harness.event(button(from, true));
+    harness.step();
+    for k in 1..=12 {
+        harness.hover_at(from + (to - from) * (k as f32 / 12.0));
+        harness.step();
+    }
+    harness.event(button(to, false));
+    settle(harness, "the stroke is recorded", |app| {
+        app.idle() && app.status.history.len() > strokes_before
+    });
+}
+
+fn positions(harness: &Harness<'_, SlayerApp>) -> (Vec<Vec3>, Vec<bool>) {
+    harness
+        .state()
+        .query(|session| {
+            let mesh = session.mesh();
+            let dead = (0..mesh.vertex_count() as u32)
+                .map(|v| mesh.is_vertex_dead(v))
+                .collect();
+            (mesh.positions().to_vec(), dead)
+        })
+        .unwrap()
+}
+
+fn digest(harness: &Harness<'_, SlayerApp>) -> String {
+    harness.state().query(|s| s.mesh().digest()).unwrap()
+}
+
+/// The surface points under the drag's ends, picked on the mesh as it was.
+fn picked(harness: &Harness<'_, SlayerApp>, pixels: [Pos2; 2]) -> [Vec3; 2] {
+    let app = harness.state();
+    let rect = app.viewport_rect().unwrap();
+    let camera = *app.camera().unwrap();
+    let size = glam::Vec2::new(rect.width(), rect.height());
+    pixels.map(|p| {
+        let ray = camera.ray(glam::Vec2::new(p.x - rect.min.x, p.y - rect.min.y), size);
+        app.query(move |s| {
+            let mesh = s.mesh();
+            slayer::app::Picker::build(mesh, &vec![true; mesh.layer_count()])
+                .pick(mesh, &ray)
+                .map(|h| h.point)
+        })
+        .flatten()
+        .expect("the drag's ends are on the mesh")
+    })
+}
+
+fn distance_to_segment(p: Vec3, [a, b]: [Vec3; 2]) -> f32 {
+    let t = ((p - a).dot(b - a) / (b - a).length_squared().max(1e-12)).clamp(0.0, 1.0);
+    (p - (a + t * (b - a))).length()
+}
+
+#[test]
+fn a_drag_sculpts_under_the_pointer_only_and_ctrl_z_restores_the_mesh_bit_for_bit() {
+    let mut harness = app(plaster());
+    let before = digest(&harness);
+    let (old, _) = positions(&harness);
+    let c = centre(&harness);
+    let ends = [c - egui::vec2(80.0, 0.0), c + egui::vec2(80.0, 0.0)];
+    let path = picked(&harness, ends);
+    let radius = harness.state().tools.brush.radius;
+
+    drag(&mut harness, ends[0], ends[1], Modifiers::NONE);
+    assert_ne!(digest(&harness), before, "the stroke changed nothing");
+    let (new, dead) = positions(&harness);
+    let mut moved_near = 0;
+    for v in 0..old.len() {
+        if dead[v] || new[v] == old[v] {
+            continue;
+        }
+        let away = distance_to_segment(old[v], path);
+        // Remeshing relaxes the ring just outside the brush: two radii bound everything.
+        assert!(
+            away < 2.0 * radius,
+            "vertex {v} moved {} though it is {away} from the stroke (radius {radius})",
+            (new[v] - old[v]).length()
+        );
+        moved_near += (away < radius) as usize;
+    }
+    assert!(
+        moved_near > 50,
+        "only {moved_near} vertices under the brush moved"
+    );
+
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    settle(&mut harness, "the undo is done", |app| app.status.done == 0);
+    assert_eq!(
+        digest(&harness),
+        before,
+        "undo did not restore the mesh bit for bit"
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    settle(&mut harness, "the redo is done", |app| app.status.done == 1);
+    assert_ne!(digest(&harness), before);
+}
+
+/// Mean displacement along +z of the vertices within half a radius of the drag.
+fn lift(harness: &mut Harness<'_, SlayerApp>, modifiers: Modifiers, dy: f32) -> f32 {
+    let (old, _) = positions(harness);
+    let c = centre(harness) + egui::vec2(0.0, dy);
+    let ends = [c - egui::vec2(40.0, 0.0), c + egui::vec2(40.0, 0.0)];
+    let path = picked(harness, ends);
+    let radius = harness.state().tools.brush.radius;
+    drag(harness, ends[0], ends[1], modifiers);
+    let (new, dead) = positions(harness);
+    let near: Vec<usize> = (0..old.len())
+        .filter(|&v| !dead[v] && distance_to_segment(old[v], path) < 0.5 * radius)
+        .collect();
+    assert!(!near.is_empty());
+    near.iter().map(|&v| new[v].z - old[v].z).sum::<f32>() / near.len() as f32
+}
+
+#[test]
+fn ctrl_drag_pushes_the_other_way_and_f_sets_the_radius() {
+    let mut harness = app(plaster());
+    harness.state_mut().tools.brush.strength = 1.0;
+    let up = lift(&mut harness, Modifiers::NONE, -120.0);
+    let down = lift(&mut harness, Modifiers::COMMAND, 120.0);
+    assert!(up > 0.0, "a draw stroke lifts the surface (mean {up})");
+    assert!(down < 0.0, "a Ctrl-draw stroke pushes it in (mean {down})");
+
+    let radius = harness.state().tools.brush.radius;
+    let c = centre(&harness);
+    harness.hover_at(c);
+    harness.step();
+    harness.key_press(Key::F);
+    harness.step();
+    harness.hover_at(c + egui::vec2(120.0, 0.0));
+    harness.step();
+    harness.event(Event::PointerButton {
+        pos: c + egui::vec2(120.0, 0.0),
+        button: PointerButton::Primary,
+        pressed: false,
+        modifiers: Modifiers::NONE,
+    });
+    harness.step();
+    let grown = harness.state().tools.brush.radius;
+    assert!(
+        grown > 1.5 * radius,
+        "F then a move right: radius {radius} -> {grown}"
+    );
+    // The F-drag was not a stroke.
+    assert_eq!(harness.state().status.history.len(), 2);
+}
+
+/// Orange pixels (the top layer's false colour, PALETTE[2]) inside the viewport.
+fn orange_pixels(harness: &mut Harness<'_, SlayerApp>) -> usize {
+    let rect = harness.state().viewport_rect().unwrap();
+    let image = harness.render().unwrap();
+    image
+        .enumerate_pixels()
+        .filter(|(x, y, _)| rect.contains(egui::pos2(*x as f32, *y as f32)))
+        .filter(|(_, _, p)| {
+            let [r, g, b, _] = p.0.map(f32::from);
+            r > 60.0 && r > 1.3 * g && g > 1.5 * b
+        })
+        .count()
+}
+
+#[test]
+fn hiding_a_layer_removes_it_from_the_picture() {
+    let mut harness = app(plaster());
+    harness.state_mut().tools.view.false_colour = true;
+    harness.step();
+    let top = harness.state().status.layers.len() as u32 - 1;
+    assert_eq!(
+        top, 2,
+        "the plaster's flakes are drawn in PALETTE[2], orange"
+    );
+    let shown = orange_pixels(&mut harness);
+    harness.state().set_layer_visible(top, false);
+    settle(&mut harness, "the layer is hidden", |app| {
+        !app.status.layers[top as usize].1.visible
+    });
+    let hidden = orange_pixels(&mut harness);
+    assert!(shown > 2_000, "the top layer covers only {shown} pixels");
+    assert!(
+        hidden * 50 < shown,
+        "{hidden} orange pixels remain of {shown}"
+    );
+}
+
+/// The default look and a sculpted one, against images stored in `tests/snapshots/`
+/// (`UPDATE_SNAPSHOTS=1 cargo test --release --test gui` rewrites them). Lavapipe renders the
+/// same bits on every run; the tolerance (0.5 % of the pixels, each by the default threshold)
+/// absorbs a different Mesa version's rounding, not a missing layer or a changed material.
+#[test]
+fn the_default_and_a_sculpted_plaster_look_as_stored() {
+    let mut harness = app(plaster());
+    harness.state_mut().tools.phase_times = false;
+    harness.step();
+    let pixels = (SIZE[0] * SIZE[1]) as usize;
+    let options = SnapshotOptions::new().failed_pixel_count_threshold(pixels / 200);
+    harness.snapshot_options("gui_plaster", &options);
+    let c = centre(&harness);
+    drag(
+        &mut harness,
+        c - egui::vec2(100.0, 30.0),
+        c + egui::vec2(60.0, 40.0),
+        Modifiers::NONE,
+    );
+    harness.snapshot_options("gui_plaster_sculpted", &options);
+}
