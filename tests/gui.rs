@@ -285,3 +285,109 @@ fn the_default_and_a_sculpted_plaster_look_as_stored() {
     );
     harness.snapshot_options("gui_plaster_sculpted", &options);
 }
+
+/// A real window under Xvfb (installed by `tools/test.sh`): the replay drives the pointer's
+/// path, the screenshot is the window's own pixels, and the saved session is the mesh
+/// `slayer sculpt` makes of the same strokes, bit for bit.
+#[test]
+fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
+    let xvfb = std::process::Command::new("xvfb-run")
+        .arg("--help")
+        .output();
+    assert!(
+        xvfb.is_ok(),
+        "xvfb-run is missing: tools/test.sh installs it (apt-get install xvfb xauth)"
+    );
+    let dir = std::env::temp_dir().join(format!("slayer-gui-xvfb-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let slayer = env!("CARGO_BIN_EXE_slayer");
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(args[0])
+            .args(&args[1..])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?} failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run(&[
+        slayer,
+        "scene",
+        "plaster",
+        "--triangles",
+        "4000",
+        "-o",
+        "p.ply",
+    ]);
+    run(&[
+        slayer,
+        "strokes",
+        "--scene",
+        "plaster",
+        "--triangles",
+        "4000",
+        "--count",
+        "3",
+        "-o",
+        "s.json",
+    ]);
+    run(&[
+        "xvfb-run",
+        "-a",
+        "-s",
+        "-screen 0 1280x1024x24",
+        slayer,
+        "gui",
+        "p.ply",
+        "--replay",
+        "s.json",
+        "--save",
+        "gui.slayer",
+        "--exit-after-frames",
+        "3",
+        "--screenshot",
+        "shot.png",
+        "--window",
+        "900x600",
+        "--backend",
+        "cpu",
+    ]);
+    run(&[
+        slayer,
+        "sculpt",
+        "--input",
+        "p.ply",
+        "--strokes",
+        "s.json",
+        "--output",
+        "cli.slayer",
+        "--backend",
+        "cpu",
+    ]);
+    let digest = |name: &str| {
+        slayer::session::open(&dir.join(name))
+            .unwrap()
+            .mesh()
+            .digest()
+    };
+    assert_eq!(digest("gui.slayer"), digest("cli.slayer"));
+
+    let shot = image::open(dir.join("shot.png")).unwrap().to_rgba8();
+    assert_eq!(
+        shot.dimensions(),
+        (900, 600),
+        "the screenshot is the window"
+    );
+    let mut colours: Vec<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(
+        colours.len() > 1_000,
+        "the screenshot is blank ({} colours)",
+        colours.len()
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

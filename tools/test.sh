@@ -29,6 +29,17 @@ if ! have_vulkan_driver || ! ldconfig -p 2>/dev/null | grep -q libvulkan.so.1; t
     $sudo apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1 >/dev/null
 fi
 
+# The app's tests open a real window on a virtual X server (Xvfb); winit loads the X11
+# client libraries at run time.
+if ! command -v xvfb-run >/dev/null 2>&1 || ! ldconfig -p 2>/dev/null | grep -q libxkbcommon-x11.so.0; then
+    echo "tools/test.sh: installing Xvfb and the X11 client libraries (for the app's window tests)"
+    if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $sudo apt-get update -qq
+    $sudo apt-get install -y -qq --no-install-recommends xvfb xauth libxkbcommon-x11-0 \
+        libx11-xcb1 libxcursor1 libxrandr2 libxi6 >/dev/null
+fi
+
 # Mesa's window-system probing complains without a runtime dir; headless runs have none.
 if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     XDG_RUNTIME_DIR=$(mktemp -d)

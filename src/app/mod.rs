@@ -16,6 +16,7 @@ mod input;
 mod panels;
 mod pick;
 mod replay;
+mod upload;
 mod viewport;
 mod worker;
 
@@ -28,8 +29,9 @@ use std::time::Instant;
 pub use camera::OrbitCamera;
 pub use pick::{Hit, Picker, Ray};
 pub use replay::{ExitPlan, Metrics};
+pub use upload::{MeshUpdate, Mirror};
 pub use viewport::ViewOptions;
-pub use worker::{Command, MeshUpdate, Reply, Status, StrokePoint};
+pub use worker::{Command, Reply, Status, StrokePoint};
 
 use eframe::{egui, egui_wgpu};
 
@@ -248,10 +250,10 @@ impl SlayerApp {
             match reply {
                 Reply::Hover(hit) => self.hover = hit,
                 Reply::Mesh(update) => {
-                    if let MeshUpdate::Whole { bounds, .. } = &update {
-                        self.scene_bounds = Some(*bounds);
+                    if let Some(bounds) = update.bounds {
+                        self.scene_bounds = Some(bounds);
                         if let Some(camera) = &mut self.camera {
-                            camera.set_bounds(*bounds);
+                            camera.set_bounds(bounds);
                         }
                     }
                     if let Ok(viewport) = &mut self.viewport {

@@ -6,7 +6,7 @@
 
 use eframe::{egui, egui_wgpu};
 
-use super::worker::MeshUpdate;
+use super::upload::MeshUpdate;
 use crate::gpu::GpuError;
 use crate::render::{
     COLOUR_FORMAT, Camera, DEPTH_FORMAT, MSAA_SAMPLES, PreviewUniforms, RenderOptions,
@@ -89,52 +89,61 @@ impl Viewport {
         })
     }
 
-    /// Writes what the engine changed into the buffers (growing them when the mesh grew).
+    /// Writes what the engine changed into the buffers, growing them (contents kept) when
+    /// the mesh grew.
     pub fn apply(&mut self, update: &MeshUpdate) {
-        match update {
-            MeshUpdate::Whole {
-                vertices, corners, ..
-            } => {
-                let vertex_bytes: &[u8] = bytemuck::cast_slice(vertices);
-                let corner_bytes: &[u8] = bytemuck::cast_slice(corners);
-                let mut rebind = false;
-                if vertex_bytes.len() as u64 > self.vertices.size() {
-                    self.vertices =
-                        storage(&self.device, "viewport vertices", grown(vertex_bytes.len()));
-                    rebind = true;
-                }
-                if corner_bytes.len() as u64 > self.corners.size() {
-                    self.corners =
-                        storage(&self.device, "viewport corners", grown(corner_bytes.len()));
-                    rebind = true;
-                }
-                if rebind {
-                    self.bind_group = bind(
-                        &self.device,
-                        &self.pipeline,
-                        &self.uniform,
-                        &self.vertices,
-                        &self.corners,
-                    );
-                }
-                self.write(&self.vertices.clone(), 0, vertex_bytes);
-                self.write(&self.corners.clone(), 0, corner_bytes);
-                self.corner_count = corners.len() as u32;
-            }
-            MeshUpdate::Rows(runs) => {
-                let row = std::mem::size_of::<RenderVertex>() as u64;
-                for (first, rows) in runs {
-                    let offset = *first as u64 * row;
-                    let bytes: &[u8] = bytemuck::cast_slice(rows);
-                    // Rows of vertices the last whole upload did not have cannot be placed;
-                    // a whole upload follows every change of topology.
-                    if offset + bytes.len() as u64 <= self.vertices.size() {
-                        self.write(&self.vertices.clone(), offset, bytes);
-                    }
-                }
-            }
+        let row = std::mem::size_of::<RenderVertex>() as u64;
+        let corner = 12u64;
+        let vertices_grown = self.grow(Grown::Vertices, update.vertex_count as u64 * row);
+        let corners_grown = self.grow(Grown::Corners, update.face_count as u64 * corner);
+        if vertices_grown || corners_grown {
+            self.bind_group = bind(
+                &self.device,
+                &self.pipeline,
+                &self.uniform,
+                &self.vertices,
+                &self.corners,
+            );
         }
+        for (first, rows) in &update.rows {
+            self.write(
+                &self.vertices.clone(),
+                *first as u64 * row,
+                bytemuck::cast_slice(rows),
+            );
+        }
+        for (first, corners) in &update.corners {
+            let bytes: &[u8] = bytemuck::cast_slice(corners);
+            self.write(&self.corners.clone(), *first as u64 * corner, bytes);
+        }
+        self.corner_count = update.face_count * 3;
         self.dirty = true;
+    }
+
+    /// Replaces a buffer by one with room for `bytes`, copying what it held; whether it did.
+    fn grow(&mut self, which: Grown, bytes: u64) -> bool {
+        let old = match which {
+            Grown::Vertices => &self.vertices,
+            Grown::Corners => &self.corners,
+        };
+        if bytes <= old.size() {
+            return false;
+        }
+        let label = match which {
+            Grown::Vertices => "viewport vertices",
+            Grown::Corners => "viewport corners",
+        };
+        let new = storage(&self.device, label, grown(bytes));
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        encoder.copy_buffer_to_buffer(old, 0, &new, 0, old.size());
+        self.queue.submit([encoder.finish()]);
+        match which {
+            Grown::Vertices => self.vertices = new,
+            Grown::Corners => self.corners = new,
+        }
+        true
     }
 
     fn write(&mut self, buffer: &wgpu::Buffer, offset: u64, bytes: &[u8]) {
@@ -281,16 +290,24 @@ impl Targets {
     }
 }
 
+#[derive(Clone, Copy)]
+enum Grown {
+    Vertices,
+    Corners,
+}
+
 /// Room for `bytes` and half as much again, so a growing mesh is not re-allocated every stroke.
-fn grown(bytes: usize) -> u64 {
-    (bytes as u64 * 3 / 2).next_multiple_of(256)
+fn grown(bytes: u64) -> u64 {
+    (bytes * 3 / 2).next_multiple_of(256)
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     })
 }

@@ -14,15 +14,12 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::pick::{Hit, Picker, Ray};
+use super::upload::{MeshUpdate, Mirror};
 use crate::brush::{BrushKind, Sample, StrokeSettings};
-use crate::mesh::{INVALID, LayerId, Mesh};
+use crate::mesh::{LayerId, Mesh};
 use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress};
-use crate::render::{RenderVertex, render_vertex};
 use crate::session::{LayerSettings, Session};
 
-/// Rows closer than this are sent as one run with those between them: one buffer write
-/// instead of several small ones.
-const RUN_GAP: u32 = 8;
 /// While a batch of points runs, the UI hears what changed at least this often, so the
 /// picture follows the stroke even when the engine is behind the pointer.
 const FLUSH_INTERVAL: std::time::Duration = std::time::Duration::from_millis(30);
@@ -62,19 +59,6 @@ pub enum Command {
     Query(Box<dyn FnOnce(&Session) + Send>),
 }
 
-/// What the UI uploads.
-#[derive(Debug, Clone)]
-pub enum MeshUpdate {
-    /// Every vertex, and three vertex numbers per live face.
-    Whole {
-        vertices: Vec<RenderVertex>,
-        corners: Vec<u32>,
-        bounds: Option<(Vec3, Vec3)>,
-    },
-    /// Runs of consecutive rows: (first vertex, rows).
-    Rows(Vec<(u32, Vec<RenderVertex>)>),
-}
-
 /// The document as the panels show it.
 #[derive(Debug, Clone, Default)]
 pub struct Status {
@@ -111,6 +95,8 @@ pub struct Worker {
     session: Session,
     pipeline: Pipeline,
     picker: Picker,
+    /// What the viewport holds.
+    mirror: Mirror,
     link: Link,
 }
 
@@ -124,6 +110,7 @@ impl Worker {
     ) -> Worker {
         Worker {
             picker: Picker::default(),
+            mirror: Mirror::default(),
             session,
             pipeline,
             link: Link {
@@ -138,7 +125,7 @@ impl Worker {
     /// Serves commands until the UI hangs up.
     pub fn run(mut self) {
         self.rebuild_picker();
-        self.send_whole();
+        self.send_changes();
         self.send_status();
         while let Some(command) = self.link.next() {
             self.serve(command);
@@ -216,7 +203,7 @@ impl Worker {
     fn after_edit(&mut self, changed: bool) {
         if changed {
             self.rebuild_picker();
-            self.send_whole();
+            self.send_changes();
         }
         self.send_status();
     }
@@ -237,6 +224,7 @@ impl Worker {
             session,
             pipeline,
             picker,
+            mirror,
             link,
         } = self;
         let mut edit = session.edit(&label);
@@ -262,6 +250,7 @@ impl Worker {
             let mut batch = Batch {
                 stroke,
                 picker,
+                mirror,
                 projector: &mut projector,
                 visible: &visible,
                 grab,
@@ -301,8 +290,10 @@ impl Worker {
         self.picker = Picker::build(self.session.mesh(), &self.visible());
     }
 
-    fn send_whole(&self) {
-        self.link.reply(Reply::Mesh(whole(self.session.mesh())));
+    /// Compares the whole mesh with what the viewport holds and sends the difference.
+    fn send_changes(&mut self) {
+        let update = self.mirror.update(self.session.mesh(), None, true);
+        self.link.reply(Reply::Mesh(update));
     }
 
     fn send_status(&self) {
@@ -393,6 +384,7 @@ struct Batch<'s, 'm> {
     /// `None`: the stroke was refused or stopped; its points run nothing.
     stroke: Option<&'s mut StrokeInProgress<'m>>,
     picker: &'s mut Picker,
+    mirror: &'s mut Mirror,
     projector: &'s mut Projector,
     visible: &'s [bool],
     grab: bool,
@@ -463,15 +455,15 @@ impl Batch<'_, '_> {
         Ok(())
     }
 
-    fn flush(&self, mut unsent: Unsent, link: &Link) {
+    fn flush(&mut self, unsent: Unsent, link: &Link) {
         if let Some(stroke) = &self.stroke {
-            let mesh = stroke.mesh();
-            if unsent.topology_changed {
-                link.reply(Reply::Mesh(whole(mesh)));
-            } else if !unsent.changed.is_empty() {
-                unsent.changed.sort_unstable();
-                unsent.changed.dedup();
-                link.reply(Reply::Mesh(rows(mesh, &unsent.changed)));
+            let update = self.mirror.update(
+                stroke.mesh(),
+                Some(&unsent.changed),
+                unsent.topology_changed,
+            );
+            if !update.is_empty() {
+                link.reply(Reply::Mesh(update));
             }
         }
         link.reply(Reply::Progress {
@@ -523,69 +515,5 @@ impl Projector {
             pressure: pressure.clamp(0.0, 1.0),
             normal: None,
         })
-    }
-}
-
-/// Every vertex's render row and the live faces' corners.
-pub fn whole(mesh: &Mesh) -> MeshUpdate {
-    let vertices = (0..mesh.vertex_count())
-        .map(|v| render_vertex(mesh, v))
-        .collect();
-    let corners = mesh
-        .faces()
-        .iter()
-        .enumerate()
-        .filter(|&(f, face)| face[0] != INVALID && !mesh.is_face_dead(f))
-        .flat_map(|(_, face)| *face)
-        .collect();
-    MeshUpdate::Whole {
-        vertices,
-        corners,
-        bounds: mesh.bounds(),
-    }
-}
-
-/// The rows of `changed` (ascending), in runs.
-fn rows(mesh: &Mesh, changed: &[u32]) -> MeshUpdate {
-    let mut runs: Vec<(u32, Vec<RenderVertex>)> = Vec::new();
-    for &v in changed {
-        match runs.last_mut() {
-            Some((first, rows))
-                if v >= *first + rows.len() as u32 && v <= *first + rows.len() as u32 + RUN_GAP =>
-            {
-                let next = *first + rows.len() as u32;
-                rows.extend((next..=v).map(|u| render_vertex(mesh, u as usize)));
-            }
-            _ => runs.push((v, vec![render_vertex(mesh, v as usize)])),
-        }
-    }
-    MeshUpdate::Rows(runs)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::{SceneKind, SceneSpec, generate};
-
-    #[test]
-    fn rows_cover_every_changed_vertex_in_few_runs() {
-        let mesh = generate(&SceneSpec {
-            kind: SceneKind::Plaster,
-            triangles: 500,
-            seed: 1,
-        })
-        .unwrap();
-        let changed = [3, 4, 5, 9, 40, 41, 200];
-        let MeshUpdate::Rows(runs) = rows(&mesh, &changed) else {
-            unreachable!()
-        };
-        assert_eq!(runs.len(), 3, "3..=9, 40..=41, 200");
-        for &v in &changed {
-            let (first, rows) = runs
-                .iter()
-                .find(|(first, rows)| (*first..*first + rows.len() as u32).contains(&v))
-                .expect("covered");
-            assert_eq!(rows[(v - first) as usize], render_vertex(&mesh, v as usize));
-        }
     }
 }
