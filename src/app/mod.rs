@@ -42,6 +42,27 @@ use crate::session::{BrushSettings, LayerSettings, Session};
 use input::PointerState;
 use viewport::Viewport;
 
+/// The engine's GPU device, for the window to draw with: one device for both, so the
+/// viewport's buffers live beside the backend's.
+#[derive(Clone)]
+pub struct SharedDevice {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+impl SharedDevice {
+    pub fn of(gpu: &crate::gpu::GpuContext) -> SharedDevice {
+        SharedDevice {
+            instance: gpu.instance.clone(),
+            adapter: gpu.wgpu_adapter.clone(),
+            device: gpu.device.clone(),
+            queue: gpu.queue.clone(),
+        }
+    }
+}
+
 /// Everything the app starts from.
 pub struct AppSetup {
     pub session: Session,
@@ -94,6 +115,8 @@ pub struct SlayerApp {
     pointer: PointerState,
     hover: Option<Hit>,
     pub progress: Progress,
+    /// What the last finished stroke did.
+    pub last_stroke: Option<crate::pipeline::StrokeReport>,
     /// Errors and notices, newest last, with when they came.
     messages: Vec<(String, Instant)>,
     help: bool,
@@ -164,6 +187,7 @@ impl SlayerApp {
             pointer: PointerState::default(),
             hover: None,
             progress: Progress::default(),
+            last_stroke: None,
             messages: Vec::new(),
             help: false,
             save_path: setup.save_path,
@@ -270,6 +294,7 @@ impl SlayerApp {
                     self.metrics.effect_arrived(sent);
                 }
                 Reply::Status(status) => self.status = status,
+                Reply::StrokeDone(report) => self.last_stroke = Some(*report),
                 Reply::Saved(path) => self.notify(format!("saved {}", path.display())),
                 Reply::Opened(path) => {
                     self.save_path = crate::app::save_path_for(&path);
@@ -418,13 +443,24 @@ pub fn save_path_for(path: &std::path::Path) -> PathBuf {
     }
 }
 
-/// Runs the app in a window until it is closed.
-pub fn run(setup: AppSetup, window: [f32; 2]) -> Result<(), String> {
+/// Runs the app in a window until it is closed; on `shared`, the engine's device, when the
+/// engine runs on the GPU.
+pub fn run(setup: AppSetup, window: [f32; 2], shared: Option<SharedDevice>) -> Result<(), String> {
+    let mut wgpu_options = egui_wgpu::WgpuConfiguration::default();
+    if let Some(shared) = shared {
+        wgpu_options.wgpu_setup = egui_wgpu::WgpuSetup::Existing(egui_wgpu::WgpuSetupExisting {
+            instance: shared.instance,
+            adapter: shared.adapter,
+            device: shared.device,
+            queue: shared.queue,
+        });
+    }
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size(window)
             .with_title("slayer"),
         renderer: eframe::Renderer::Wgpu,
+        wgpu_options,
         ..Default::default()
     };
     eframe::run_native(

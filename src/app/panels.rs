@@ -17,7 +17,7 @@ const MESSAGE_SECONDS: u64 = 8;
 
 pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
     egui::Panel::bottom("status").show(ui, |ui| {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             let status = &app.status;
             ui.label(format!(
                 "{} · {} faces · {} vertices",
@@ -44,6 +44,16 @@ pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
                     .collect::<Vec<_>>()
                     .join(" · ");
                 ui.label(format!("last samples, ms: {names}"));
+                if let Some(stroke) = &app.last_stroke {
+                    ui.separator();
+                    ui.label(format!(
+                        "last stroke: {} samples, {:.0} ms ({:.0} remeshing), {} moves clamped",
+                        stroke.samples,
+                        stroke.phases.total(),
+                        stroke.phases.remesh,
+                        stroke.clamped
+                    ));
+                }
             }
             app.messages
                 .retain(|(_, at)| at.elapsed() < Duration::from_secs(MESSAGE_SECONDS));

@@ -17,7 +17,7 @@ use super::pick::{Hit, Picker, Ray};
 use super::upload::{MeshUpdate, Mirror};
 use crate::brush::{BrushKind, Sample, StrokeSettings};
 use crate::mesh::{LayerId, Mesh};
-use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress};
+use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress, StrokeReport};
 use crate::session::{LayerSettings, Session};
 
 /// While a batch of points runs, the UI hears what changed at least this often, so the
@@ -84,6 +84,8 @@ pub enum Reply {
         sent: Instant,
     },
     Status(Status),
+    /// A stroke ended: its counts and phase times, remeshing included.
+    StrokeDone(Box<StrokeReport>),
     Saved(PathBuf),
     Opened(PathBuf),
     /// A refused command or a failed stroke: the mesh is as the last good step left it.
@@ -218,7 +220,7 @@ impl Worker {
     /// One stroke, from its settings to its `End`.
     fn stroke(&mut self, settings: StrokeSettings) {
         let grab = settings.brush.kind == BrushKind::Grab;
-        let label = format!("{} stroke", settings.brush.kind.name());
+        let label = crate::session::stroke_label(&settings);
         let visible = self.visible();
         let Worker {
             session,
@@ -259,8 +261,12 @@ impl Worker {
                 failure = Some(why);
             }
         }
-        if let Some(Err(e)) = stroke.map(|s| s.finish()) {
-            failure.get_or_insert(format!("stroke stopped: {e}"));
+        match stroke.map(|s| s.finish()) {
+            Some(Ok(report)) => link.reply(Reply::StrokeDone(Box::new(report))),
+            Some(Err(e)) => {
+                failure.get_or_insert(format!("stroke stopped: {e}"));
+            }
+            None => {}
         }
         drop(edit);
         if let Some(why) = failure {

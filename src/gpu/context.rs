@@ -156,6 +156,10 @@ pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter: AdapterSummary,
+    /// The instance and adapter the device came from: a window that shares the device (the
+    /// app's) makes its surface with them.
+    pub instance: wgpu::Instance,
+    pub wgpu_adapter: wgpu::Adapter,
     pub limits: wgpu::Limits,
     /// How much GPU memory a backend may keep resident, in bytes: our own budget, because
     /// lavapipe never reports running out (it takes host memory until the process dies) and
@@ -238,6 +242,8 @@ impl GpuContext {
             device,
             queue,
             adapter: summary,
+            instance,
+            wgpu_adapter: adapter,
             limits,
             budget_bytes: budget_mib << 20,
             pipelines: Default::default(),

@@ -35,7 +35,7 @@ pub use history::{DEFAULT_HISTORY_CAP_BYTES, Entry, History};
 
 use serde::{Deserialize, Serialize};
 
-use crate::brush::{BrushKind, Falloff, Stroke};
+use crate::brush::{BrushKind, Falloff, Stroke, StrokeSettings};
 use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta};
 use crate::pipeline::{Pipeline, PipelineError, StrokeReport};
 
@@ -199,7 +199,7 @@ impl Session {
         pipeline: &mut Pipeline,
         stroke: &Stroke,
     ) -> Result<(StrokeReport, Recorded), PipelineError> {
-        let mut edit = self.edit(&stroke_label(stroke));
+        let mut edit = self.edit(&stroke_label(&stroke.settings()));
         let report = pipeline.apply_stroke(edit.mesh(), stroke);
         // A failed stroke leaves the mesh intact but may have moved some of it: recorded too.
         let recorded = edit.commit();
@@ -394,8 +394,8 @@ fn default_layers(mesh: &Mesh) -> Vec<LayerSettings> {
         .collect()
 }
 
-/// "draw stroke", "paint stroke", "grab stroke (painting)".
-fn stroke_label(stroke: &Stroke) -> String {
+/// The history label of a stroke: "draw stroke", "paint stroke", "grab stroke (painting)".
+pub fn stroke_label(stroke: &StrokeSettings) -> String {
     let kind = stroke.brush.kind.name();
     let painting = if stroke.paint.is_some() && stroke.brush.kind != BrushKind::Paint {
         " (painting)"

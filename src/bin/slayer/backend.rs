@@ -92,6 +92,30 @@ fn on_gpu(context: GpuContext, options: &GpuOptions, settings: PipelineSettings)
     }
 }
 
+/// As [`choose`], with the GPU backend's device for a window to share (the app's).
+pub fn choose_sharing(
+    backend: Backend,
+    settings: PipelineSettings,
+) -> anyhow::Result<(Chosen, Option<slayer::app::SharedDevice>)> {
+    let (context, options) = match backend {
+        Backend::Gpu => {
+            let options = gpu_options(true);
+            match GpuContext::open(&options) {
+                Ok(context) => (context, options),
+                // `gpu` says why it cannot.
+                Err(_) => return gpu(settings).map(|chosen| (chosen, None)),
+            }
+        }
+        Backend::Auto => match GpuContext::open(&gpu_options(false)) {
+            Ok(context) => (context, gpu_options(false)),
+            Err(_) => return choose(backend, settings).map(|chosen| (chosen, None)),
+        },
+        _ => return choose(backend, settings).map(|chosen| (chosen, None)),
+    };
+    let shared = slayer::app::SharedDevice::of(&context);
+    Ok((on_gpu(context, &options, settings), Some(shared)))
+}
+
 /// `cpu`, `gpu` or `auto`, saying what `auto` chose; `both` runs two pipelines, which only
 /// `slayer bench` does.
 pub fn choose(backend: Backend, settings: PipelineSettings) -> anyhow::Result<Chosen> {

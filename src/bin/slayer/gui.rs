@@ -43,7 +43,8 @@ pub fn run(args: Args<'_>) -> anyhow::Result<ExitCode> {
         }
         None => Vec::new(),
     };
-    let chosen = crate::backend::choose(args.backend, PipelineSettings::default())?;
+    let (chosen, shared) =
+        crate::backend::choose_sharing(args.backend, PipelineSettings::default())?;
     eprintln!(
         "slayer gui: {} faces, sculpting on {}",
         session.mesh().live_face_count(),
@@ -62,6 +63,12 @@ pub fn run(args: Args<'_>) -> anyhow::Result<ExitCode> {
         antialias: args.antialias,
     };
     let (width, height) = args.window;
-    slayer::app::run(setup, [width as f32, height as f32]).map_err(anyhow::Error::msg)?;
+    let sharing = if shared.is_some() {
+        "the window draws with the engine's GPU device"
+    } else {
+        "the window opens its own GPU device"
+    };
+    eprintln!("slayer gui: {sharing}");
+    slayer::app::run(setup, [width as f32, height as f32], shared).map_err(anyhow::Error::msg)?;
     Ok(ExitCode::SUCCESS)
 }
