@@ -274,7 +274,7 @@ fn the_default_and_a_sculpted_plaster_look_as_stored() {
     harness.state_mut().tools.phase_times = false;
     harness.step();
     let pixels = (SIZE[0] * SIZE[1]) as usize;
-    let options = SnapshotOptions::new().failed_pixel_count_threshold(pixels / 200);
+    let options = SnapshotOptions::new().max_failed_pixels(pixels / 200);
     harness.snapshot_options("gui_plaster", &options);
     let c = centre(&harness);
     drag(

@@ -555,7 +555,7 @@ fn render_host_structs_match_naga_layout() {
             normal,
             roughness,
             diffuse,
-            _pad0,
+            mask,
             specular,
             _pad1
         }
@@ -574,7 +574,11 @@ fn render_host_structs_match_naga_layout() {
             wireframe,
             false_colour,
             line_width,
-            _pad,
+            hidden_layers,
+            show_mask,
+            _pad0,
+            _pad1,
+            _pad2,
             palette
         }
     );

@@ -281,7 +281,7 @@ impl Worker {
     /// strokes run on the CPU, on the mesh as it is.
     fn fall_back_if_the_gpu_failed(&mut self) {
         if let Some(why) = self.pipeline.kernel_failure() {
-            self.pipeline = Pipeline::new(self.pipeline.settings().clone());
+            self.pipeline = Pipeline::new(*self.pipeline.settings());
             self.link.reply(Reply::Error(format!(
                 "the GPU failed ({why}); sculpting goes on on the CPU"
             )));

@@ -76,7 +76,9 @@ pub struct PreviewUniforms {
     /// Bit `l`: layer `l` (< 32) is not drawn.
     pub hidden_layers: u32,
     pub show_mask: u32,
-    pub _pad: [u32; 3],
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
     pub palette: [[f32; 4]; 8],
 }
 
@@ -253,7 +255,9 @@ pub(crate) fn uniforms(camera: &Camera, options: &RenderOptions) -> PreviewUnifo
         line_width: LINE_WIDTH,
         hidden_layers: 0,
         show_mask: 0,
-        _pad: [0; 3],
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
         palette: PALETTE.map(|[r, g, b]| [r, g, b, 1.0]),
     }
 }
