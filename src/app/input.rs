@@ -74,21 +74,51 @@ pub fn pointer(app: &mut SlayerApp, ui: &egui::Ui, rect: Rect, response: &egui::
     let arrived = Instant::now();
     for event in events {
         match event {
-            Event::Touch { force, .. } => app.pointer.pressure = force,
+            Event::Touch { force, phase, .. } => {
+                // A lifted pen's last force must not weigh on the next (mouse) stroke.
+                let lifted = matches!(phase, egui::TouchPhase::End | egui::TouchPhase::Cancel);
+                app.pointer.pressure = if lifted { None } else { force };
+            }
             Event::PointerButton {
                 pos,
                 button,
                 pressed,
                 modifiers,
-            } => button_event(app, rect, pos, button, pressed, modifiers, &mut points),
+            } => {
+                let on_viewport = response.hovered() || response.contains_pointer();
+                button_event(
+                    app,
+                    rect,
+                    on_viewport,
+                    pos,
+                    button,
+                    pressed,
+                    modifiers,
+                    &mut points,
+                );
+            }
             Event::PointerMoved(pos) => {
                 moved(app, rect, pos, &mut points);
                 app.pointer.last = Some(pos);
             }
-            Event::MouseWheel { delta, .. } if response.hovered() => {
+            // The release may never come: the stroke ends here.
+            Event::PointerGone | Event::WindowFocused(false) => {
+                if app.pointer.gesture == Gesture::Stroke {
+                    end_stroke(app, &mut points);
+                }
+                app.pointer.gesture = Gesture::None;
+                app.hover = None;
+            }
+            Event::MouseWheel { delta, unit, .. } if response.hovered() => {
+                let steps = match unit {
+                    egui::MouseWheelUnit::Point => delta.y / 50.0,
+                    egui::MouseWheelUnit::Line => delta.y,
+                    egui::MouseWheelUnit::Page => delta.y * 10.0,
+                };
                 if let Some(camera) = &mut app.camera {
-                    camera.zoom(delta.y.signum() * delta.y.abs().min(10.0));
+                    camera.zoom(steps.clamp(-10.0, 10.0));
                     app.pointer.moved_camera = true;
+                    app.hover = None;
                 }
             }
             _ => {}
@@ -103,19 +133,21 @@ pub fn pointer(app: &mut SlayerApp, ui: &egui::Ui, rect: Rect, response: &egui::
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn button_event(
     app: &mut SlayerApp,
     rect: Rect,
+    on_viewport: bool,
     pos: Pos2,
     button: PointerButton,
     pressed: bool,
     modifiers: Modifiers,
     points: &mut Vec<StrokePoint>,
 ) {
-    let inside = rect.contains(pos);
+    // A press over a window drawn above the viewport (help, open) is the window's.
+    let inside = rect.contains(pos) && on_viewport;
     match (button, pressed, app.pointer.gesture) {
-        (PointerButton::Primary, true, Gesture::Adjust { .. }) => {}
-        (PointerButton::Primary, true, _) if inside => {
+        (PointerButton::Primary, true, Gesture::None) if inside => {
             app.pointer.gesture = if app.hover.is_some() {
                 begin_stroke(app, modifiers, rect, pos, points)
             } else {
@@ -124,14 +156,7 @@ fn button_event(
         }
         (PointerButton::Primary, false, gesture) => {
             if gesture == Gesture::Stroke {
-                if !points.is_empty() {
-                    app.progress.sent += points.len();
-                    app.send(Command::Points {
-                        points: std::mem::take(points),
-                        sent: Instant::now(),
-                    });
-                }
-                app.send(Command::End);
+                end_stroke(app, points);
             }
             app.pointer.gesture = Gesture::None;
         }
@@ -160,6 +185,20 @@ fn button_event(
     }
 }
 
+/// Sends the stroke's last points and its end; the surface under the pointer is picked again
+/// when it next moves.
+fn end_stroke(app: &mut SlayerApp, points: &mut Vec<StrokePoint>) {
+    if !points.is_empty() {
+        app.progress.sent += points.len();
+        app.send(Command::Points {
+            points: std::mem::take(points),
+            sent: Instant::now(),
+        });
+    }
+    app.send(Command::End);
+    app.hover = None;
+}
+
 fn begin_stroke(
     app: &mut SlayerApp,
     modifiers: Modifiers,
@@ -169,7 +208,6 @@ fn begin_stroke(
 ) -> Gesture {
     match app.stroke_settings(modifiers) {
         Ok(settings) => {
-            app.progress = Default::default();
             app.send(Command::Begin(settings));
             if let Some(point) = ray_point(app, rect, pos) {
                 points.push(point);
@@ -194,12 +232,14 @@ fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoin
             if let Some(camera) = &mut app.camera {
                 camera.orbit(delta);
                 app.pointer.moved_camera = true;
+                app.hover = None;
             }
         }
         Gesture::Pan => {
             if let Some(camera) = &mut app.camera {
                 camera.pan(delta, rect.height(), rect.aspect_ratio());
                 app.pointer.moved_camera = true;
+                app.hover = None;
             }
         }
         Gesture::Adjust {
@@ -298,9 +338,11 @@ pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
             start,
         };
     };
-    if pressed((Modifiers::SHIFT, Key::F)) {
+    // Not while a drag is going on: its release must end what it began.
+    let free = app.pointer.gesture == Gesture::None;
+    if pressed((Modifiers::SHIFT, Key::F)) && free {
         adjust(true, app);
-    } else if pressed((Modifiers::NONE, Key::F)) {
+    } else if pressed((Modifiers::NONE, Key::F)) && free {
         adjust(false, app);
     }
     if pressed((Modifiers::NONE, Key::OpenBracket)) {

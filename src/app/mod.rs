@@ -94,7 +94,9 @@ pub struct Tools {
     pub phase_times: bool,
 }
 
-/// Samples sent and done in the current stroke, and the engine's last phase times.
+/// Stroke samples sent and done since the app started (running totals: a reply that comes
+/// after the next stroke began still counts where it belongs), and the engine's last phase
+/// times.
 #[derive(Debug, Clone, Default)]
 pub struct Progress {
     pub sent: usize,
@@ -128,6 +130,10 @@ pub struct SlayerApp {
     rename: Option<(u32, String)>,
     /// Where the viewport was drawn last frame, in points.
     viewport_rect: Option<egui::Rect>,
+    /// The engine thread's end, when it ended early.
+    engine_stopped: Option<String>,
+    /// A status came from the engine (the panels can be laid out).
+    status_received: bool,
     /// The mesh's box as of the last whole upload (`Some(None)`: an empty mesh).
     scene_bounds: Option<Option<(glam::Vec3, glam::Vec3)>>,
     started: Instant,
@@ -198,6 +204,8 @@ impl SlayerApp {
             rename: None,
             viewport_rect: None,
             scene_bounds: None,
+            engine_stopped: None,
+            status_received: false,
             started: Instant::now(),
         }
     }
@@ -239,9 +247,11 @@ impl SlayerApp {
         self.hover
     }
 
-    /// No stroke in progress and every sent sample done.
+    /// No stroke in progress and every sent sample done (or the engine gone: nothing more
+    /// will be).
     pub fn idle(&self) -> bool {
-        !self.pointer.stroking() && self.progress.done >= self.progress.sent
+        self.engine_stopped.is_some()
+            || (!self.pointer.stroking() && self.progress.done >= self.progress.sent)
     }
 
     /// The replay (if any) and what follows it are done.
@@ -264,13 +274,37 @@ impl SlayerApp {
         self.camera.as_ref()
     }
 
+    /// The engine thread ended (a panic): say why, once; the window stays for saving nothing
+    /// more, but does not spin.
+    fn engine_gone(&mut self) {
+        if self.engine_stopped.is_some() {
+            return;
+        }
+        let why = match self.worker.take().map(|h| h.join()) {
+            Some(Err(panic)) => panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "a panic".into()),
+            _ => "it stopped".into(),
+        };
+        let message = format!("the engine stopped ({why}); the last saved file is intact");
+        self.notify(message.clone());
+        self.engine_stopped = Some(message);
+    }
+
     pub(crate) fn notify(&mut self, message: String) {
         self.messages.push((message, Instant::now()));
     }
 
     /// Takes every reply that arrived.
     fn receive(&mut self) {
-        while let Ok(reply) = self.replies.try_recv() {
+        loop {
+            let reply = match self.replies.try_recv() {
+                Ok(reply) => reply,
+                Err(mpsc::TryRecvError::Empty) => return,
+                Err(mpsc::TryRecvError::Disconnected) => return self.engine_gone(),
+            };
             match reply {
                 Reply::Hover(hit) => self.hover = hit,
                 Reply::Mesh(update) => {
@@ -280,8 +314,10 @@ impl SlayerApp {
                             camera.set_bounds(bounds);
                         }
                     }
-                    if let Ok(viewport) = &mut self.viewport {
-                        viewport.apply(&update);
+                    if let Ok(viewport) = &mut self.viewport
+                        && let Err(why) = viewport.apply(&update)
+                    {
+                        self.notify(why);
                     }
                 }
                 Reply::Progress {
@@ -293,10 +329,16 @@ impl SlayerApp {
                     self.progress.phases = phases;
                     self.metrics.effect_arrived(sent);
                 }
-                Reply::Status(status) => self.status = status,
+                Reply::Status(status) => {
+                    self.status = status;
+                    self.status_received = true;
+                }
                 Reply::StrokeDone(report) => self.last_stroke = Some(*report),
                 Reply::Saved(path) => self.notify(format!("saved {}", path.display())),
                 Reply::Opened(path) => {
+                    // Framed again when the new mesh's box arrives (it follows).
+                    self.camera = None;
+                    self.scene_bounds = None;
                     self.save_path = crate::app::save_path_for(&path);
                     self.notify(format!("opened {}", path.display()));
                 }
@@ -355,7 +397,7 @@ impl eframe::App for SlayerApp {
         input::keys(self, ui.ctx());
         panels::status_bar(self, ui);
         // The panels' ranges come from the mesh: they wait for the engine's first report.
-        if self.status.faces > 0 {
+        if self.status_received {
             panels::tools_panel(self, ui);
             panels::document_panel(self, ui);
         }
@@ -391,7 +433,7 @@ impl SlayerApp {
         // Framed once the panels are laid out (they wait for the status): the viewport's shape
         // is then final.
         if self.camera.is_none()
-            && self.status.faces > 0
+            && self.status_received
             && let Some(bounds) = self.scene_bounds
         {
             self.camera = Some(OrbitCamera::framing(bounds, self.aspect()));

@@ -27,8 +27,8 @@ pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
             let progress = &app.progress;
             if app.pointer.stroking() || progress.done < progress.sent {
                 ui.label(format!(
-                    "stroke: {} of {} samples done",
-                    progress.done, progress.sent
+                    "stroking: {} samples queued",
+                    progress.sent - progress.done.min(progress.sent)
                 ));
                 ui.add(egui::Spinner::new());
             } else {
@@ -54,6 +54,10 @@ pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
                         stroke.clamped
                     ));
                 }
+            }
+            if let Some(why) = &app.engine_stopped {
+                ui.separator();
+                ui.label(RichText::new(why).color(Color32::from_rgb(255, 110, 90)));
             }
             app.messages
                 .retain(|(_, at)| at.elapsed() < Duration::from_secs(MESSAGE_SECONDS));
@@ -326,7 +330,6 @@ pub fn overlays(app: &mut SlayerApp, ctx: &egui::Context) {
     }
     if let Some(path) = open {
         app.send(Command::Open(path.into()));
-        app.camera = None;
     }
 }
 

@@ -197,12 +197,18 @@ fn fit(cluster: &mut Cluster, order: &[u32], mesh: &Mesh) {
 
 /// Where a ray enters the box (0 when it starts inside), or `None` when it misses it.
 fn slab_entry(origin: Vec3, inverse: Vec3, lo: Vec3, hi: Vec3) -> Option<f32> {
-    let t0 = (lo - origin) * inverse;
-    let t1 = (hi - origin) * inverse;
-    // NaN (a zero direction component on the box's plane) must not hide the box: min/max of
-    // glam ignore it the way the slab test needs.
-    let near = t0.min(t1).max_element().max(0.0);
-    let far = t0.max(t1).min_element();
+    let (mut near, mut far) = (0.0f32, f32::INFINITY);
+    for axis in 0..3 {
+        let t0 = (lo[axis] - origin[axis]) * inverse[axis];
+        let t1 = (hi[axis] - origin[axis]) * inverse[axis];
+        // A ray parallel to this slab's planes (an infinite inverse) lying on one of them
+        // gives 0 × ∞ = NaN: it is inside the slab along this axis, which constrains nothing.
+        if t0.is_nan() || t1.is_nan() {
+            continue;
+        }
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
     (near <= far).then_some(near)
 }
 
@@ -302,6 +308,17 @@ mod tests {
             hits += got.is_some() as usize;
         }
         assert!(hits > 100, "only {hits} of 400 rays met the sheet");
+    }
+
+    #[test]
+    fn a_ray_along_a_box_face_still_enters_the_box() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
+        // Straight down, on the plane x = 0 of the box.
+        let origin = Vec3::new(0.0, 0.5, 2.0);
+        let entry = slab_entry(origin, Vec3::NEG_Z.recip(), lo, hi);
+        assert_eq!(entry, Some(1.0));
+        let beside = slab_entry(Vec3::new(-0.1, 0.5, 2.0), Vec3::NEG_Z.recip(), lo, hi);
+        assert_eq!(beside, None);
     }
 
     #[test]

@@ -102,7 +102,6 @@ fn advance(app: &mut SlayerApp, ctx: &egui::Context, replay: &mut Replay) -> Pha
         Phase::Strokes { stroke, sample } => match replay.strokes.get(stroke) {
             Some(current) => {
                 if sample == 0 {
-                    app.progress = Default::default();
                     app.send(Command::Begin(current.settings()));
                 }
                 let (start, fed) = *replay.clock.get_or_insert((Instant::now(), 0));

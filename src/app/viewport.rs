@@ -90,12 +90,28 @@ impl Viewport {
     }
 
     /// Writes what the engine changed into the buffers, growing them (contents kept) when
-    /// the mesh grew.
-    pub fn apply(&mut self, update: &MeshUpdate) {
+    /// the mesh grew. A mesh too large for one storage binding of this adapter is refused with
+    /// the reason (the viewport then draws nothing; the engine is unaffected).
+    pub fn apply(&mut self, update: &MeshUpdate) -> Result<(), String> {
         let row = std::mem::size_of::<RenderVertex>() as u64;
         let corner = 12u64;
-        let vertices_grown = self.grow(Grown::Vertices, update.vertex_count as u64 * row);
-        let corners_grown = self.grow(Grown::Corners, update.face_count as u64 * corner);
+        let (vertex_bytes, corner_bytes) = (
+            update.vertex_count as u64 * row,
+            update.face_count as u64 * corner,
+        );
+        let limit = self.binding_limit();
+        if vertex_bytes.max(corner_bytes) > limit {
+            self.corner_count = 0;
+            self.dirty = true;
+            return Err(format!(
+                "the viewport cannot draw {} vertices: {} MiB of vertex rows, over this adapter's storage binding limit of {} MiB",
+                update.vertex_count,
+                vertex_bytes.max(corner_bytes) >> 20,
+                limit >> 20
+            ));
+        }
+        let vertices_grown = self.grow(Grown::Vertices, vertex_bytes);
+        let corners_grown = self.grow(Grown::Corners, corner_bytes);
         if vertices_grown || corners_grown {
             self.bind_group = bind(
                 &self.device,
@@ -118,6 +134,13 @@ impl Viewport {
         }
         self.corner_count = update.face_count * 3;
         self.dirty = true;
+        Ok(())
+    }
+
+    /// The largest buffer one binding may hold on this device.
+    fn binding_limit(&self) -> u64 {
+        let limits = self.device.limits();
+        limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
     }
 
     /// Replaces a buffer by one with room for `bytes`, copying what it held; whether it did.
@@ -133,7 +156,7 @@ impl Viewport {
             Grown::Vertices => "viewport vertices",
             Grown::Corners => "viewport corners",
         };
-        let new = storage(&self.device, label, grown(bytes));
+        let new = storage(&self.device, label, grown(bytes).min(self.binding_limit()));
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });

@@ -88,7 +88,8 @@ pub enum Reply {
     StrokeDone(Box<StrokeReport>),
     Saved(PathBuf),
     Opened(PathBuf),
-    /// A refused command or a failed stroke: the mesh is as the last good step left it.
+    /// A refused command, or a stroke that stopped: the mesh keeps what the stroke did before
+    /// the failed call (that call changes nothing), remeshed as any stroke's end.
     Error(String),
 }
 
@@ -229,18 +230,28 @@ impl Worker {
             mirror,
             link,
         } = self;
+        if let Some(why) = refusal(&settings, session.mesh()) {
+            return self.refuse_stroke(why);
+        }
         let mut edit = session.edit(&label);
-        // A refused stroke still reads its points up to its end, running none.
+        // A stroke the pipeline refuses still reads its points up to its end, running none.
         let (mut stroke, mut failure) = match pipeline.begin_stroke(edit.mesh(), settings) {
             Ok(stroke) => (Some(stroke), None),
             Err(e) => (None, Some(format!("stroke refused: {e}"))),
         };
         let mut projector = Projector::default();
         let mut deferred = Vec::new();
+        let mut next_begin = None;
         loop {
             let points = match link.next() {
                 Some(Command::Points { points, sent }) => link.take_queued_points(points, sent),
                 Some(Command::End) | None => break,
+                // A new stroke without this one's end (a release the window never saw):
+                // this one ends here.
+                Some(begin @ Command::Begin(_)) => {
+                    next_begin = Some(begin);
+                    break;
+                }
                 Some(Command::Hover(_)) => continue,
                 Some(other) => {
                     // Undo, saving and the like wait for the stroke to end.
@@ -272,9 +283,38 @@ impl Worker {
         if let Some(why) = failure {
             link.reply(Reply::Error(why));
         }
+        // What waited for the stroke's end, then the next stroke.
         link.pending.extend(deferred);
+        link.pending.extend(next_begin);
         self.fall_back_if_the_gpu_failed();
         self.after_edit(true);
+    }
+
+    /// A stroke refused before it began: it changes nothing, not even the history (whose
+    /// undone entries stay redoable); its points are read up to its end and reported done.
+    fn refuse_stroke(&mut self, why: String) {
+        let mut deferred = Vec::new();
+        let mut next_begin = None;
+        loop {
+            match self.link.next() {
+                Some(Command::Points { points, sent }) => self.link.reply(Reply::Progress {
+                    points: points.len(),
+                    phases: PhaseTimes::default(),
+                    sent,
+                }),
+                Some(Command::End) | None => break,
+                Some(begin @ Command::Begin(_)) => {
+                    next_begin = Some(begin);
+                    break;
+                }
+                Some(Command::Hover(_)) => {}
+                Some(other) => deferred.push(other),
+            }
+        }
+        self.link.reply(Reply::Error(why));
+        self.link.pending.extend(deferred);
+        self.link.pending.extend(next_begin);
+        self.send_status();
     }
 
     /// A GPU that failed (lost device, out of memory) leaves its pipeline unusable: the next
@@ -383,6 +423,26 @@ impl Link {
         }
         all
     }
+}
+
+/// Why a stroke cannot begin on `mesh`, if it cannot: a layer that does not exist, a brush
+/// out of bounds.
+fn refusal(settings: &StrokeSettings, mesh: &Mesh) -> Option<String> {
+    if let Some(layer) = settings
+        .layers
+        .iter()
+        .find(|&&l| l as usize >= mesh.layer_count())
+    {
+        return Some(format!(
+            "stroke refused: layer {layer} does not exist (the mesh has {})",
+            mesh.layer_count()
+        ));
+    }
+    let extent = mesh.bounds().map_or(0.0, |(lo, hi)| (hi - lo).length());
+    settings
+        .check(extent)
+        .err()
+        .map(|why| format!("stroke refused: {why}"))
 }
 
 /// A stroke's points that arrived together.
