@@ -395,3 +395,53 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_paint_brush_lays_down_the_panels_material_through_its_stencil() {
+    let mut harness = app(plaster());
+    let rust = slayer::material::preset("rust").unwrap().brdf;
+    let metal = slayer::material::preset("bare-metal").unwrap().brdf;
+    {
+        let tools = &mut harness.state_mut().tools;
+        tools.brush.kind = slayer::brush::BrushKind::Paint;
+        tools.brush.strength = 1.0;
+        tools.material = rust;
+        tools.stencil = Some(slayer::app::StencilChoice {
+            pattern: slayer::brush::Pattern::Checker,
+            second: "bare-metal",
+            tile: 0.05,
+        });
+    }
+    let before = digest(&harness);
+    let (old, _) = positions(&harness);
+    let c = centre(&harness);
+    drag(
+        &mut harness,
+        c - egui::vec2(60.0, 0.0),
+        c + egui::vec2(60.0, 0.0),
+        Modifiers::NONE,
+    );
+    assert_ne!(digest(&harness), before);
+    let (new, _) = positions(&harness);
+    assert_eq!(old, new, "painting moves nothing");
+    let (near_rust, near_metal) = harness
+        .state()
+        .query(move |s| {
+            let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 0.02);
+            let brdfs = s.mesh().brdfs();
+            let rusty = brdfs
+                .iter()
+                .filter(|b| close(b.diffuse, rust.diffuse))
+                .count();
+            let metallic = brdfs
+                .iter()
+                .filter(|b| close(b.diffuse, metal.diffuse))
+                .count();
+            (rusty, metallic)
+        })
+        .unwrap();
+    assert!(
+        near_rust > 20 && near_metal > 20,
+        "rust {near_rust}, bare metal {near_metal}"
+    );
+}

@@ -85,6 +85,8 @@ pub struct Tools {
     pub material: Brdf,
     pub material_name: String,
     pub opacity: f32,
+    /// Lay the material down through a generated pattern of it and a second preset.
+    pub stencil: Option<StencilChoice>,
     /// Mirror strokes across the plane x = the scene's centre.
     pub symmetry_x: bool,
     pub remesh: bool,
@@ -92,6 +94,15 @@ pub struct Tools {
     /// The engine's phase times in the status bar (off for pictures that must not change
     /// from run to run).
     pub phase_times: bool,
+}
+
+/// A generated stencil: `pattern` of the brush's material and `second`, repeating every
+/// `tile` world units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StencilChoice {
+    pub pattern: crate::brush::Pattern,
+    pub second: &'static str,
+    pub tile: f32,
 }
 
 /// Stroke samples sent and done since the app started (running totals: a reply that comes
@@ -185,9 +196,13 @@ impl SlayerApp {
                 material: preset.brdf,
                 material_name: preset.name.into(),
                 opacity: 1.0,
+                stencil: None,
                 symmetry_x: false,
                 remesh: true,
-                view: ViewOptions::default(),
+                view: ViewOptions {
+                    show_mask: true,
+                    ..ViewOptions::default()
+                },
                 phase_times: true,
             },
             pointer: PointerState::default(),
@@ -359,8 +374,18 @@ impl SlayerApp {
         }
         let paints =
             kind == BrushKind::Paint || (tools.paint_while_sculpting && kind != BrushKind::Mask);
+        let stencil = tools.stencil.map(|choice| {
+            let second = crate::material::preset(choice.second).map_or(Brdf::CLAY, |m| m.brdf);
+            Arc::new(crate::brush::Stencil::pattern(
+                choice.pattern,
+                tools.material,
+                second,
+                choice.tile,
+            ))
+        });
         let paint = paints.then(|| crate::brush::Paint {
             opacity: tools.opacity,
+            stencil,
             ..crate::brush::Paint::material(tools.material)
         });
         let layers: Vec<u32> = (0..self.status.layers.len() as u32)

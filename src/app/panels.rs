@@ -6,9 +6,9 @@ use std::time::Duration;
 use eframe::egui::{self, Color32, Painter, Rect, RichText, Stroke as Line, Ui};
 use glam::Vec3;
 
-use super::SlayerApp;
 use super::worker::Command;
-use crate::brush::{BrushKind, Falloff};
+use super::{SlayerApp, StencilChoice};
+use crate::brush::{BrushKind, Falloff, Pattern};
 use crate::material::{PRESETS, linear_to_srgb, srgb_to_linear};
 use crate::mesh::Brdf;
 
@@ -153,7 +153,46 @@ fn material_section(app: &mut SlayerApp, ui: &mut Ui) {
         tools.material_name = "custom".into();
     }
     ui.add(egui::Slider::new(&mut tools.opacity, 0.0..=1.0).text("opacity"));
+    stencil_editor(ui, &mut tools.stencil, app.status.edge_length);
     ui.checkbox(&mut tools.paint_while_sculpting, "paint while sculpting");
+}
+
+/// No stencil, or a pattern of the material and a second preset, and its tile size.
+fn stencil_editor(ui: &mut Ui, stencil: &mut Option<StencilChoice>, edge: f32) {
+    let name = stencil.map_or("none", |s| s.pattern.name());
+    egui::ComboBox::from_label("stencil")
+        .selected_text(name)
+        .show_ui(ui, |ui| {
+            if ui.selectable_label(stencil.is_none(), "none").clicked() {
+                *stencil = None;
+            }
+            for pattern in Pattern::ALL {
+                let chosen = stencil.is_some_and(|s| s.pattern == pattern);
+                if ui.selectable_label(chosen, pattern.name()).clicked() {
+                    *stencil = Some(StencilChoice {
+                        pattern,
+                        second: stencil.map_or("bare-metal", |s| s.second),
+                        tile: stencil.map_or(8.0 * edge.max(1e-6), |s| s.tile),
+                    });
+                }
+            }
+        });
+    let Some(choice) = stencil else {
+        return;
+    };
+    egui::ComboBox::from_label("with")
+        .selected_text(choice.second)
+        .show_ui(ui, |ui| {
+            for preset in PRESETS {
+                ui.selectable_value(&mut choice.second, preset.name, preset.name);
+            }
+        });
+    let edge = edge.max(1e-6);
+    ui.add(
+        egui::Slider::new(&mut choice.tile, edge..=200.0 * edge)
+            .logarithmic(true)
+            .text("tile"),
+    );
 }
 
 /// Diffuse colour (shown in sRGB, kept linear), grey specular and roughness.
@@ -211,12 +250,26 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
             ui.checkbox(&mut changed.active, "")
                 .on_hover_text("active: brushed by strokes");
             let [r, g, b] = settings.material.diffuse.map(linear_to_srgb);
-            let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+            let (rect, swatch) =
+                ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::click());
             ui.painter().rect_filled(
                 rect,
                 2.0,
                 Color32::from_rgb((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8),
             );
+            let swatch = swatch.on_hover_text(
+                "the layer's material: click to paint with it, right click to set it",
+            );
+            swatch.context_menu(|ui| {
+                if ui.button("set to the brush's material").clicked() {
+                    changed.material = app.tools.material;
+                    ui.close();
+                }
+            });
+            if swatch.clicked() {
+                app.tools.material = settings.material;
+                app.tools.material_name = format!("{name}'s");
+            }
             match &mut app.rename {
                 Some((editing, text)) if *editing == l => {
                     let response = ui.text_edit_singleline(text);

@@ -140,7 +140,9 @@ impl Viewport {
     /// The largest buffer one binding may hold on this device.
     fn binding_limit(&self) -> u64 {
         let limits = self.device.limits();
-        limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
+        limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
     }
 
     /// Replaces a buffer by one with room for `bytes`, copying what it held; whether it did.
