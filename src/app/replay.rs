@@ -212,8 +212,10 @@ pub struct Metrics {
     /// The oldest pointer event whose effect arrived this frame.
     arrived: Option<Instant>,
     uploads: Vec<u64>,
-    /// The longest time one frame's code ran on the UI thread, ms.
+    /// The longest time one frame's code ran on the UI thread, ms, and the bytes that frame
+    /// uploaded (what made it long, when it was the uploads).
     longest_frame_work: f64,
+    longest_frame_uploaded: u64,
     last_frame: Option<Instant>,
 }
 
@@ -228,6 +230,7 @@ struct Summary {
     latency_samples: usize,
     bytes_uploaded_per_stroking_frame: f64,
     longest_frame_work_ms: f64,
+    longest_frame_bytes_uploaded: u64,
     peak_memory_mib: Option<f64>,
     seconds: f64,
 }
@@ -290,6 +293,7 @@ impl Metrics {
             latency_samples: latencies.len(),
             bytes_uploaded_per_stroking_frame: mean(&uploads),
             longest_frame_work_ms: self.longest_frame_work,
+            longest_frame_bytes_uploaded: self.longest_frame_uploaded,
             peak_memory_mib: peak_memory_mib(),
             seconds: started.elapsed().as_secs_f64(),
         }
