@@ -9,25 +9,13 @@
 
 use glam::Vec3;
 
+pub use crate::geom::Ray;
+use crate::geom::ray_triangle;
 use crate::mesh::{INVALID, Mesh};
 
 /// Faces per cluster: small enough that a ray tests few faces, large enough that the box test
 /// over all clusters stays cheap.
 const CLUSTER_FACES: usize = 64;
-
-/// A ray from the eye.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ray {
-    pub origin: Vec3,
-    /// Unit length.
-    pub direction: Vec3,
-}
-
-impl Ray {
-    pub fn at(&self, distance: f32) -> Vec3 {
-        self.origin + self.direction * distance
-    }
-}
 
 /// Where a ray met the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -210,29 +198,6 @@ fn slab_entry(origin: Vec3, inverse: Vec3, lo: Vec3, hi: Vec3) -> Option<f32> {
         far = far.min(t0.max(t1));
     }
     (near <= far).then_some(near)
-}
-
-/// Möller–Trumbore, both sides: the distance along the ray, if it meets the triangle.
-fn ray_triangle(ray: &Ray, a: Vec3, b: Vec3, c: Vec3) -> Option<f32> {
-    let (ab, ac) = (b - a, c - a);
-    let p = ray.direction.cross(ac);
-    let det = ab.dot(p);
-    if det.abs() < 1e-20 {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = ray.origin - a;
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(ab);
-    let v = ray.direction.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = ac.dot(q) * inv;
-    (t >= 0.0).then_some(t)
 }
 
 /// Interleaves the bits of three 10-bit coordinates.

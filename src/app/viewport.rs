@@ -10,7 +10,7 @@ use super::upload::MeshUpdate;
 use crate::gpu::GpuError;
 use crate::render::{
     COLOUR_FORMAT, Camera, DEPTH_FORMAT, MSAA_SAMPLES, PreviewUniforms, RenderOptions,
-    RenderVertex, preview_pipeline, preview_uniforms,
+    RenderVertex, preview_bind_group, preview_pipeline, preview_uniforms,
 };
 
 /// What the user toggles in the view.
@@ -344,22 +344,6 @@ fn bind(
     vertices: &wgpu::Buffer,
     corners: &wgpu::Buffer,
 ) -> wgpu::BindGroup {
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("viewport"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: vertices.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: corners.as_entire_binding(),
-            },
-        ],
-    })
+    let layout = pipeline.get_bind_group_layout(0);
+    preview_bind_group(device, &layout, uniform, vertices, corners)
 }

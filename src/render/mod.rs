@@ -16,6 +16,6 @@ pub use preview::{
     Rendered, render,
 };
 pub(crate) use preview::{
-    COLOUR_FORMAT, DEPTH_FORMAT, MSAA_SAMPLES, pipeline as preview_pipeline, render_vertex,
-    uniforms as preview_uniforms,
+    COLOUR_FORMAT, DEPTH_FORMAT, MSAA_SAMPLES, bind_group as preview_bind_group,
+    pipeline as preview_pipeline, render_vertex, uniforms as preview_uniforms,
 };

@@ -423,6 +423,30 @@ fn chunk_limits(gpu: &GpuContext, options: &RenderOptions) -> (usize, usize) {
     (max_vertices, (binding_limit / 12) as usize)
 }
 
+/// The shader's bindings: the uniforms, the vertex rows and the corners (three vertex numbers
+/// per face).
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    uniform: &wgpu::Buffer,
+    vertices: &wgpu::Buffer,
+    corners: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = [uniform, vertices, corners]
+        .into_iter()
+        .enumerate()
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("preview"),
+        layout,
+        entries: &entries,
+    })
+}
+
 /// One bind group per chunk (the uniforms, its vertices and corners), with its corner count.
 fn bind_chunks(
     gpu: &GpuContext,
@@ -436,24 +460,7 @@ fn bind_chunks(
         .map(|chunk| {
             let vertices = gpu.storage_buffer("preview vertices", &chunk.vertices, false);
             let corners = gpu.storage_buffer("preview corners", &chunk.corners, false);
-            let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: vertices.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: corners.as_entire_binding(),
-                    },
-                ],
-            });
+            let group = bind_group(&gpu.device, &layout, uniform, &vertices, &corners);
             (group, chunk.corners.len() as u32)
         })
         .collect()
