@@ -245,8 +245,10 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
         let l = l as u32;
         ui.horizontal(|ui| {
             let mut changed = *settings;
-            ui.checkbox(&mut changed.visible, "")
-                .on_hover_text("visible");
+            // The viewport's visibility mask has 32 bits.
+            ui.add_enabled(l < 32, egui::Checkbox::without_text(&mut changed.visible))
+                .on_hover_text("visible")
+                .on_disabled_hover_text("only the first 32 layers can be hidden");
             ui.checkbox(&mut changed.active, "")
                 .on_hover_text("active: brushed by strokes");
             let [r, g, b] = settings.material.diffuse.map(linear_to_srgb);
@@ -293,6 +295,9 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
                 .on_hover_text("contact stops motion: this layer never crosses another");
             if changed != *settings {
                 app.send(Command::SetLayer(l, changed));
+                // Shown at once, and the next change builds on it (the engine's status
+                // confirms it; a stroke in progress delays that).
+                app.status.layers[l as usize].1 = changed;
             }
         });
     }
