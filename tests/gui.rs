@@ -445,3 +445,47 @@ fn the_paint_brush_lays_down_the_panels_material_through_its_stencil() {
         "rust {near_rust}, bare metal {near_metal}"
     );
 }
+
+/// Asks the window to close, as its close button does.
+fn request_close(harness: &mut Harness<'_, SlayerApp>) {
+    let root = harness
+        .input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default();
+    root.events.push(egui::ViewportEvent::Close);
+    harness.step();
+    // The question's window is laid out, then its widgets are in the tree.
+    harness.step();
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_and_save_and_quit_saves() {
+    use egui_kittest::kittest::Queryable;
+    let mut harness = app(plaster());
+    request_close(&mut harness);
+    assert!(!harness.state().asking_to_save(), "nothing to save yet");
+
+    let c = centre(&harness);
+    drag(
+        &mut harness,
+        c - egui::vec2(50.0, 0.0),
+        c + egui::vec2(50.0, 0.0),
+        Modifiers::NONE,
+    );
+    assert!(!harness.state().may_close());
+    request_close(&mut harness);
+    assert!(harness.state().asking_to_save());
+    harness.get_by_label("Cancel").click();
+    harness.step();
+    assert!(!harness.state().asking_to_save() && !harness.state().may_close());
+
+    request_close(&mut harness);
+    harness.get_by_label("Save and quit").click();
+    settle(&mut harness, "the session is saved", |app| app.may_close());
+    let saved = std::env::temp_dir().join(format!("slayer-gui-test-{}.slayer", std::process::id()));
+    let session = slayer::session::open(&saved).expect("the session was written");
+    assert_eq!(session.mesh().digest(), digest(&harness));
+    assert_eq!(session.history().entries().len(), 1, "with its history");
+    std::fs::remove_file(saved).ok();
+}

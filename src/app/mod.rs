@@ -141,6 +141,10 @@ pub struct SlayerApp {
     rename: Option<(u32, String)>,
     /// Where the viewport was drawn last frame, in points.
     viewport_rect: Option<egui::Rect>,
+    /// The window may close without asking (the user chose, or the replay closes it).
+    close_confirmed: bool,
+    /// The unsaved-changes question is shown; `Some(true)`: quit once the save is done.
+    closing: Option<bool>,
     /// The engine thread's end, when it ended early.
     engine_stopped: Option<String>,
     /// A status came from the engine (the panels can be laid out).
@@ -218,6 +222,8 @@ impl SlayerApp {
             open_path: None,
             rename: None,
             viewport_rect: None,
+            close_confirmed: false,
+            closing: None,
             scene_bounds: None,
             engine_stopped: None,
             status_received: false,
@@ -274,6 +280,16 @@ impl SlayerApp {
         self.replay.as_ref().is_none_or(|r| r.finished())
     }
 
+    /// The unsaved-changes question is on screen (a close was held back).
+    pub fn asking_to_save(&self) -> bool {
+        self.closing == Some(false)
+    }
+
+    /// The window may close now without asking.
+    pub fn may_close(&self) -> bool {
+        self.close_confirmed || !self.status.unsaved
+    }
+
     /// Where the viewport was drawn last frame, in points.
     pub fn viewport_rect(&self) -> Option<egui::Rect> {
         self.viewport_rect
@@ -287,6 +303,54 @@ impl SlayerApp {
 
     pub fn camera(&self) -> Option<&OrbitCamera> {
         self.camera.as_ref()
+    }
+
+    /// A close with unsaved changes is held until the user says save, discard or cancel.
+    fn ask_before_closing(&mut self, ctx: &egui::Context) {
+        let requested = ctx.input(|i| i.viewport().close_requested());
+        if requested
+            && self.status.unsaved
+            && !self.close_confirmed
+            && self.engine_stopped.is_none()
+        {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.closing.get_or_insert(false);
+        }
+        if self.closing != Some(false) {
+            return;
+        }
+        let mut choice = None;
+        egui::Modal::new(egui::Id::unique("unsaved")).show(ctx, |ui| {
+            ui.heading("Unsaved changes");
+            ui.label(format!(
+                "Save the session to {} before quitting?",
+                self.save_path.display()
+            ));
+            ui.horizontal(|ui| {
+                if ui.button("Save and quit").clicked() {
+                    choice = Some("save");
+                }
+                if ui.button("Quit without saving").clicked() {
+                    choice = Some("discard");
+                }
+                if ui.button("Cancel").clicked() {
+                    choice = Some("cancel");
+                }
+            });
+        });
+        match choice {
+            Some("save") => {
+                self.closing = Some(true);
+                self.send(Command::Save(self.save_path.clone()));
+            }
+            Some("discard") => {
+                self.close_confirmed = true;
+                self.closing = None;
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            Some(_) => self.closing = None,
+            None => {}
+        }
     }
 
     /// The engine thread ended (a panic): say why, once; the window stays for saving nothing
@@ -313,7 +377,7 @@ impl SlayerApp {
     }
 
     /// Takes every reply that arrived.
-    fn receive(&mut self) {
+    fn receive(&mut self, ctx: &egui::Context) {
         loop {
             let reply = match self.replies.try_recv() {
                 Ok(reply) => reply,
@@ -349,7 +413,14 @@ impl SlayerApp {
                     self.status_received = true;
                 }
                 Reply::StrokeDone(report) => self.last_stroke = Some(*report),
-                Reply::Saved(path) => self.notify(format!("saved {}", path.display())),
+                Reply::Saved(path) => {
+                    self.notify(format!("saved {}", path.display()));
+                    if self.closing == Some(true) {
+                        self.close_confirmed = true;
+                        self.closing = None;
+                        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                    }
+                }
                 Reply::Opened(path) => {
                     // Framed again when the new mesh's box arrives (it follows).
                     self.camera = None;
@@ -418,7 +489,8 @@ impl SlayerApp {
 impl eframe::App for SlayerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let frame_start = Instant::now();
-        self.receive();
+        self.receive(ui.ctx());
+        self.ask_before_closing(ui.ctx());
         input::keys(self, ui.ctx());
         panels::status_bar(self, ui);
         // The panels' ranges come from the mesh: they wait for the engine's first report.

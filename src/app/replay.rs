@@ -161,15 +161,15 @@ fn advance(app: &mut SlayerApp, ctx: &egui::Context, replay: &mut Replay) -> Pha
             app.pointer.orbiting_by_replay = false;
             match &replay.plan.screenshot {
                 Some(path) => Phase::Screenshot(request_screenshot(ctx, path.clone())),
-                None => close(ctx),
+                None => close(app, ctx),
             }
         }
         Phase::Waiting(left) => Phase::Waiting(left - 1),
         Phase::Screenshot(wait) => match wait.try_recv() {
-            Ok(Ok(())) => close(ctx),
+            Ok(Ok(())) => close(app, ctx),
             Ok(Err(why)) => {
                 eprintln!("slayer gui: {why}");
-                close(ctx)
+                close(app, ctx)
             }
             Err(_) => Phase::Screenshot(wait),
         },
@@ -177,7 +177,9 @@ fn advance(app: &mut SlayerApp, ctx: &egui::Context, replay: &mut Replay) -> Pha
     }
 }
 
-fn close(ctx: &egui::Context) -> Phase {
+/// Quits without asking: the replay's session was saved (`--save`) or is not wanted.
+fn close(app: &mut SlayerApp, ctx: &egui::Context) -> Phase {
+    app.close_confirmed = true;
     ctx.send_viewport_cmd(egui::ViewportCommand::Close);
     Phase::Done
 }

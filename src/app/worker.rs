@@ -72,6 +72,8 @@ pub struct Status {
     pub extent: f32,
     pub centre: Vec3,
     pub backend: String,
+    /// Something changed since the session was opened or last saved.
+    pub unsaved: bool,
 }
 
 pub enum Reply {
@@ -96,6 +98,9 @@ pub enum Reply {
 /// The engine thread's state.
 pub struct Worker {
     session: Session,
+    /// Edits so far, and how many there were at the last save (or open).
+    revision: u64,
+    saved_revision: u64,
     pipeline: Pipeline,
     picker: Picker,
     /// What the viewport holds.
@@ -114,6 +119,8 @@ impl Worker {
         Worker {
             picker: Picker::default(),
             mirror: Mirror::default(),
+            revision: 0,
+            saved_revision: 0,
             session,
             pipeline,
             link: Link {
@@ -171,7 +178,13 @@ impl Worker {
                 self.after_edit(true);
             }
             Command::Save(path) => match crate::session::save(&self.session, &path, true) {
-                Ok(()) => self.link.reply(Reply::Saved(path)),
+                Ok(()) => {
+                    // A mesh file (not `.slayer`) keeps the mesh, not the document: still
+                    // counts as saved, as the user chose that file.
+                    self.saved_revision = self.revision;
+                    self.link.reply(Reply::Saved(path));
+                    self.send_status();
+                }
                 Err(e) => self
                     .link
                     .reply(Reply::Error(format!("{}: {e}", path.display()))),
@@ -190,6 +203,8 @@ impl Worker {
         match crate::session::open_with(&path, &Default::default()) {
             Ok((session, report)) => {
                 self.session = session;
+                // The file as opened is saved: `after_edit` counts the change of document.
+                self.saved_revision = self.revision + 1;
                 for line in report.lines() {
                     self.link
                         .reply(Reply::Error(format!("{}: {line}", path.display())));
@@ -205,6 +220,7 @@ impl Worker {
 
     fn after_edit(&mut self, changed: bool) {
         if changed {
+            self.revision += 1;
             self.rebuild_picker();
             self.send_changes();
         }
@@ -212,8 +228,9 @@ impl Worker {
     }
 
     fn after_refusable(&mut self, result: Result<(), String>) {
-        if let Err(why) = result {
-            self.link.reply(Reply::Error(why));
+        match result {
+            Ok(()) => self.revision += 1,
+            Err(why) => self.link.reply(Reply::Error(why)),
         }
         self.send_status();
     }
@@ -229,6 +246,7 @@ impl Worker {
             picker,
             mirror,
             link,
+            ..
         } = self;
         if let Some(why) = refusal(&settings, session.mesh()) {
             return self.refuse_stroke(why);
@@ -361,6 +379,7 @@ impl Worker {
             extent: (bounds.1 - bounds.0).length(),
             centre: 0.5 * (bounds.0 + bounds.1),
             backend: self.pipeline.name(),
+            unsaved: self.revision != self.saved_revision,
         };
         self.link.reply(Reply::Status(status));
     }
