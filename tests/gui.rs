@@ -351,6 +351,8 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             .args(["--save", &format!("gui-{backend}.slayer")])
             .args(["--screenshot", &format!("shot-{backend}.png")])
             .args(["--window", "900x600", "--backend", backend])
+            // On lavapipe the window would otherwise open its own device.
+            .args(["--device", "shared"])
             .current_dir(&dir)
             .output()
             .unwrap();

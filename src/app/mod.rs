@@ -46,6 +46,8 @@ use viewport::Viewport;
 /// viewport's buffers live beside the backend's.
 #[derive(Clone)]
 pub struct SharedDevice {
+    /// A software rasterizer (lavapipe): one queue for the engine and the window.
+    pub software: bool,
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
@@ -55,6 +57,7 @@ pub struct SharedDevice {
 impl SharedDevice {
     pub fn of(gpu: &crate::gpu::GpuContext) -> SharedDevice {
         SharedDevice {
+            software: gpu.adapter.software,
             instance: gpu.instance.clone(),
             adapter: gpu.wgpu_adapter.clone(),
             device: gpu.device.clone(),

@@ -19,6 +19,8 @@ pub struct Args<'a> {
     pub plan: ExitPlan,
     pub window: (u32, u32),
     pub antialias: bool,
+    /// `auto`, `shared` or `own`: the window's device when the engine is on the GPU.
+    pub device: &'a str,
     pub backend: crate::backend::Backend,
     pub strict: bool,
 }
@@ -63,6 +65,12 @@ pub fn run(args: Args<'_>) -> anyhow::Result<ExitCode> {
         antialias: args.antialias,
     };
     let (width, height) = args.window;
+    let shared = shared.filter(|shared| match args.device {
+        "shared" => true,
+        "own" => false,
+        // Measured on lavapipe (docs/app.md): sharing its one queue made strokes 5× slower.
+        _ => !shared.software,
+    });
     let sharing = if shared.is_some() {
         "the window draws with the engine's GPU device"
     } else {

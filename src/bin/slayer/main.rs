@@ -294,6 +294,11 @@ enum Command {
         /// lavapipe included).
         #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
         backend: backend::Backend,
+        /// With the GPU backend, which device the window draws with: the engine's (`shared`),
+        /// its own (`own`), or `auto`: shared on a hardware GPU, its own on a software one
+        /// (lavapipe's single queue would hold the engine's read-backs behind each frame).
+        #[arg(long, default_value = "auto", value_parser = ["auto", "shared", "own"])]
+        device: String,
     },
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
@@ -418,6 +423,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             window,
             no_antialias,
             backend,
+            device,
         } => gui::run(gui::Args {
             file: file.as_deref(),
             triangles,
@@ -432,6 +438,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             window,
             antialias: !no_antialias,
             backend,
+            device: &device,
             strict,
         }),
         Command::Strokes {
