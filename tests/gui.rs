@@ -23,9 +23,13 @@ fn plaster() -> Session {
     )
 }
 
+/// Where the test app's Ctrl-S (and "Save and quit") writes.
+fn save_path() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("slayer-gui-test-{}.slayer", std::process::id()))
+}
+
 fn app(session: Session) -> Harness<'static, SlayerApp> {
-    let save_path =
-        std::env::temp_dir().join(format!("slayer-gui-test-{}.slayer", std::process::id()));
+    let save_path = save_path();
     let mut harness = Harness::builder()
         .with_size(SIZE)
         .wgpu()
@@ -91,6 +95,12 @@ fn drag(harness: &mut Harness<'_, SlayerApp>, from: Pos2, to: Pos2, modifiers: M
     settle(harness, "the stroke is recorded", |app| {
         app.idle() && app.status.history.len() > strokes_before
     });
+}
+
+/// A plain drag between two points given relative to the viewport's centre.
+fn drag_across(harness: &mut Harness<'_, SlayerApp>, from: egui::Vec2, to: egui::Vec2) {
+    let c = centre(harness);
+    drag(harness, c + from, c + to, Modifiers::NONE);
 }
 
 fn positions(harness: &Harness<'_, SlayerApp>) -> (Vec<Vec3>, Vec<bool>) {
@@ -276,12 +286,10 @@ fn the_default_and_a_sculpted_plaster_look_as_stored() {
     let pixels = (SIZE[0] * SIZE[1]) as usize;
     let options = SnapshotOptions::new().max_failed_pixels(pixels / 200);
     harness.snapshot_options("gui_plaster", &options);
-    let c = centre(&harness);
-    drag(
+    drag_across(
         &mut harness,
-        c - egui::vec2(100.0, 30.0),
-        c + egui::vec2(60.0, 40.0),
-        Modifiers::NONE,
+        egui::vec2(-100.0, -30.0),
+        egui::vec2(60.0, 40.0),
     );
     harness.snapshot_options("gui_plaster_sculpted", &options);
 }
@@ -416,13 +424,7 @@ fn the_paint_brush_lays_down_the_panels_material_through_its_stencil() {
     }
     let before = digest(&harness);
     let (old, _) = positions(&harness);
-    let c = centre(&harness);
-    drag(
-        &mut harness,
-        c - egui::vec2(60.0, 0.0),
-        c + egui::vec2(60.0, 0.0),
-        Modifiers::NONE,
-    );
+    drag_across(&mut harness, egui::vec2(-60.0, 0.0), egui::vec2(60.0, 0.0));
     assert_ne!(digest(&harness), before);
     let (new, _) = positions(&harness);
     assert_eq!(old, new, "painting moves nothing");
@@ -468,13 +470,7 @@ fn closing_with_unsaved_changes_asks_and_save_and_quit_saves() {
     request_close(&mut harness);
     assert!(!harness.state().asking_to_save(), "nothing to save yet");
 
-    let c = centre(&harness);
-    drag(
-        &mut harness,
-        c - egui::vec2(50.0, 0.0),
-        c + egui::vec2(50.0, 0.0),
-        Modifiers::NONE,
-    );
+    drag_across(&mut harness, egui::vec2(-50.0, 0.0), egui::vec2(50.0, 0.0));
     assert!(!harness.state().may_close());
     request_close(&mut harness);
     assert!(harness.state().asking_to_save());
@@ -485,7 +481,7 @@ fn closing_with_unsaved_changes_asks_and_save_and_quit_saves() {
     request_close(&mut harness);
     harness.get_by_label("Save and quit").click();
     settle(&mut harness, "the session is saved", |app| app.may_close());
-    let saved = std::env::temp_dir().join(format!("slayer-gui-test-{}.slayer", std::process::id()));
+    let saved = save_path();
     let session = slayer::session::open(&saved).expect("the session was written");
     assert_eq!(session.mesh().digest(), digest(&harness));
     assert_eq!(session.history().entries().len(), 1, "with its history");

@@ -82,10 +82,14 @@ impl OrbitCamera {
     /// point under the cursor at the target's depth follows the cursor.
     pub fn pan(&mut self, delta: Vec2, height: f32, aspect: f32) {
         let camera = self.view(aspect);
-        let world_per_pixel =
-            2.0 * self.distance * (0.5 * crate::render::FIELD_OF_VIEW_DEGREES.to_radians()).tan()
-                / height.max(1.0);
-        self.target += (-delta.x * camera.right + delta.y * camera.up) * world_per_pixel;
+        self.target +=
+            (-delta.x * camera.right + delta.y * camera.up) * self.world_per_pixel(height);
+    }
+
+    /// World units a pixel spans at the target's depth, in a viewport `height` pixels tall.
+    pub fn world_per_pixel(&self, height: f32) -> f32 {
+        2.0 * self.distance * (0.5 * crate::render::FIELD_OF_VIEW_DEGREES.to_radians()).tan()
+            / height.max(1.0)
     }
 
     /// Moves toward the target (`steps` > 0) or away, 10 % a step.

@@ -252,9 +252,7 @@ fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoin
                 (start + travel / 300.0).clamp(0.0, 1.0)
             } else {
                 // The radius follows the pointer: world units per point at the target depth.
-                let per_point = app
-                    .camera
-                    .map_or(0.0, |c| world_per_point(&c, rect.height()));
+                let per_point = app.camera.map_or(0.0, |c| c.world_per_pixel(rect.height()));
                 (start + travel * per_point).max(0.25 * app.status.edge_length.max(1e-6))
             };
             set_adjusted(app, strength, value);
@@ -270,11 +268,6 @@ fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoin
             }
         }
     }
-}
-
-fn world_per_point(camera: &super::OrbitCamera, height: f32) -> f32 {
-    2.0 * camera.distance * (0.5 * crate::render::FIELD_OF_VIEW_DEGREES.to_radians()).tan()
-        / height.max(1.0)
 }
 
 fn set_adjusted(app: &mut SlayerApp, strength: bool, value: f32) {

@@ -65,18 +65,22 @@ impl Picker {
             .filter(|&f| pickable(f))
             .map(|f| f as u32)
             .collect();
-        let centroid = |f: u32| {
-            let [a, b, c] = mesh.faces()[f as usize];
-            (positions[a as usize] + positions[b as usize] + positions[c as usize]) / 3.0
-        };
-        let (lo, hi) = faces.iter().fold(
+        let centroids: Vec<Vec3> = faces
+            .iter()
+            .map(|&f| {
+                let [a, b, c] = mesh.faces()[f as usize];
+                (positions[a as usize] + positions[b as usize] + positions[c as usize]) / 3.0
+            })
+            .collect();
+        let (lo, hi) = centroids.iter().fold(
             (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            |(lo, hi), &f| (lo.min(centroid(f)), hi.max(centroid(f))),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
         );
         let scale = 1023.0 / (hi - lo).max(Vec3::splat(1e-12));
         let mut keyed: Vec<(u32, u32)> = faces
             .iter()
-            .map(|&f| (morton((centroid(f) - lo) * scale), f))
+            .zip(&centroids)
+            .map(|(&f, &p)| (morton((p - lo) * scale), f))
             .collect();
         keyed.sort_unstable();
         let order: Vec<u32> = keyed.into_iter().map(|(_, f)| f).collect();

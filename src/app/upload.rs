@@ -5,6 +5,7 @@
 //! is compared (a few milliseconds at a million faces, on the engine's thread) and still only
 //! what differs is sent.
 
+use bytemuck::Zeroable;
 use glam::Vec3;
 
 use crate::mesh::{INVALID, Mesh};
@@ -130,16 +131,6 @@ fn runs<T: Copy>(items: &[u32], all: &[T]) -> Vec<(u32, Vec<T>)> {
         }
     }
     runs
-}
-
-trait Zeroed {
-    fn zeroed() -> Self;
-}
-
-impl Zeroed for RenderVertex {
-    fn zeroed() -> Self {
-        bytemuck::Zeroable::zeroed()
-    }
 }
 
 #[cfg(test)]

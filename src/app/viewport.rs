@@ -9,8 +9,8 @@ use eframe::{egui, egui_wgpu};
 use super::upload::MeshUpdate;
 use crate::gpu::GpuError;
 use crate::render::{
-    COLOUR_FORMAT, Camera, DEPTH_FORMAT, MSAA_SAMPLES, PreviewUniforms, RenderOptions,
-    RenderVertex, preview_bind_group, preview_pipeline, preview_uniforms,
+    Camera, MSAA_SAMPLES, PreviewTargets, PreviewUniforms, RenderOptions, RenderVertex,
+    preview_bind_group, preview_pipeline, preview_uniforms, record_preview_draws,
 };
 
 /// What the user toggles in the view.
@@ -32,7 +32,7 @@ pub struct Viewport {
     corners: wgpu::Buffer,
     corner_count: u32,
     bind_group: wgpu::BindGroup,
-    targets: Option<Targets>,
+    targets: Option<PreviewTargets>,
     /// The texture egui shows.
     pub texture: Option<egui::TextureId>,
     /// Something changed since the last render.
@@ -42,14 +42,6 @@ pub struct Viewport {
     /// What the last render drew with: a camera or view change differs from it.
     drawn_with: Option<PreviewUniforms>,
     samples: u32,
-}
-
-struct Targets {
-    size: (u32, u32),
-    resolved: wgpu::TextureView,
-    /// `None` without antialiasing: the pass draws straight into `resolved`.
-    multisampled: Option<wgpu::TextureView>,
-    depth: wgpu::TextureView,
 }
 
 impl Viewport {
@@ -110,9 +102,11 @@ impl Viewport {
                 limit >> 20
             ));
         }
-        let vertices_grown = self.grow(Grown::Vertices, vertex_bytes);
-        let corners_grown = self.grow(Grown::Corners, corner_bytes);
-        if vertices_grown || corners_grown {
+        let grown_vertices = self.grown(&self.vertices, "viewport vertices", vertex_bytes);
+        let grown_corners = self.grown(&self.corners, "viewport corners", corner_bytes);
+        if grown_vertices.is_some() || grown_corners.is_some() {
+            self.vertices = grown_vertices.unwrap_or_else(|| self.vertices.clone());
+            self.corners = grown_corners.unwrap_or_else(|| self.corners.clone());
             self.bind_group = bind(
                 &self.device,
                 &self.pipeline,
@@ -122,15 +116,16 @@ impl Viewport {
             );
         }
         for (first, rows) in &update.rows {
-            self.write(
-                &self.vertices.clone(),
-                *first as u64 * row,
-                bytemuck::cast_slice(rows),
-            );
+            let bytes: &[u8] = bytemuck::cast_slice(rows);
+            self.queue
+                .write_buffer(&self.vertices, *first as u64 * row, bytes);
+            self.uploaded += bytes.len() as u64;
         }
         for (first, corners) in &update.corners {
             let bytes: &[u8] = bytemuck::cast_slice(corners);
-            self.write(&self.corners.clone(), *first as u64 * corner, bytes);
+            self.queue
+                .write_buffer(&self.corners, *first as u64 * corner, bytes);
+            self.uploaded += bytes.len() as u64;
         }
         self.corner_count = update.face_count * 3;
         self.dirty = true;
@@ -145,38 +140,22 @@ impl Viewport {
             .min(limits.max_buffer_size)
     }
 
-    /// Replaces a buffer by one with room for `bytes`, copying what it held; whether it did.
-    fn grow(&mut self, which: Grown, bytes: u64) -> bool {
-        let old = match which {
-            Grown::Vertices => &self.vertices,
-            Grown::Corners => &self.corners,
-        };
+    /// A buffer with room for `bytes` holding what `old` held, when `old` is too small.
+    fn grown(&self, old: &wgpu::Buffer, label: &str, bytes: u64) -> Option<wgpu::Buffer> {
         if bytes <= old.size() {
-            return false;
+            return None;
         }
-        let label = match which {
-            Grown::Vertices => "viewport vertices",
-            Grown::Corners => "viewport corners",
-        };
-        let new = storage(&self.device, label, grown(bytes).min(self.binding_limit()));
+        // Half as much again, so a growing mesh is not re-allocated every stroke.
+        let size = (bytes * 3 / 2)
+            .next_multiple_of(256)
+            .min(self.binding_limit());
+        let new = storage(&self.device, label, size);
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         encoder.copy_buffer_to_buffer(old, 0, &new, 0, old.size());
         self.queue.submit([encoder.finish()]);
-        match which {
-            Grown::Vertices => self.vertices = new,
-            Grown::Corners => self.corners = new,
-        }
-        true
-    }
-
-    fn write(&mut self, buffer: &wgpu::Buffer, offset: u64, bytes: &[u8]) {
-        // Buffer writes must be whole multiples of 4 bytes; every row and corner is.
-        if !bytes.is_empty() {
-            self.queue.write_buffer(buffer, offset, bytes);
-            self.uploaded += bytes.len() as u64;
-        }
+        Some(new)
     }
 
     /// Bytes uploaded since the last call.
@@ -194,18 +173,19 @@ impl Viewport {
     ) {
         let size = (size.0.max(1), size.1.max(1));
         if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            let targets = Targets::new(&self.device, size, self.samples);
+            let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
+            let targets = PreviewTargets::new(&self.device, size, self.samples, sampled);
             match self.texture {
                 Some(id) => renderer.update_egui_texture_from_wgpu_texture(
                     &self.device,
-                    &targets.resolved,
+                    &targets.resolved_view,
                     wgpu::FilterMode::Linear,
                     id,
                 ),
                 None => {
                     self.texture = Some(renderer.register_native_texture(
                         &self.device,
-                        &targets.resolved,
+                        &targets.resolved_view,
                         wgpu::FilterMode::Linear,
                     ))
                 }
@@ -234,96 +214,15 @@ impl Viewport {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("viewport"),
             });
-        {
-            let background = crate::render::BACKGROUND;
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("viewport"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: targets.multisampled.as_ref().unwrap_or(&targets.resolved),
-                    depth_slice: None,
-                    resolve_target: targets.multisampled.as_ref().map(|_| &targets.resolved),
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: background[0],
-                            g: background[1],
-                            b: background[2],
-                            a: 1.0,
-                        }),
-                        // Multisampled, only the resolved image is kept.
-                        store: if targets.multisampled.is_some() {
-                            wgpu::StoreOp::Discard
-                        } else {
-                            wgpu::StoreOp::Store
-                        },
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if self.corner_count > 0 {
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.bind_group, &[]);
-                pass.draw(0..self.corner_count, 0..1);
-            }
-        }
+        let draws = [(self.bind_group.clone(), self.corner_count)];
+        let draws = if self.corner_count > 0 {
+            &draws[..]
+        } else {
+            &[]
+        };
+        record_preview_draws(&mut encoder, &self.pipeline, draws, targets);
         self.queue.submit([encoder.finish()]);
     }
-}
-
-impl Targets {
-    fn new(device: &wgpu::Device, size: (u32, u32), samples: u32) -> Targets {
-        let texture = |label, samples, format, usage| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: size.0,
-                        height: size.1,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        Targets {
-            size,
-            resolved: texture(
-                "viewport image",
-                1,
-                COLOUR_FORMAT,
-                attachment | wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
-            multisampled: (samples > 1)
-                .then(|| texture("viewport samples", samples, COLOUR_FORMAT, attachment)),
-            depth: texture("viewport depth", samples, DEPTH_FORMAT, attachment),
-        }
-    }
-}
-
-#[derive(Clone, Copy)]
-enum Grown {
-    Vertices,
-    Corners,
-}
-
-/// Room for `bytes` and half as much again, so a growing mesh is not re-allocated every stroke.
-fn grown(bytes: u64) -> u64 {
-    (bytes * 3 / 2).next_multiple_of(256)
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {

@@ -102,6 +102,8 @@ pub struct Worker {
     revision: u64,
     saved_revision: u64,
     pipeline: Pipeline,
+    /// The GPU's failure was reported.
+    gpu_failure_said: bool,
     picker: Picker,
     /// What the viewport holds.
     mirror: Mirror,
@@ -121,6 +123,7 @@ impl Worker {
             mirror: Mirror::default(),
             revision: 0,
             saved_revision: 0,
+            gpu_failure_said: false,
             session,
             pipeline,
             link: Link {
@@ -248,8 +251,8 @@ impl Worker {
             link,
             ..
         } = self;
-        if let Some(why) = refusal(&settings, session.mesh()) {
-            return self.refuse_stroke(why);
+        if let Err(why) = Pipeline::check_stroke(session.mesh(), &settings) {
+            return self.refuse_stroke(format!("stroke refused: {why}"));
         }
         let mut edit = session.edit(&label);
         // A stroke the pipeline refuses still reads its points up to its end, running none.
@@ -258,25 +261,8 @@ impl Worker {
             Err(e) => (None, Some(format!("stroke refused: {e}"))),
         };
         let mut projector = Projector::default();
-        let mut deferred = Vec::new();
-        let mut next_begin = None;
-        loop {
-            let points = match link.next() {
-                Some(Command::Points { points, sent }) => link.take_queued_points(points, sent),
-                Some(Command::End) | None => break,
-                // A new stroke without this one's end (a release the window never saw):
-                // this one ends here.
-                Some(begin @ Command::Begin(_)) => {
-                    next_begin = Some(begin);
-                    break;
-                }
-                Some(Command::Hover(_)) => continue,
-                Some(other) => {
-                    // Undo, saving and the like wait for the stroke to end.
-                    deferred.push(other);
-                    continue;
-                }
-            };
+        let mut waiting = Waiting::default();
+        while let Some(points) = link.next_points(&mut waiting) {
             let stroke = stroke.as_mut().filter(|_| failure.is_none());
             let mut batch = Batch {
                 stroke,
@@ -301,45 +287,34 @@ impl Worker {
         if let Some(why) = failure {
             link.reply(Reply::Error(why));
         }
-        // What waited for the stroke's end, then the next stroke.
-        link.pending.extend(deferred);
-        link.pending.extend(next_begin);
-        self.fall_back_if_the_gpu_failed();
+        link.requeue(waiting);
+        self.say_if_the_gpu_failed();
         self.after_edit(true);
     }
 
     /// A stroke refused before it began: it changes nothing, not even the history (whose
     /// undone entries stay redoable); its points are read up to its end and reported done.
     fn refuse_stroke(&mut self, why: String) {
-        let mut deferred = Vec::new();
-        let mut next_begin = None;
-        loop {
-            match self.link.next() {
-                Some(Command::Points { points, sent }) => self.link.reply(Reply::Progress {
-                    points: points.len(),
-                    phases: PhaseTimes::default(),
-                    sent,
-                }),
-                Some(Command::End) | None => break,
-                Some(begin @ Command::Begin(_)) => {
-                    next_begin = Some(begin);
-                    break;
-                }
-                Some(Command::Hover(_)) => {}
-                Some(other) => deferred.push(other),
-            }
+        let mut waiting = Waiting::default();
+        while let Some(points) = self.link.next_points(&mut waiting) {
+            self.link.reply(Reply::Progress {
+                points: points.len(),
+                phases: PhaseTimes::default(),
+                sent: points[0].1,
+            });
         }
         self.link.reply(Reply::Error(why));
-        self.link.pending.extend(deferred);
-        self.link.pending.extend(next_begin);
+        self.link.requeue(waiting);
         self.send_status();
     }
 
-    /// A GPU that failed (lost device, out of memory) leaves its pipeline unusable: the next
-    /// strokes run on the CPU, on the mesh as it is.
-    fn fall_back_if_the_gpu_failed(&mut self) {
-        if let Some(why) = self.pipeline.kernel_failure() {
-            self.pipeline = Pipeline::new(*self.pipeline.settings());
+    /// The GPU kernels go on with the CPU's when the GPU fails (a lost device, memory):
+    /// the user hears it once.
+    fn say_if_the_gpu_failed(&mut self) {
+        if let Some(why) = self.pipeline.kernel_failure()
+            && !self.gpu_failure_said
+        {
+            self.gpu_failure_said = true;
             self.link.reply(Reply::Error(format!(
                 "the GPU failed ({why}); sculpting goes on on the CPU"
             )));
@@ -409,11 +384,19 @@ impl Link {
         }
     }
 
+    /// A command already in the channel, unless one taken early still waits in `pending`
+    /// (it must go first).
+    fn next_queued(&mut self) -> Option<Command> {
+        if self.pending.is_empty() {
+            self.commands.try_recv().ok()
+        } else {
+            None
+        }
+    }
+
     /// Skips hovers that queued behind this one: only where the pointer is now matters.
     fn latest_hover(&mut self, mut ray: Ray) -> Ray {
-        while self.pending.is_empty()
-            && let Ok(command) = self.commands.try_recv()
-        {
+        while let Some(command) = self.next_queued() {
             match command {
                 Command::Hover(later) => ray = later,
                 other => self.pending.push_back(other),
@@ -422,46 +405,48 @@ impl Link {
         ray
     }
 
-    /// The points of `Points` commands queued right behind the first, each with when its
-    /// command was sent.
-    fn take_queued_points(
-        &mut self,
-        points: Vec<StrokePoint>,
-        sent: Instant,
-    ) -> Vec<(StrokePoint, Instant)> {
-        let mut all: Vec<(StrokePoint, Instant)> = points.into_iter().map(|p| (p, sent)).collect();
-        while self.pending.is_empty()
-            && let Ok(command) = self.commands.try_recv()
-        {
-            match command {
+    /// The next points of the stroke in progress (those of `Points` commands queued right
+    /// behind each other joined, each with when its command was sent); `None` at the
+    /// stroke's end. Commands that must wait for the end (undo, save) go to `waiting`, and so
+    /// does a new stroke's `Begin`, which ends this one (a release the window never saw).
+    fn next_points(&mut self, waiting: &mut Waiting) -> Option<Vec<(StrokePoint, Instant)>> {
+        loop {
+            match self.next()? {
                 Command::Points { points, sent } => {
-                    all.extend(points.into_iter().map(|p| (p, sent)))
+                    let mut all: Vec<_> = points.into_iter().map(|p| (p, sent)).collect();
+                    while let Some(command) = self.next_queued() {
+                        match command {
+                            Command::Points { points, sent } => {
+                                all.extend(points.into_iter().map(|p| (p, sent)))
+                            }
+                            other => self.pending.push_back(other),
+                        }
+                    }
+                    return Some(all);
                 }
-                other => self.pending.push_back(other),
+                Command::End => return None,
+                begin @ Command::Begin(_) => {
+                    waiting.next_begin = Some(begin);
+                    return None;
+                }
+                Command::Hover(_) => {}
+                other => waiting.deferred.push(other),
             }
         }
-        all
+    }
+
+    /// After a stroke: what waited for its end, then the next stroke.
+    fn requeue(&mut self, waiting: Waiting) {
+        self.pending.extend(waiting.deferred);
+        self.pending.extend(waiting.next_begin);
     }
 }
 
-/// Why a stroke cannot begin on `mesh`, if it cannot: a layer that does not exist, a brush
-/// out of bounds.
-fn refusal(settings: &StrokeSettings, mesh: &Mesh) -> Option<String> {
-    if let Some(layer) = settings
-        .layers
-        .iter()
-        .find(|&&l| l as usize >= mesh.layer_count())
-    {
-        return Some(format!(
-            "stroke refused: layer {layer} does not exist (the mesh has {})",
-            mesh.layer_count()
-        ));
-    }
-    let extent = mesh.bounds().map_or(0.0, |(lo, hi)| (hi - lo).length());
-    settings
-        .check(extent)
-        .err()
-        .map(|why| format!("stroke refused: {why}"))
+/// Commands that came during a stroke and wait for its end.
+#[derive(Default)]
+struct Waiting {
+    deferred: Vec<Command>,
+    next_begin: Option<Command>,
 }
 
 /// A stroke's points that arrived together.

@@ -117,6 +117,28 @@ impl Pipeline {
         StrokeInProgress::begin(self, mesh, stroke)
     }
 
+    /// Whether [`Pipeline::begin_stroke`] would take `stroke` on `mesh`: its layers exist and
+    /// its brush is within bounds for the mesh's size. Nothing runs either way.
+    pub fn check_stroke(mesh: &Mesh, stroke: &StrokeSettings) -> Result<(), PipelineError> {
+        if let Some(&layer) = stroke
+            .layers
+            .iter()
+            .find(|&&l| l as usize >= mesh.layer_count())
+        {
+            return Err(PipelineError::LayerOutOfRange {
+                layer,
+                layer_count: mesh.layer_count(),
+            });
+        }
+        // A mesh with no vertices has no size to measure the brush by; it has no edges either,
+        // which `begin_stroke` reports.
+        if let Some(extent) = mesh.extent() {
+            let extent = extent.max(f32::MIN_POSITIVE);
+            stroke.check(extent).map_err(PipelineError::InvalidBrush)?;
+        }
+        Ok(())
+    }
+
     /// A whole stroke: [`Pipeline::begin_stroke`], then its samples and its end in one
     /// [`StrokeInProgress::finish_with`] (the same mesh as `add_samples` then `finish`).
     pub fn apply_stroke(

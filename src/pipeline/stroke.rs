@@ -96,22 +96,7 @@ impl<'a> StrokeInProgress<'a> {
         mesh: &'a mut Mesh,
         stroke: StrokeSettings,
     ) -> Result<StrokeInProgress<'a>, PipelineError> {
-        if let Some(&layer) = stroke
-            .layers
-            .iter()
-            .find(|&&l| l as usize >= mesh.layer_count())
-        {
-            return Err(PipelineError::LayerOutOfRange {
-                layer,
-                layer_count: mesh.layer_count(),
-            });
-        }
-        // A mesh with no vertices has no size to measure the brush by; it has no edges either,
-        // which `take_prepared` reports.
-        if let Some(extent) = mesh.extent() {
-            let extent = extent.max(f32::MIN_POSITIVE);
-            stroke.check(extent).map_err(PipelineError::InvalidBrush)?;
-        }
+        Pipeline::check_stroke(mesh, &stroke)?;
         let (prepared, phases) = pipeline.take_prepared(mesh)?;
         let edge = pipeline.edge_length.unwrap_or(1.0);
         let mut scratch = std::mem::take(&mut pipeline.scratch);

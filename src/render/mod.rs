@@ -16,6 +16,7 @@ pub use preview::{
     Rendered, render,
 };
 pub(crate) use preview::{
-    COLOUR_FORMAT, DEPTH_FORMAT, MSAA_SAMPLES, bind_group as preview_bind_group,
-    pipeline as preview_pipeline, render_vertex, uniforms as preview_uniforms,
+    MSAA_SAMPLES, Targets as PreviewTargets, bind_group as preview_bind_group,
+    pipeline as preview_pipeline, record_draws as record_preview_draws, render_vertex,
+    uniforms as preview_uniforms,
 };

@@ -15,8 +15,8 @@ use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// The colour target: 8-bit sRGB, so the shader writes linear radiance and the hardware
 /// encodes it.
-pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
-pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Samples per pixel when antialiasing (4 is what every WebGPU adapter supports).
 pub(crate) const MSAA_SAMPLES: u32 = 4;
 /// Above this many samples (pixels × samples) antialiasing is dropped: the multisampled colour
@@ -312,14 +312,14 @@ pub(crate) fn pipeline(
 }
 
 fn target(
-    gpu: &GpuContext,
+    device: &wgpu::Device,
     label: &str,
     (width, height): (u32, u32),
     samples: u32,
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
+    device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
             width,
@@ -365,7 +365,8 @@ pub fn render(
     let uniform = gpu.uniform_buffer("preview uniforms", &uniforms(&camera, options));
     let draws = bind_chunks(gpu, &pipeline, &uniform, &chunks);
     drop(chunks);
-    let targets = Targets::new(gpu, (width, height), samples);
+    let copied = wgpu::TextureUsages::COPY_SRC;
+    let targets = Targets::new(&gpu.device, (width, height), samples, copied);
     let readback = Readback::new(gpu, width, height);
     let mut encoder = gpu
         .device
@@ -468,28 +469,44 @@ fn bind_chunks(
 
 /// The render targets: the image (resolved, copied out), its multisampled twin when
 /// antialiasing, and depth; each texture kept beside its view for the pass.
-struct Targets {
+pub(crate) struct Targets {
+    pub(crate) size: (u32, u32),
     resolved: wgpu::Texture,
-    resolved_view: wgpu::TextureView,
+    /// What the pass leaves its image in (the resolve target when multisampled).
+    pub(crate) resolved_view: wgpu::TextureView,
     multisampled: Option<(wgpu::Texture, wgpu::TextureView)>,
     depth: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl Targets {
-    fn new(gpu: &GpuContext, size: (u32, u32), samples: u32) -> Targets {
+    /// Colour and depth targets of `size` at `samples` per pixel; the image also gets
+    /// `image_usage` (copied out by `render`, sampled by the app's viewport).
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        size: (u32, u32),
+        samples: u32,
+        image_usage: wgpu::TextureUsages,
+    ) -> Targets {
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let copied = attachment | wgpu::TextureUsages::COPY_SRC;
         let with_view = |texture: wgpu::Texture| {
             let view = texture.create_view(&Default::default());
             (texture, view)
         };
-        let resolved = target(gpu, "preview image", size, 1, COLOUR_FORMAT, copied);
+        let image = attachment | image_usage;
+        let resolved = target(device, "preview image", size, 1, COLOUR_FORMAT, image);
         let multisampled = (samples > 1).then(|| {
             let name = "preview samples";
-            with_view(target(gpu, name, size, samples, COLOUR_FORMAT, attachment))
+            with_view(target(
+                device,
+                name,
+                size,
+                samples,
+                COLOUR_FORMAT,
+                attachment,
+            ))
         });
         let depth = target(
-            gpu,
+            device,
             "preview depth",
             size,
             samples,
@@ -497,6 +514,7 @@ impl Targets {
             attachment,
         );
         Targets {
+            size,
             resolved_view: resolved.create_view(&Default::default()),
             resolved,
             multisampled,
@@ -507,7 +525,7 @@ impl Targets {
 
 /// Records the render pass: cleared to the background, every chunk drawn, resolved into the
 /// image when multisampled.
-fn record_draws(
+pub(crate) fn record_draws(
     encoder: &mut wgpu::CommandEncoder,
     pipeline: &wgpu::RenderPipeline,
     draws: &[(wgpu::BindGroup, u32)],
