@@ -30,6 +30,7 @@ fn phases(c: &mut Criterion) {
         collision_distance: edge,
         ring: exclusion_ring(&mesh, edge),
         max_edge: mesh.edge_length_stats().max as f32,
+        cull: true,
     };
     // The middle of the paint layer, pushed down hard.
     let (lo, hi) = mesh.bounds().unwrap();

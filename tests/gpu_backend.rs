@@ -453,6 +453,7 @@ fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
             collision_distance: edge,
             ring: 2,
             max_edge: 2.0 * edge,
+            cull: true,
         }
     }
     let mut kernels = all_on_gpu();
@@ -528,6 +529,7 @@ fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
         collision_distance: 0.05,
         ring: 2,
         max_edge: 0.08,
+        cull: true,
     };
     let mut gpu_kernels = GpuKernels::new(gpu());
     let dab = |kind, radius| Dab {

@@ -10,6 +10,7 @@ use crate::brush::{BrushKind, Falloff, LayerRef, SampleSpec, StrokeFile, StrokeS
 use crate::geom::Ray;
 use crate::grid::SpatialHash;
 use crate::mesh::Mesh;
+use crate::scene::SceneKind;
 
 /// Which brushes a script uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -18,6 +19,22 @@ pub enum BrushMix {
     Bench,
     /// Every brush, pushed harder: for the no-interpenetration property tests.
     Torture,
+    /// Straight draw strokes across the sheet, 50 samples each, radius 5 % of its width,
+    /// strength 0.5, on rows spread over it: an artist's plain stroke (the plane scene).
+    StraightDraw,
+    /// Inflate, deflate and grab strokes (the sphere scene).
+    InflateGrab,
+}
+
+impl BrushMix {
+    /// The strokes `slayer bench` runs on a scene.
+    pub fn for_scene(kind: SceneKind) -> BrushMix {
+        match kind {
+            SceneKind::Plane => BrushMix::StraightDraw,
+            SceneKind::Sphere => BrushMix::InflateGrab,
+            SceneKind::Plaster | SceneKind::Bark | SceneKind::Metal => BrushMix::Bench,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,6 +113,9 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
             strokes: Vec::new(),
         };
     };
+    if spec.mix == BrushMix::StraightDraw {
+        return straight_draws(mesh, &surface, spec.strokes);
+    }
     let (lo, hi) = mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
     let edge = mesh.mean_edge_length();
     let radius = spec.radius_edges * edge;
@@ -106,8 +126,9 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
         let (brush, invert, strength) = pick_brush(&mut rng, spec.mix);
         // Active layers: the upper ones, pressed into the base; sometimes only the top one,
         // sometimes all of them.
+        let lowest_upper = layers.saturating_sub(2).max(1).min(layers - 1);
         let active: Vec<u32> = match rng.random_range(0..10) {
-            0..=5 => (1.max(layers.saturating_sub(2))..layers).collect(),
+            0..=5 => (lowest_upper..layers).collect(),
             6..=7 => vec![layers - 1],
             _ => (0..layers).collect(),
         };
@@ -166,8 +187,59 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
     }
 }
 
+/// [`BrushMix::StraightDraw`]: strokes along x from 10 % to 90 % of the sheet's width, on
+/// seven rows from 10 % to 90 % of its depth (a later stroke goes over an earlier row again).
+fn straight_draws(mesh: &Mesh, surface: &Surface<'_>, count: usize) -> StrokeFile {
+    const SAMPLES: usize = 50;
+    const ROWS: usize = 7;
+    let (lo, hi) = mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
+    let size = (hi - lo).truncate();
+    let layers = (0..mesh.layer_count() as u32)
+        .map(LayerRef::Index)
+        .collect::<Vec<_>>();
+    let strokes = (0..count)
+        .map(|i| {
+            let row = (i % ROWS) as f32 / (ROWS - 1) as f32;
+            let samples = (0..SAMPLES)
+                .filter_map(|k| {
+                    let across = k as f32 / (SAMPLES - 1) as f32;
+                    let xy = lo.truncate() + size * Vec2::new(0.1 + 0.8 * across, 0.1 + 0.8 * row);
+                    let (point, _) = surface.under(xy)?;
+                    Some(SampleSpec {
+                        position: point.to_array(),
+                        pressure: 1.0,
+                        normal: None,
+                    })
+                })
+                .collect();
+            StrokeSpec {
+                brush: BrushKind::Draw,
+                radius: 0.05 * size.x,
+                strength: 0.5,
+                falloff: Falloff::Blend { n: 3 },
+                invert: false,
+                layers: layers.clone(),
+                paint: None,
+                spacing: 0.25,
+                symmetry: None,
+                samples,
+            }
+        })
+        .filter(|stroke| !stroke.samples.is_empty())
+        .collect();
+    StrokeFile {
+        version: 1,
+        strokes,
+    }
+}
+
 fn pick_brush(rng: &mut ChaCha8Rng, mix: BrushMix) -> (BrushKind, bool, f32) {
     match mix {
+        BrushMix::StraightDraw => (BrushKind::Draw, false, 0.5),
+        BrushMix::InflateGrab => match rng.random_range(0..4) {
+            0..=1 => (BrushKind::Inflate, rng.random(), rng.random_range(0.2..0.5)),
+            _ => (BrushKind::Grab, false, 1.0),
+        },
         BrushMix::Bench => match rng.random_range(0..20) {
             0..=6 => (BrushKind::Draw, true, rng.random_range(0.3..0.6)),
             7..=8 => (BrushKind::Draw, false, rng.random_range(0.2..0.4)),

@@ -57,10 +57,15 @@ pub(super) fn undo_crossings(
         .map(|(&(v, _), _)| v)
         .collect();
     loop {
-        let mut moving_faces: Vec<u32> =
-            changed.iter().flat_map(|&v| mesh.faces_around(v)).collect();
-        moving_faces.sort_unstable();
-        moving_faces.dedup();
+        // Each face once, in the order met (the pairs found are sorted); the marks then say
+        // which faces are moving.
+        let marks = &mut region.face_marks;
+        marks.start(mesh.face_count());
+        let moving_faces: Vec<u32> = changed
+            .iter()
+            .flat_map(|&v| mesh.faces_around(v))
+            .filter(|&f| marks.insert(f as usize))
+            .collect();
         if moving_faces.is_empty() {
             break;
         }
@@ -76,6 +81,11 @@ pub(super) fn undo_crossings(
                     gather_from_start(state, region, mesh, moves, before);
                     gathered = true;
                 }
+                region.find_sheets(state, mesh);
+                let all_local = moving_faces.iter().all(|&f| region.local(f).is_some());
+                if region.worth_searching() || !all_local {
+                    region.file_faces();
+                }
                 crossings(state, region, mesh, &moving_faces, (target_of, before))
             }
         };
@@ -84,6 +94,7 @@ pub(super) fn undo_crossings(
         }
         pairs.sort_unstable();
         let undo = undo_pairs(mesh, pairs, (target_of, before), &mut still_moved);
+        region.positions_changed();
         let undone = undo.len();
         reverted += undone;
         changed = undo;
@@ -141,7 +152,7 @@ fn gather_from_start(
     for (&(v, _), &p) in selection.iter().zip(before) {
         positions[v as usize] = p;
     }
-    region.gather(state, mesh, selection, targets, target_of);
+    region.gather_unfiled(state, mesh, selection, targets, target_of);
     let positions = mesh.positions_mut();
     for (&(v, _), p) in selection.iter().zip(now) {
         positions[v as usize] = p;
@@ -188,7 +199,7 @@ fn face_normal(t: [Vec3; 3]) -> Vec3 {
     (t[1] - t[0]).cross(t[2] - t[0])
 }
 
-/// The crossing pairs of `moving_faces` (ascending), searched in the gathered region: each
+/// The crossing pairs of `moving_faces` (marked in `region.face_marks`), searched in the gathered region: each
 /// moving face against itself (turned over), the faces around its vertices (overlap beyond
 /// a shared vertex) and the region's faces whose boxes meet its box. A pair of two moving
 /// faces is tested from the lower one.
@@ -199,7 +210,7 @@ fn crossings(
     moving_faces: &[u32],
     (target_of, before): (&[u32], &[Vec3]),
 ) -> Vec<(u32, u32)> {
-    let is_moving = |f: u32| moving_faces.binary_search(&f).is_ok();
+    let is_moving = |f: u32| region.face_marks.contains(f as usize);
     let found: Vec<Vec<(u32, u32)>> =
         map_with_scratch(state.parallel, moving_faces, |scratch, &f| {
             let tri_f = triangle(mesh, f);
@@ -209,12 +220,20 @@ fn crossings(
             if turned_over(mesh, f, target_of, before) {
                 found.push((f, f));
             }
+            // Two faces of a sheet never meet beyond what they share (`super::sheet`).
+            let layer = mesh.face_layers()[f as usize];
+            let in_sheet = |g: u32| {
+                region.is_sheet(layer)
+                    && mesh.face_layers()[g as usize] == layer
+                    && region.local(f).is_some()
+                    && region.local(g).is_some()
+            };
             // Nor may the step fold two faces around a shared vertex onto each other: they
             // overlap while sharing a vertex, which the pair test skips.
             let ids_f = faces[f as usize];
             for w in ids_f {
                 for g in mesh.faces_around(w) {
-                    if g == f || (g < f && is_moving(g)) {
+                    if g == f || (g < f && is_moving(g)) || in_sheet(g) {
                         continue;
                     }
                     let tri_g = triangle(mesh, g);
@@ -223,9 +242,12 @@ fn crossings(
                     }
                 }
             }
+            if in_sheet(f) && region.single_layer() {
+                return found;
+            }
             region.candidates(&box_f, scratch, |local| {
                 let g = region.faces[local];
-                if g == f || (g < f && is_moving(g)) || share_a_vertex(mesh, f, g) {
+                if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
                     return;
                 }
                 if apart_faces_cross(tri_f, &box_f, triangle(mesh, g)) {

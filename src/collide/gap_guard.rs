@@ -12,7 +12,8 @@
 
 use glam::Vec3;
 
-use super::region::{StepMoves, map_with_scratch, start_position, triangle};
+use super::LocalFaceGrid;
+use super::region::{Region, StepMoves, map_with_scratch, start_position, triangle};
 use super::state::StrokeState;
 use crate::abi::CLAMP_SLACK;
 use crate::geom::{Aabb, closest_point_on_triangle};
@@ -23,6 +24,7 @@ use crate::mesh::{INVALID, Mesh};
 /// were undone.
 pub(super) fn undo_gap_violations(
     state: &StrokeState<'_>,
+    region: &mut Region,
     mesh: &mut Mesh,
     (selection, _, target_of): StepMoves<'_>,
     before: &[Vec3],
@@ -47,14 +49,27 @@ pub(super) fn undo_gap_violations(
             .filter(|((v, _), p)| mesh.positions()[*v as usize] != **p)
             .map(|((v, _), _)| *v);
         let view: &Mesh = mesh;
-        let mut faces: Vec<u32> = moved
+        // Each face once, in the order met: what is found does not depend on it.
+        let marks = &mut region.face_marks;
+        marks.start(view.face_count());
+        let faces: Vec<u32> = moved
             .chain(went_back.iter().copied())
             .flat_map(|v| view.faces_around(v))
+            .filter(|&f| marks.insert(f as usize))
             .collect();
-        faces.sort_unstable();
-        faces.dedup();
+        let region: &Region = region;
+        let others = other_layers_near(state, region, view, &faces, drift);
+        if others.as_ref().is_some_and(|near| near.vertices.is_empty()) {
+            return undone;
+        }
         let too_close: Vec<Vec<u32>> = map_with_scratch(state.parallel, &faces, |_, &f| {
-            vertices_too_close(state, view, (f, drift), (target_of, before))
+            vertices_too_close(
+                state,
+                view,
+                (f, drift),
+                (target_of, before),
+                others.as_ref(),
+            )
         });
         // Each pair goes back to where both were at the step's start, where they were apart
         // enough: the face's moved vertices, and every vertex too close to it that moved (all
@@ -89,6 +104,7 @@ fn vertices_too_close(
     mesh: &Mesh,
     (f, drift): (u32, f32),
     (target_of, before): (&[u32], &[Vec3]),
+    others: Option<&OtherLayers>,
 ) -> Vec<u32> {
     let d = state.collision_distance;
     let ids = mesh.faces()[f as usize];
@@ -120,14 +136,65 @@ fn vertices_too_close(
             found.push(y);
         }
     };
-    match state.grid {
-        Some(grid) => {
+    match (others, state.grid) {
+        (Some(others), _) => others
+            .grid
+            .for_each_candidate(&near, |i| test(others.vertices[i as usize])),
+        (None, Some(grid)) => {
             let reach = near.expanded(drift);
             grid.for_each_in_box(reach.min, reach.max, &mut test)
         }
-        None => (0..mesh.vertex_count() as u32)
+        (None, None) => (0..mesh.vertex_count() as u32)
             .filter(|&v| mesh.is_vertex_live(v))
             .for_each(&mut test),
     }
     found
+}
+
+/// The vertices that a round's faces could be too close to, where the step's region holds
+/// them all: those of other layers than the faces', filed where they are now. None when the
+/// region does not reach that far (or culling is off): search the grid face by face.
+struct OtherLayers {
+    vertices: Vec<u32>,
+    grid: LocalFaceGrid,
+}
+
+fn other_layers_near(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    faces: &[u32],
+    drift: f32,
+) -> Option<OtherLayers> {
+    let d = state.collision_distance;
+    let near = faces
+        .iter()
+        .fold(Aabb::EMPTY, |b, &f| {
+            b.including_box(&Aabb::of_points(&triangle(mesh, f)))
+        })
+        .expanded(d);
+    if !state.cull || faces.is_empty() || !region.covers(&near.expanded(drift)) {
+        return None;
+    }
+    let face_layers = mesh.face_layers();
+    let first = face_layers[faces[0] as usize];
+    let one_layer = faces.iter().all(|&f| face_layers[f as usize] == first);
+    let vertex_layers = mesh.vertex_layers();
+    // With faces of several layers every vertex may be of another layer than one of them.
+    let vertices: Vec<u32> = region
+        .vertices()
+        .iter()
+        .copied()
+        .filter(|&y| !one_layer || vertex_layers[y as usize] != first)
+        .collect();
+    let mut grid = LocalFaceGrid::default();
+    if !vertices.is_empty() {
+        let points: Vec<Aabb> = vertices
+            .iter()
+            .map(|&y| Aabb::of_points(&[mesh.positions()[y as usize]]))
+            .collect();
+        let bounds = points.iter().fold(near, |b, p| b.including_box(p));
+        grid.build(&points, bounds, d);
+    }
+    Some(OtherLayers { vertices, grid })
 }

@@ -15,6 +15,7 @@ mod local_grid;
 pub mod neighbourhood;
 mod region;
 mod response;
+mod sheet;
 mod stamps;
 mod state;
 

@@ -50,16 +50,50 @@ pub struct Region {
     pub(super) boxes: Vec<Aabb>,
     grid: LocalFaceGrid,
     use_grid: bool,
+    /// The local grid's cell side (none without a global grid), and whether the faces are
+    /// filed in it yet.
+    cell: Option<f32>,
+    filed: bool,
     vertices: Vec<u32>,
     /// Mesh faces already in `faces`, and their index there.
     gathered: Stamps,
     local_index: Vec<u32>,
+    /// The box of the step's moves (starts and targets), and the box whose vertices were
+    /// gathered (filed in the grid in a cell that overlaps it).
+    pub(super) bounds: Aabb,
+    reach: Aabb,
+    /// Gathered for the step under way ([`Region::forget`] clears it between steps).
+    pub(super) ready: bool,
+    /// The layers of the region's faces, ascending.
+    layers: Vec<u32>,
+    /// Per layer id: whether the region's faces of that layer are a sheet where the mesh is
+    /// now (`super::sheet`); `None` once a vertex moved since it was found.
+    sheets: Option<Vec<bool>>,
+    /// The first look this step found no sheet.
+    no_sheet_this_step: bool,
+    /// Mesh faces met already, for the phases that list each face once.
+    pub(super) face_marks: Stamps,
 }
 
 impl Region {
-    /// Collects the faces around the step's moves (public so that `tests/gpu_parity/` can
-    /// check the GPU proximity mirror against [`pull_back`](super::pull_back)).
+    /// Collects the faces around the step's moves, ready for searching (public so that
+    /// `tests/gpu_parity/` can check the GPU proximity mirror against
+    /// [`pull_back`](super::pull_back)).
     pub fn gather(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        selection: &[(u32, f32)],
+        targets: &[Vec3],
+        target_of: &[u32],
+    ) {
+        self.gather_unfiled(state, mesh, selection, targets, target_of);
+        self.file_faces();
+    }
+
+    /// [`Region::gather`] without filing the faces in the local grid: the searches that need
+    /// it call [`Region::file_faces`] first; a step whose every layer is a sheet needs none.
+    pub(super) fn gather_unfiled(
         &mut self,
         state: &StrokeState<'_>,
         mesh: &Mesh,
@@ -76,6 +110,8 @@ impl Region {
         // crosses a moving face has a vertex within two longest edges of the moving vertex.
         let reach = state.collision_distance + 2.0 * state.max_edge;
         let region = bounds.expanded(reach);
+        self.bounds = bounds;
+        self.reach = region;
         self.vertices.clear();
         match state.grid {
             Some(grid) => {
@@ -118,11 +154,94 @@ impl Region {
                 }
             })
         }));
-        self.use_grid = state.grid.is_some();
-        if let Some(g) = state.grid {
-            self.grid
-                .build(&self.boxes, region, LOCAL_CELL_EDGES * g.cell_size());
+        let mut present = vec![false; mesh.layer_count()];
+        for &f in &self.faces {
+            present[mesh.face_layers()[f as usize] as usize] = true;
         }
+        self.layers.clear();
+        self.layers
+            .extend((0..present.len() as u32).filter(|&l| present[l as usize]));
+        self.sheets = None;
+        self.no_sheet_this_step = false;
+        self.ready = true;
+        self.use_grid = state.grid.is_some();
+        self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
+        self.filed = false;
+    }
+
+    /// Files the faces in the local grid, once per gathering.
+    pub(super) fn file_faces(&mut self) {
+        if let (false, Some(cell)) = (self.filed, self.cell) {
+            self.grid.build(&self.boxes, self.reach, cell);
+        }
+        self.filed = true;
+    }
+
+    /// Whether a search of the region could find anything where the mesh is now: not when
+    /// every layer in it is a sheet and alone there.
+    pub(super) fn worth_searching(&self) -> bool {
+        !(self.single_layer() && self.layers.iter().all(|&l| self.is_sheet(l)))
+    }
+
+    /// Marks the region as not gathered for the step about to start.
+    pub(super) fn forget(&mut self) {
+        self.ready = false;
+        self.sheets = None;
+        self.no_sheet_this_step = false;
+    }
+
+    /// Finds which layers are sheets where the mesh is now (`super::sheet`), unless known
+    /// since the last move; all are taken as not when the stroke does not cull. Searches
+    /// within a sheet are skipped until [`Region::positions_changed`].
+    pub(super) fn find_sheets(&mut self, state: &StrokeState<'_>, mesh: &Mesh) {
+        if self.sheets.is_some() {
+            return;
+        }
+        // Pulling moves back seldom makes a sheet of what was none at the step's targets:
+        // not worth another look this step.
+        if self.no_sheet_this_step {
+            self.sheets = Some(Vec::new());
+            return;
+        }
+        self.sheets = Some(if state.cull {
+            super::sheet::find_sheets(state, mesh, self, &self.layers)
+        } else {
+            Vec::new()
+        });
+        self.no_sheet_this_step = !self.sheets.iter().flatten().any(|&sheet| sheet);
+    }
+
+    /// Whether the first look this step found a layer that is a sheet, whose searches
+    /// were then skipped.
+    pub(super) fn found_a_sheet(&self) -> bool {
+        self.ready && self.sheets.is_some() && !self.no_sheet_this_step
+    }
+
+    /// Vertices of the region moved: which layers are sheets is not known any more.
+    pub(super) fn positions_changed(&mut self) {
+        self.sheets = None;
+    }
+
+    /// Whether `layer` is a sheet where the mesh is now, as far as known.
+    pub(super) fn is_sheet(&self, layer: u32) -> bool {
+        self.sheets
+            .as_ref()
+            .is_some_and(|sheets| sheets.get(layer as usize) == Some(&true))
+    }
+
+    /// Whether every face of the region is of one layer.
+    pub(super) fn single_layer(&self) -> bool {
+        self.layers.len() <= 1
+    }
+
+    /// Whether a query of the grid over `query` finds only vertices this region gathered.
+    pub(super) fn covers(&self, query: &Aabb) -> bool {
+        self.ready && query.min.cmpge(self.reach.min).all() && query.max.cmple(self.reach.max).all()
+    }
+
+    /// The vertices gathered (those the grid files in a cell overlapping the reach).
+    pub(super) fn vertices(&self) -> &[u32] {
+        &self.vertices
     }
 
     /// Index of a mesh face in this region, if it is in it.
@@ -134,6 +253,7 @@ impl Region {
 
     /// Local faces whose box overlaps `query`, each once.
     pub(super) fn candidates(&self, query: &Aabb, scratch: &mut Scratch, mut f: impl FnMut(usize)) {
+        debug_assert!(self.filed, "a search before the faces were filed");
         if self.use_grid {
             scratch.seen.start(self.faces.len());
             self.grid.for_each_candidate(query, |local| {

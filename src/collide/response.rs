@@ -42,6 +42,11 @@ pub fn pull_back(
     let query = Aabb::of_points(&[start, x]).expanded(d);
     let own_layer = mesh.vertex_layers()[v as usize];
     let layers = mesh.face_layers();
+    // Within a sheet nothing outside the ring is within d (`super::sheet`).
+    let own_sheet = region.is_sheet(own_layer);
+    if own_sheet && region.single_layer() {
+        return None;
+    }
     let mut ring_ready = false;
     let mut ring = std::mem::take(&mut scratch.ring);
     let mut nearby = std::mem::take(&mut scratch.nearby);
@@ -59,6 +64,9 @@ pub fn pull_back(
         }
         // The vertex's own neighbourhood is near by construction, not by collision.
         if layers[f as usize] == own_layer {
+            if own_sheet {
+                continue;
+            }
             if !ring_ready {
                 ring_vertices(mesh, v, state.ring, &mut ring);
                 ring_ready = true;
@@ -105,6 +113,8 @@ pub struct CollisionOutcome {
     pub positions: Vec<Vec3>,
     pub clamped: usize,
     pub reverted: usize,
+    /// Searches within a layer were skipped: it was a sheet in the step's region.
+    pub culled: bool,
 }
 
 /// Passes of the proximity test before giving up on converging (each pass only re-tests against
@@ -153,7 +163,9 @@ pub fn collide_with(
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
         .collect();
+    region.forget();
     let backstop = clamp(region, mesh, &before);
+    let culled = region.found_a_sheet();
     let clamped_count = selection
         .iter()
         .zip(targets)
@@ -166,7 +178,10 @@ pub fn collide_with(
     let mut reverted = 0;
     let mut backstop = Some(backstop);
     loop {
-        let kept_apart = undo_gap_violations(state, mesh, moves, &before);
+        let kept_apart = undo_gap_violations(state, region, mesh, moves, &before);
+        if kept_apart > 0 {
+            region.positions_changed();
+        }
         // Pairs a GPU filtered were filtered before those moves were undone: search instead.
         let next = match backstop.take() {
             Some(Backstop::Undecided(_)) if kept_apart > 0 => Backstop::Gather,
@@ -187,6 +202,7 @@ pub fn collide_with(
         positions,
         clamped: clamped_count,
         reverted,
+        culled,
     }
 }
 
@@ -198,7 +214,7 @@ pub fn clamp_in_region(
     (selection, targets, target_of): StepMoves<'_>,
     before: &[Vec3],
 ) -> Backstop {
-    region.gather(state, mesh, selection, targets, target_of);
+    region.gather_unfiled(state, mesh, selection, targets, target_of);
     clamp_moves(state, region, mesh, selection, targets, before);
     Backstop::Search
 }
@@ -208,7 +224,7 @@ pub fn clamp_in_region(
 /// holds each selected vertex's start; the positions are left in `mesh`.
 pub fn clamp_moves(
     state: &StrokeState<'_>,
-    region: &Region,
+    region: &mut Region,
     mesh: &mut Mesh,
     selection: &[(u32, f32)],
     targets: &[Vec3],
@@ -220,6 +236,7 @@ pub fn clamp_moves(
             positions[v as usize] = q;
         }
     }
+    region.positions_changed();
 
     // Per local face: changed by the last pass (the first pass tests every face).
     let mut changed: Option<Vec<bool>> = None;
@@ -231,6 +248,11 @@ pub fn clamp_moves(
         let moving: Vec<usize> = (0..selection.len())
             .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
             .collect();
+        region.find_sheets(state, mesh);
+        if region.worth_searching() {
+            region.file_faces();
+        }
+        let region_view: &Region = region;
         let mesh_view: &Mesh = mesh;
         let changed_view = changed.as_deref();
         let pulled_view = &pulled_last;
@@ -238,7 +260,7 @@ pub fn clamp_moves(
             let faces = if pulled_view[i] { None } else { changed_view };
             pull_back(
                 state,
-                region,
+                region_view,
                 mesh_view,
                 selection[i].0,
                 before[i],
@@ -263,6 +285,7 @@ pub fn clamp_moves(
         if moved_back.is_empty() {
             break;
         }
+        region.positions_changed();
         let mut marks = vec![false; region.faces.len()];
         for &v in &moved_back {
             for f in mesh.faces_around(v) {

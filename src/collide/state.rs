@@ -16,4 +16,8 @@ pub struct StrokeState<'a> {
     pub ring: u32,
     /// An upper bound on every edge length right now.
     pub max_edge: f32,
+    /// Skip the searches that cannot find anything: within a layer where it is a sheet
+    /// (`collide::sheet`), against other layers where they have nothing near. Off only to
+    /// compare: the results are the same either way.
+    pub cull: bool,
 }

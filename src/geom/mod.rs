@@ -33,6 +33,12 @@ pub struct Aabb {
     pub max: Vec3,
 }
 
+impl Default for Aabb {
+    fn default() -> Self {
+        Aabb::EMPTY
+    }
+}
+
 impl Aabb {
     pub const EMPTY: Aabb = Aabb {
         min: Vec3::splat(f32::INFINITY),
@@ -47,6 +53,13 @@ impl Aabb {
         Aabb {
             min: self.min.min(p),
             max: self.max.max(p),
+        }
+    }
+
+    pub fn including_box(self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
         }
     }
 

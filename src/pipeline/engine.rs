@@ -44,6 +44,8 @@ pub(super) struct Scratch {
     pub target_of: Vec<u32>,
     /// Per vertex: whether the stroke moved it.
     pub touched: Vec<bool>,
+    /// Vertices met already, to list each once without sorting duplicates away.
+    pub vertex_marks: crate::collide::Stamps,
 }
 
 /// What lasts between strokes: the grid and the collision set-up, with the mesh version they

@@ -75,6 +75,11 @@ pub struct PipelineSettings {
     /// The most dabs (samples after resampling) one stroke may make; samples that would take a
     /// stroke past it are refused with [`PipelineError::TooManyDabs`] before they run.
     pub max_dabs_per_stroke: usize,
+    /// Skip the collision searches that provably find nothing: within a layer where it is a
+    /// sheet that cannot touch itself, against other layers where none is near
+    /// (`collide::sheet`). The result is the same, bit for bit; off only to compare
+    /// (`slayer bench --no-cull`).
+    pub cull: bool,
 }
 
 /// When the pipeline remeshes what the brush touched (sLayer discusses both; docs/design.md).
@@ -114,6 +119,7 @@ impl Default for PipelineSettings {
             edge_length: None,
             remeshing: Remeshing::AfterStroke,
             max_dabs_per_stroke: crate::brush::MAX_DABS_PER_STROKE,
+            cull: true,
         }
     }
 }
@@ -169,6 +175,9 @@ pub struct StrokeReport {
     /// Samples whose move needed more than [`step::MAX_STEPS_PER_SAMPLE`] steps (a runaway brush):
     /// each moved only that many steps of at most `max_step`.
     pub capped_samples: usize,
+    /// Steps whose collision searches within a layer were skipped, the layer being a sheet
+    /// that cannot touch itself there ([`PipelineSettings::cull`]).
+    pub culled_steps: usize,
     /// Distinct vertices the stroke moved.
     pub touched: usize,
     /// What remeshing did, summed over the stroke's remeshing passes.
@@ -190,6 +199,7 @@ impl StrokeReport {
         self.clamped += call.clamped;
         self.reverted += call.reverted;
         self.capped_samples += call.capped_samples;
+        self.culled_steps += call.culled_steps;
         self.phases.add(&call.phases);
     }
 }

@@ -16,7 +16,7 @@ use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
 use crate::brush::{BrushKind, Dab, DabFrame, Resampler, Sample, StrokeSettings};
-use crate::collide::{StrokeState, collide_with};
+use crate::collide::{Stamps, StrokeState, collide_with};
 use crate::geom::largest_move;
 use crate::mesh::{INVALID, Mesh};
 
@@ -42,6 +42,9 @@ pub struct SamplesReport {
     /// Samples whose move needed more than [`MAX_STEPS_PER_SAMPLE`](super::step::MAX_STEPS_PER_SAMPLE)
     /// steps: each moved only that many steps' worth.
     pub capped_samples: usize,
+    /// Steps whose collision searches within a layer were skipped, the layer being a sheet
+    /// that cannot touch itself there ([`PipelineSettings::cull`](super::PipelineSettings::cull)).
+    pub culled_steps: usize,
     /// Vertices whose position, normal, BRDF or mask changed in this call (ascending): what a
     /// viewer uploads again. Vertices remeshing added are among them.
     pub changed: Vec<u32>,
@@ -61,6 +64,8 @@ struct Active {
     active: Vec<bool>,
     /// Search through the grid on all cores; the reference pipeline scans on one thread.
     fast: bool,
+    /// Skip the collision searches that cannot find anything ([`PipelineSettings::cull`]).
+    cull: bool,
     lengths: Lengths,
     /// Where the last sample was: the next one's motion starts there.
     previous: Option<Vec3>,
@@ -122,6 +127,7 @@ impl<'a> StrokeInProgress<'a> {
                 scratch,
                 active,
                 fast,
+                cull: settings.cull,
                 lengths: Lengths {
                     edge,
                     collision_distance: settings.collision_distance * edge,
@@ -304,7 +310,12 @@ impl Active {
 
     /// What a step reads that lasts for the stroke.
     fn state(&self) -> StrokeState<'_> {
-        stroke_state(&self.prepared, &self.active, self.lengths, self.fast)
+        stroke_state(
+            &self.prepared,
+            &self.active,
+            self.lengths,
+            (self.fast, self.cull),
+        )
     }
 
     /// One sample of Algorithm 2: select, paint, deform in steps, collide, update the grid,
@@ -336,7 +347,7 @@ impl Active {
             return None;
         }
         let moved = self.deform_in_steps(kernels, mesh, (opened, number), call);
-        refresh_normals(kernels, mesh, &moved, call);
+        refresh_normals(kernels, mesh, &moved, &mut self.scratch.vertex_marks, call);
         Some(moved)
     }
 
@@ -524,7 +535,12 @@ impl Active {
             .iter()
             .map(|&(v, _)| mesh.positions()[v as usize])
             .collect();
-        let state = stroke_state(&self.prepared, &self.active, self.lengths, self.fast);
+        let state = stroke_state(
+            &self.prepared,
+            &self.active,
+            self.lengths,
+            (self.fast, self.cull),
+        );
         let moves = (selection, targets, target_of.as_slice());
         let outcome = collide_with(
             &state,
@@ -564,6 +580,7 @@ impl Active {
         call.moves += moved.len();
         call.clamped += outcome.clamped;
         call.reverted += outcome.reverted;
+        call.culled_steps += usize::from(outcome.culled);
         for &v in &moved {
             if !self.scratch.touched[v as usize] {
                 self.scratch.touched[v as usize] = true;
@@ -704,15 +721,23 @@ fn refresh_normals(
     kernels: &mut dyn StepKernels,
     mesh: &mut Mesh,
     moved: &[u32],
+    marks: &mut Stamps,
     call: &mut SamplesReport,
 ) {
     let started = Instant::now();
-    let mut refresh: Vec<u32> = moved
-        .iter()
-        .flat_map(|&v| mesh.faces_around(v).flat_map(|f| mesh.faces()[f as usize]))
-        .collect();
+    // Listed once each as met, then sorted: far fewer than the fans' repeats.
+    marks.start(mesh.vertex_count());
+    let mut refresh: Vec<u32> = Vec::new();
+    for &v in moved {
+        for f in mesh.faces_around(v) {
+            refresh.extend(
+                mesh.faces()[f as usize]
+                    .into_iter()
+                    .filter(|&w| marks.insert(w as usize)),
+            );
+        }
+    }
     refresh.sort_unstable();
-    refresh.dedup();
     mesh.recompute_normals_at(&refresh);
     kernels.normals_changed(mesh, &refresh);
     call.changed.extend_from_slice(&refresh);
@@ -723,9 +748,10 @@ fn stroke_state<'s>(
     prepared: &'s Prepared,
     active: &'s [bool],
     lengths: Lengths,
-    fast: bool,
+    (fast, cull): (bool, bool),
 ) -> StrokeState<'s> {
     StrokeState {
+        cull,
         grid: fast.then_some(&prepared.grid),
         active,
         parallel: fast,

@@ -161,10 +161,18 @@ fn check_clamp_loop(scene: ProximityScene) {
             collision_distance: 0.5 * scene.edge,
             ring: 2,
             max_edge: longest_edge(mesh),
+            cull: true,
         };
-        let (region, target_of) = gathered_region(&state, mesh, &selection, &targets);
+        let (mut region, target_of) = gathered_region(&state, mesh, &selection, &targets);
         let mut on_cpu = mesh.clone();
-        slayer::collide::clamp_moves(&state, &region, &mut on_cpu, &selection, &targets, &before);
+        slayer::collide::clamp_moves(
+            &state,
+            &mut region,
+            &mut on_cpu,
+            &selection,
+            &targets,
+            &before,
+        );
         let mut on_gpu = mesh.clone();
         let backstop = kernels.clamp(
             &state,

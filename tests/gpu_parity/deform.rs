@@ -48,6 +48,7 @@ fn check_deform(binding: Binding) {
         collision_distance: 0.05,
         ring: 2,
         max_edge: 0.08,
+        cull: true,
     };
     let neighbours = smoothing_neighbours(&mesh, 0);
     let (mut worst_mirror, mut worst_gpu) = (0.0f32, 0.0f32);

@@ -64,6 +64,7 @@ fn reference_pull_back(
         collision_distance: distance,
         ring,
         max_edge: longest_edge(mesh).max(longest_edge(&current)),
+        cull: true,
     };
     let pairs: Vec<(u32, f32)> = selection.iter().map(|&v| (v, 1.0)).collect();
     let targets: Vec<Vec3> = selection

@@ -326,6 +326,7 @@ fn select_mirror_matches_the_cpu_pipeline_for_every_falloff() {
         collision_distance: 0.1,
         ring: 2,
         max_edge: 0.15,
+        cull: true,
     };
     let flags = flag_bits(&mesh);
     let layers = mesh.vertex_layers().to_vec();

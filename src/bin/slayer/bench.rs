@@ -26,6 +26,8 @@ pub struct Options {
     pub remeshing: Remeshing,
     /// Samples per `add_samples` call (`None`: a stroke's samples in one call).
     pub samples_per_call: Option<usize>,
+    /// Skip the collision searches that cannot find anything (`--no-cull` turns it off).
+    pub cull: bool,
 }
 
 /// `--scene`: one scene name, `all` (the paper's three materials) or `none` (scaling only).
@@ -87,7 +89,7 @@ fn bench_scene(
     triangles: usize,
     strokes: usize,
     seed: u64,
-    (remeshing, chosen, feed): (Remeshing, Backend, Option<usize>),
+    (remeshing, chosen, feed, cull): (Remeshing, Backend, Option<usize>, bool),
 ) -> anyhow::Result<SceneRun> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
@@ -102,6 +104,7 @@ fn bench_scene(
         &ScriptSpec {
             strokes,
             seed,
+            mix: slayer::bench::BrushMix::for_scene(kind),
             ..ScriptSpec::default()
         },
     );
@@ -109,6 +112,7 @@ fn bench_scene(
     steps.finish();
     let settings = PipelineSettings {
         remeshing,
+        cull,
         ..PipelineSettings::default()
     };
     let start = mesh.clone();
@@ -177,7 +181,12 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
             triangles,
             options.strokes,
             options.seed,
-            (options.remeshing, resolved, options.samples_per_call),
+            (
+                options.remeshing,
+                resolved,
+                options.samples_per_call,
+                options.cull,
+            ),
         )?);
     }
     let scenes: Vec<SceneResult> = runs.iter().map(|r| r.result.clone()).collect();
@@ -276,7 +285,12 @@ fn scaling_rows(options: &Options, backend: Backend) -> anyhow::Result<Vec<Scali
             faces,
             options.strokes.min(8),
             options.seed,
-            (options.remeshing, backend, options.samples_per_call),
+            (
+                options.remeshing,
+                backend,
+                options.samples_per_call,
+                options.cull,
+            ),
         )?
         .result;
         scaling.push(ScalingRow {

@@ -124,6 +124,10 @@ enum Command {
         /// lavapipe included).
         #[arg(long, default_value = "auto", value_name = "auto|cpu|gpu")]
         backend: backend::Backend,
+        /// Test every vertex against everything near it, even where the layer is a sheet that
+        /// cannot touch itself or no other layer is near: the same result, slower; to compare.
+        #[arg(long)]
+        no_cull: bool,
     },
     /// Undo the last entries of a session file's history and write the result.
     Undo {
@@ -181,7 +185,8 @@ enum Command {
     },
     /// Time the brush pipeline on generated scenes, in the layout of the sLayer paper's Table 1.
     Bench {
-        /// plaster, bark, metal, or all.
+        /// plaster, bark, metal (the paper's materials), plane (straight draw strokes), sphere
+        /// (inflate and grab), or all (the three materials).
         #[arg(long, default_value = "all")]
         scene: String,
         #[arg(long)]
@@ -215,6 +220,10 @@ enum Command {
         /// pointer event (default: the whole stroke in one call, the batch).
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         samples_per_call: Option<u64>,
+        /// Test every vertex against everything near it, even where the layer is a sheet that
+        /// cannot touch itself or no other layer is near: the same result, slower; to compare.
+        #[arg(long)]
+        no_cull: bool,
     },
     /// Render a mesh file to a PNG with the preview renderer (headless; lavapipe without a GPU).
     ///
@@ -365,6 +374,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             symmetry,
             remesh,
             backend,
+            no_cull,
         } => sculpt::run(&sculpt::Args {
             input: &input,
             strokes: &strokes,
@@ -376,6 +386,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             remeshing: remesh,
             backend,
             strict,
+            cull: !no_cull,
         }),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output, strict),
         Command::Undo {
@@ -460,6 +471,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             backend,
             remesh,
             samples_per_call,
+            no_cull,
         } => {
             let scenes = match bench::parse_scenes(&scene) {
                 Ok(scenes) => scenes,
@@ -479,6 +491,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
                 backend,
                 remeshing: remesh,
                 samples_per_call: samples_per_call.map(|n| n as usize),
+                cull: !no_cull,
             })
         }
     }

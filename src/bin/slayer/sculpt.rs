@@ -25,6 +25,8 @@ pub struct Args<'a> {
     pub backend: crate::backend::Backend,
     /// Refuse an input mesh that needs repairs.
     pub strict: bool,
+    /// Skip the collision searches that cannot find anything (`--no-cull`: off).
+    pub cull: bool,
 }
 
 /// Applies a stroke file to a mesh or session and writes the result (and the stats) as one
@@ -50,6 +52,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         PipelineSettings {
             remeshing: args.remeshing,
             max_dabs_per_stroke: args.max_dabs,
+            cull: args.cull,
             ..PipelineSettings::default()
         },
     )?

@@ -26,7 +26,7 @@ pub fn run(
         mix: if torture {
             BrushMix::Torture
         } else {
-            BrushMix::Bench
+            BrushMix::for_scene(kind)
         },
         ..ScriptSpec::default()
     };

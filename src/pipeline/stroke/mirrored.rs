@@ -54,7 +54,7 @@ impl Active {
             return None;
         }
         let moved = self.deform_mirrored_in_steps(kernels, mesh, &sides, call);
-        refresh_normals(kernels, mesh, &moved, call);
+        refresh_normals(kernels, mesh, &moved, &mut self.scratch.vertex_marks, call);
         Some(moved)
     }
 

@@ -1,0 +1,261 @@
+//! Culling within a layer: the parts of a step's region where a layer is a *sheet*, a surface
+//! that cannot come within the collision distance of itself, so the searches of a vertex
+//! against its own layer there (the proximity clamp's, the backstop's) are skipped. A plain
+//! draw on one flat layer then tests nothing against nothing, where it used to prove, face by
+//! face, that the sheet does not touch itself.
+//!
+//! The test is the normal-cone test of Volino & Magnenat-Thalmann (a surface whose normals lie
+//! in a cone of half-angle < 90° around an axis `a`, and whose boundary projected along `a` is
+//! one simple loop, projects one-to-one onto the plane across `a`), adapted to proximity.
+//!
+//! **Why no vertex of a sheet comes within `d` of a face of it outside its exclusion ring.**
+//! Let `S` be the region's faces of one layer, every unit normal `n` with `n·a ≥ cos θ > 0`,
+//! its boundary (edges with one face in `S`) one loop, not on the mesh's rim, simple once
+//! projected along `a`, and every boundary edge farther than `d / cos θ` from the box of the
+//! step's moves. Then:
+//! 1. The projection is one-to-one: all faces keep their orientation in it, so a point of the
+//!    plane has as many points of `S` above it as the projected loop winds around it, 0 or 1.
+//! 2. A straight segment of length `h` in the projection of `S` lifts to a path on `S` no
+//!    longer than `h / cos θ` (a face's slope along any direction is at most `tan θ`).
+//! 3. A moving vertex `v` (inside the box of the moves) is more than `d` from the boundary in
+//!    the projection: the segment to the nearest boundary point lifts to a path shorter than
+//!    `d / cos θ`, which would end nearer `v` than every boundary edge is.
+//! 4. Let `φ` be the graph distance from `v`, interpolated linearly over each face. Neighbours
+//!    differ by at most 1, so on a face `|∇φ| ≤ 1 / ρ`, `ρ` the face's smallest altitude. A
+//!    face outside `v`'s `r`-ring has `φ ≥ r + 1`, so any path to it on `S` is at least
+//!    `(r + 1)·ρ_min` long.
+//! 5. A point `q` of such a face with `|v − q| < d` would be above the disk of radius `d`
+//!    around `v` (inside `S`'s projection by 3), reached by a lifted segment of length at most
+//!    `|v − q| / cos θ` (by 2), so `|v − q| ≥ cos θ·(r + 1)·ρ_min`. The sheet test asks for
+//!    that to be at least `d`, with a margin for rounding.
+//!
+//! By 1 no two faces of a sheet meet beyond what they share either, so the backstop's pair
+//! tests within it find nothing. The test costs one pass over the region's faces and its
+//! boundary; `tests/culling.rs` compares culled and unculled strokes on folded, pinched,
+//! twisted and crumpled sheets, which must end identical.
+
+use glam::{DVec2, DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::region::Region;
+use super::state::StrokeState;
+use crate::geom::Aabb;
+use crate::mesh::{INVALID, Mesh, face_of, next, prev};
+
+/// Relative margin on the distance bound: far above `f32` rounding in the clamp's distances.
+const MARGIN: f64 = 1e-3;
+
+/// Per layer id: whether the region's faces of that layer, where the mesh is now, form a sheet
+/// (the module's conditions), for the `layers` present in the region.
+pub(super) fn find_sheets(
+    state: &StrokeState<'_>,
+    mesh: &Mesh,
+    region: &Region,
+    layers: &[u32],
+) -> Vec<bool> {
+    let mut sheets = vec![false; mesh.layer_count()];
+    let face_layers = mesh.face_layers();
+    if let [layer] = layers {
+        sheets[*layer as usize] = is_sheet(state, mesh, region, &region.faces);
+        return sheets;
+    }
+    for &layer in layers {
+        let of_layer: Vec<u32> = region
+            .faces
+            .iter()
+            .copied()
+            .filter(|&f| face_layers[f as usize] == layer)
+            .collect();
+        sheets[layer as usize] = is_sheet(state, mesh, region, &of_layer);
+    }
+    sheets
+}
+
+fn is_sheet(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]) -> bool {
+    let Some(cone) = normal_cone(mesh, faces, state.parallel) else {
+        return false;
+    };
+    let d = state.collision_distance as f64 * (1.0 + MARGIN);
+    if cone.cos * (state.ring + 1) as f64 * cone.min_altitude < d {
+        return false;
+    }
+    let Some(boundary) = boundary_loop(mesh, region, faces) else {
+        return false;
+    };
+    let far_enough = d / cone.cos;
+    let edge_far = |&(u, w): &(u32, u32)| {
+        let (p, q) = (mesh.positions()[u as usize], mesh.positions()[w as usize]);
+        box_gap(&region.bounds, &Aabb::of_points(&[p, q])) > far_enough
+    };
+    let ends = boundary.windows(2).map(|w| (w[0], w[1]));
+    let closing = (boundary[boundary.len() - 1], boundary[0]);
+    ends.chain(std::iter::once(closing)).all(|e| edge_far(&e))
+        && projected_loop_is_simple(mesh, &boundary, cone.axis)
+}
+
+struct Cone {
+    axis: DVec3,
+    /// The smallest `n·axis` over the faces' unit normals.
+    cos: f64,
+    min_altitude: f64,
+}
+
+/// The faces' normals' cone around their area-weighted mean, and their smallest altitude; none
+/// for a degenerate face or a cone as wide as a hemisphere.
+fn normal_cone(mesh: &Mesh, faces: &[u32], parallel: bool) -> Option<Cone> {
+    // Per face: its normal (twice its area long) and its longest edge, squared.
+    let shape = |&f: &u32| {
+        let [a, b, c] = mesh.face_positions(f as usize).map(|p| p.as_dvec3());
+        let (ab, bc, ca) = (b - a, c - b, a - c);
+        let longest = ab
+            .length_squared()
+            .max(bc.length_squared())
+            .max(ca.length_squared());
+        (ab.cross(-ca), longest)
+    };
+    let shapes: Vec<(DVec3, f64)> = if parallel {
+        faces.par_iter().map(shape).collect()
+    } else {
+        faces.iter().map(shape).collect()
+    };
+    // Summed in the region's order, which is the same on every run.
+    let axis = shapes.iter().map(|s| s.0).sum::<DVec3>().try_normalize()?;
+    // The smallest cos², and altitude², without a root per face.
+    let mut cos_squared = 1.0f64;
+    let mut altitude_squared = f64::INFINITY;
+    for &(n, longest) in &shapes {
+        let (along, area_squared) = (n.dot(axis), n.length_squared());
+        if along <= 0.0 || area_squared == 0.0 {
+            return None;
+        }
+        cos_squared = cos_squared.min(along * along / area_squared);
+        altitude_squared = altitude_squared.min(area_squared / longest);
+    }
+    Some(Cone {
+        axis,
+        cos: cos_squared.sqrt(),
+        min_altitude: altitude_squared.sqrt(),
+    })
+}
+
+/// The vertices of the one loop that bounds `faces`, in order; none when the faces touch the
+/// mesh's rim, or their boundary is several loops or passes a vertex twice.
+fn boundary_loop(mesh: &Mesh, region: &Region, faces: &[u32]) -> Option<Vec<u32>> {
+    let layers = mesh.face_layers();
+    let layer = layers[faces[0] as usize];
+    let opposite = &mesh.adjacency().opposite;
+    // Each edge directed as its face runs: next(c) → prev(c) for the corner facing it.
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    for &f in faces {
+        for c in 3 * f..3 * f + 3 {
+            let o = opposite[c as usize];
+            if o == INVALID {
+                return None;
+            }
+            let g = face_of(o);
+            if layers[g as usize] != layer || region.local(g).is_none() {
+                edges.push((mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c))));
+            }
+        }
+    }
+    if edges.len() < 3 {
+        return None;
+    }
+    edges.sort_unstable();
+    if edges.windows(2).any(|w| w[0].0 == w[1].0) {
+        return None;
+    }
+    let mut ordered = Vec::with_capacity(edges.len());
+    let mut at = edges[0].0;
+    for _ in 0..edges.len() {
+        ordered.push(at);
+        let i = edges.binary_search_by_key(&at, |e| e.0).ok()?;
+        at = edges[i].1;
+        if at == ordered[0] {
+            break;
+        }
+    }
+    (at == ordered[0] && ordered.len() == edges.len()).then_some(ordered)
+}
+
+/// The per-axis gap between two boxes (0 when they overlap): a lower bound on the distance
+/// between any point of one and any point of the other.
+fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
+    let gap = (a.min - b.max).max(b.min - a.max).max(Vec3::ZERO);
+    gap.max_element() as f64
+}
+
+/// Whether the closed polyline through `loop_vertices`, projected along `axis`, is simple:
+/// no two edges closer than a hair (touching counts as crossing), no edge folded back onto
+/// the next. Edges are bucketed in a grid of cells about one edge long.
+fn projected_loop_is_simple(mesh: &Mesh, loop_vertices: &[u32], axis: DVec3) -> bool {
+    let (u, w) = axis.any_orthonormal_pair();
+    let points: Vec<DVec2> = loop_vertices
+        .iter()
+        .map(|&v| {
+            let p = mesh.positions()[v as usize].as_dvec3();
+            DVec2::new(p.dot(u), p.dot(w))
+        })
+        .collect();
+    let n = points.len();
+    let edge = |i: usize| (points[i], points[(i + 1) % n]);
+    let longest = (0..n)
+        .map(|i| edge(i).0.distance(edge(i).1))
+        .fold(0.0f64, f64::max);
+    if longest == 0.0 {
+        return false;
+    }
+    let hair = 1e-6 * longest;
+    // Consecutive edges may only meet at their shared point.
+    for i in 0..n {
+        let (a, b) = edge(i);
+        let c = edge((i + 1) % n).1;
+        let (back, ahead) = (a - b, c - b);
+        if back.perp_dot(ahead).abs() <= hair * back.length() && back.dot(ahead) > 0.0 {
+            return false;
+        }
+    }
+    let lo = points.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+    let cell_of = |p: DVec2| ((p - lo) / longest).floor().as_ivec2();
+    let mut cells: Vec<(glam::IVec2, u32)> = Vec::with_capacity(4 * n);
+    for i in 0..n {
+        let (a, b) = edge(i);
+        let (c0, c1) = (cell_of(a.min(b) - hair), cell_of(a.max(b) + hair));
+        for x in c0.x..=c1.x {
+            for y in c0.y..=c1.y {
+                cells.push((glam::IVec2::new(x, y), i as u32));
+            }
+        }
+    }
+    cells.sort_unstable_by_key(|&(c, i)| (c.x, c.y, i));
+    let apart = |i: usize, j: usize| {
+        let adjacent = (i + 1) % n == j || (j + 1) % n == i;
+        adjacent || segments_apart(edge(i), edge(j), hair)
+    };
+    cells.chunk_by(|a, b| a.0 == b.0).all(|cell| {
+        cell.iter().enumerate().all(|(k, &(_, i))| {
+            cell[k + 1..]
+                .iter()
+                .all(|&(_, j)| apart(i as usize, j as usize))
+        })
+    })
+}
+
+/// Whether two segments neither cross nor come within `hair` of each other.
+fn segments_apart((a, b): (DVec2, DVec2), (c, d): (DVec2, DVec2), hair: f64) -> bool {
+    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let crossing = side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0;
+    if crossing {
+        return false;
+    }
+    let to_segment = |p: DVec2, (s, t): (DVec2, DVec2)| {
+        let st = t - s;
+        let k = ((p - s).dot(st) / st.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+        p.distance(s + st * k)
+    };
+    to_segment(a, (c, d))
+        .min(to_segment(b, (c, d)))
+        .min(to_segment(c, (a, b)))
+        .min(to_segment(d, (a, b)))
+        > hair
+}

@@ -1,0 +1,210 @@
+//! Culling changes nothing: the collision searches skipped where a layer is a sheet that cannot
+//! touch itself (`collide::sheet`), or where no other layer is near, would have found nothing.
+//! Every stroke here runs twice, culled and not, on shapes chosen to break a careless bound —
+//! a sheet folded back onto itself, a crumpled one, pinched, twisted and creased ones, a closed
+//! sphere and a layered material with remeshing on — and must end bit-identical, with the same
+//! clamps and undos. The flat sheet shows the culling acts at all.
+
+use glam::Vec3;
+use slayer::bench::{BrushMix, ScriptSpec, generate_script};
+use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
+use slayer::mesh::Mesh;
+use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+
+fn scene(kind: SceneKind, triangles: usize) -> Mesh {
+    generate(&SceneSpec {
+        kind,
+        triangles,
+        seed: 3,
+    })
+    .unwrap()
+}
+
+fn script(mesh: &Mesh, mix: BrushMix, strokes: usize) -> Vec<Stroke> {
+    let spec = ScriptSpec {
+        strokes,
+        seed: 5,
+        samples: 12,
+        mix,
+        ..ScriptSpec::default()
+    };
+    generate_script(mesh, &spec)
+        .resolve(mesh, "script")
+        .unwrap()
+}
+
+/// What one run did: the mesh's digest, and its clamps, undos and culled steps.
+#[derive(Debug)]
+struct Run {
+    digest: String,
+    clamped: usize,
+    reverted: usize,
+    culled_steps: usize,
+    steps: usize,
+}
+
+fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run {
+    let mut mesh = mesh.clone();
+    let mut pipeline = Pipeline::new(PipelineSettings {
+        remeshing,
+        cull,
+        ..PipelineSettings::default()
+    });
+    let mut outcome = Run {
+        digest: String::new(),
+        clamped: 0,
+        reverted: 0,
+        culled_steps: 0,
+        steps: 0,
+    };
+    for stroke in strokes {
+        let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+        outcome.clamped += report.clamped;
+        outcome.reverted += report.reverted;
+        outcome.culled_steps += report.culled_steps;
+        outcome.steps += report.steps;
+    }
+    mesh.validate().unwrap();
+    outcome.digest = mesh.digest();
+    outcome
+}
+
+/// Runs `strokes` culled and not; they must end identical. Returns the culled run.
+fn assert_culling_changes_nothing(
+    name: &str,
+    mesh: &Mesh,
+    strokes: &[Stroke],
+    remeshing: Remeshing,
+) -> Run {
+    let culled = run(mesh, strokes, remeshing, true);
+    let searched = run(mesh, strokes, remeshing, false);
+    assert_eq!(searched.culled_steps, 0, "{name}: culling off still culled");
+    assert_eq!(
+        (&culled.digest, culled.clamped, culled.reverted),
+        (&searched.digest, searched.clamped, searched.reverted),
+        "{name}: culling changed the result"
+    );
+    eprintln!(
+        "{name}: {} steps, {} culled, {} clamped, {} undone",
+        culled.steps, culled.culled_steps, culled.clamped, culled.reverted
+    );
+    culled
+}
+
+/// Moves every vertex of `mesh` by `shape`, given its position in the unit square.
+fn reshaped(mut mesh: Mesh, shape: impl Fn(f32, f32) -> Vec3) -> Mesh {
+    let (lo, hi) = mesh.bounds().unwrap();
+    let size = hi - lo;
+    for p in mesh.positions_mut() {
+        let (u, v) = ((p.x - lo.x) / size.x, (p.y - lo.y) / size.y);
+        *p = shape(u, v);
+    }
+    mesh.recompute_normals();
+    mesh
+}
+
+#[test]
+fn a_plain_draw_on_a_flat_sheet_is_culled() {
+    let mesh = scene(SceneKind::Plane, 6_000);
+    let strokes = script(&mesh, BrushMix::StraightDraw, 4);
+    let run = assert_culling_changes_nothing("flat sheet", &mesh, &strokes, Remeshing::AfterStroke);
+    // Only the steps whose region reaches the sheet's rim are searched.
+    assert!(
+        run.culled_steps * 2 > run.steps,
+        "a flat sheet is a sheet: {run:?}"
+    );
+}
+
+#[test]
+fn a_sheet_folded_onto_itself_collides_the_same() {
+    // A hairpin: the sheet runs along x, turns over a half circle and comes back above
+    // itself, three edge lengths higher; draws on the upper half push it into the lower one.
+    let flat = scene(SceneKind::Plane, 6_000);
+    let edge = flat.mean_edge_length();
+    let gap = 3.0 * edge;
+    let turn = std::f32::consts::PI * gap / 2.0;
+    let straight = (1.0 - turn) / 2.0;
+    let mesh = reshaped(flat, |u, v| {
+        let t = u;
+        if t < straight {
+            Vec3::new(t, v, 0.0)
+        } else if t < straight + turn {
+            let angle = (t - straight) / (gap / 2.0);
+            Vec3::new(
+                straight + gap / 2.0 * angle.sin(),
+                v,
+                gap / 2.0 * (1.0 - angle.cos()),
+            )
+        } else {
+            Vec3::new(straight - (t - straight - turn), v, gap)
+        }
+    });
+    // Narrower than the gap, so that the brush moves the upper half only, back and forth
+    // over the same stretch until it meets the lower one.
+    let draw_down = |y: f32| Stroke {
+        paint: None,
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius: 0.8 * gap,
+            strength: 1.0,
+            falloff: Falloff::Smooth,
+            invert: false,
+        },
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        samples: (0..40)
+            .map(|k| Sample {
+                position: Vec3::new(0.2 + 0.1 * ((k % 8) as f32 / 7.0), y, gap),
+                pressure: 1.0,
+                normal: Some(-Vec3::Z),
+            })
+            .collect(),
+    };
+    let strokes: Vec<Stroke> = [0.3, 0.5, 0.7].map(draw_down).into();
+    let run = assert_culling_changes_nothing("folded sheet", &mesh, &strokes, Remeshing::Off);
+    assert!(
+        run.clamped > 0,
+        "the fold must collide with itself: {run:?}"
+    );
+}
+
+#[test]
+fn crumpled_pinched_twisted_and_creased_sheets_end_the_same() {
+    let flat = scene(SceneKind::Plane, 5_000);
+    let edge = flat.mean_edge_length();
+    let crumpled = reshaped(flat.clone(), |u, v| {
+        let tau = std::f32::consts::TAU;
+        Vec3::new(
+            u,
+            v,
+            4.0 * edge * (tau * 3.0 * u).sin() * (tau * 2.5 * v).sin(),
+        )
+    });
+    for (name, mesh) in [
+        ("torture on a flat sheet", flat),
+        ("crumpled sheet", crumpled),
+    ] {
+        let strokes = script(&mesh, BrushMix::Torture, 16);
+        let kinds: Vec<BrushKind> = strokes.iter().map(|s| s.brush.kind).collect();
+        assert!(
+            [BrushKind::Pinch, BrushKind::Twist, BrushKind::Crease]
+                .iter()
+                .any(|k| kinds.contains(k)),
+            "{name}: the torture mix should pinch, twist or crease: {kinds:?}"
+        );
+        assert_culling_changes_nothing(name, &mesh, &strokes, Remeshing::Off);
+    }
+}
+
+#[test]
+fn a_closed_sphere_and_a_layered_material_end_the_same() {
+    let sphere = scene(SceneKind::Sphere, 5_000);
+    let strokes = script(&sphere, BrushMix::InflateGrab, 10);
+    assert_culling_changes_nothing("sphere", &sphere, &strokes, Remeshing::AfterStroke);
+    let plaster = scene(SceneKind::Plaster, 6_000);
+    let strokes = script(&plaster, BrushMix::Torture, 14);
+    let run = assert_culling_changes_nothing("plaster", &plaster, &strokes, Remeshing::AfterStroke);
+    assert!(run.clamped > 0, "plaster's layers must collide: {run:?}");
+}
