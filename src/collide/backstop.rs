@@ -7,6 +7,7 @@
 use glam::Vec3;
 
 use super::region::{Region, StepMoves, map_with_scratch, start_position, triangle};
+use super::sheet;
 use super::state::StrokeState;
 use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
 use crate::mesh::{INVALID, Mesh};
@@ -84,9 +85,16 @@ pub(super) fn undo_crossings(
                 region.find_sheets(state, mesh);
                 let all_local = moving_faces.iter().all(|&f| region.local(f).is_some());
                 if region.worth_searching() || !all_local {
-                    region.file_faces();
+                    region.file_faces(mesh, moves, before);
                 }
-                crossings(state, region, mesh, &moving_faces, (target_of, before))
+                let kept = kept_orientation(state, region, mesh, (target_of, before));
+                crossings(
+                    state,
+                    region,
+                    mesh,
+                    (&moving_faces, &kept),
+                    (target_of, before),
+                )
             }
         };
         if pairs.is_empty() {
@@ -141,7 +149,7 @@ fn gather_from_start(
     state: &StrokeState<'_>,
     region: &mut Region,
     mesh: &mut Mesh,
-    (selection, targets, target_of): StepMoves<'_>,
+    (selection, targets, _): StepMoves<'_>,
     before: &[Vec3],
 ) {
     let now: Vec<Vec3> = selection
@@ -152,11 +160,31 @@ fn gather_from_start(
     for (&(v, _), &p) in selection.iter().zip(before) {
         positions[v as usize] = p;
     }
-    region.gather_unfiled(state, mesh, selection, targets, target_of);
+    region.gather_unfiled(state, mesh, selection, targets);
     let positions = mesh.positions_mut();
     for (&(v, _), p) in selection.iter().zip(now) {
         positions[v as usize] = p;
     }
+}
+
+/// Per layer id: whether the layer is a sheet in the region whose faces all kept their
+/// orientation since the step's start (`super::sheet::kept_orientation`).
+fn kept_orientation(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    (target_of, before): (&[u32], &[Vec3]),
+) -> Vec<bool> {
+    let mut kept = vec![false; mesh.layer_count()];
+    for (layer, kept) in kept.iter_mut().enumerate() {
+        let Some(cone) = region.sheet_cone(layer as u32) else {
+            continue;
+        };
+        let faces = sheet::faces_of_layer(mesh, region, layer as u32);
+        let start = |v: u32| start_position(mesh, v, target_of, before);
+        *kept = sheet::kept_orientation(state, mesh, &faces, cone, start);
+    }
+    kept
 }
 
 /// Whether face `f` turned over in the step: its normal before (vertices of the selection at
@@ -207,54 +235,68 @@ fn crossings(
     state: &StrokeState<'_>,
     region: &Region,
     mesh: &Mesh,
-    moving_faces: &[u32],
+    (moving_faces, kept_orientation): (&[u32], &[bool]),
     (target_of, before): (&[u32], &[Vec3]),
 ) -> Vec<(u32, u32)> {
     let is_moving = |f: u32| region.face_marks.contains(f as usize);
-    let found: Vec<Vec<(u32, u32)>> =
-        map_with_scratch(state.parallel, moving_faces, |scratch, &f| {
-            let tri_f = triangle(mesh, f);
-            let box_f = Aabb::of_points(&tri_f);
-            let faces = mesh.faces();
-            let mut found = Vec::new();
-            if turned_over(mesh, f, target_of, before) {
-                found.push((f, f));
-            }
-            // Two faces of a sheet never meet beyond what they share (`super::sheet`).
-            let layer = mesh.face_layers()[f as usize];
-            let in_sheet = |g: u32| {
-                region.is_sheet(layer)
-                    && mesh.face_layers()[g as usize] == layer
-                    && region.local(f).is_some()
-                    && region.local(g).is_some()
-            };
-            // Nor may the step fold two faces around a shared vertex onto each other: they
-            // overlap while sharing a vertex, which the pair test skips.
-            let ids_f = faces[f as usize];
-            for w in ids_f {
-                for g in mesh.faces_around(w) {
-                    if g == f || (g < f && is_moving(g)) || in_sheet(g) {
-                        continue;
-                    }
-                    let tri_g = triangle(mesh, g);
-                    if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
-                        found.push((f.min(g), f.max(g)));
-                    }
+    let layers = mesh.face_layers();
+    // Two faces of a sheet never meet beyond what they share (`super::sheet`).
+    let in_sheet = |f: u32, g: u32| {
+        let layer = layers[f as usize];
+        region.is_sheet(layer)
+            && layers[g as usize] == layer
+            && region.local(f).is_some()
+            && region.local(g).is_some()
+    };
+    // A face of a sheet alone in the region that kept its orientation has nothing to find.
+    let searched: Vec<u32> = moving_faces
+        .iter()
+        .copied()
+        .filter(|&f| {
+            !(region.single_layer()
+                && in_sheet(f, f)
+                && kept_orientation[layers[f as usize] as usize])
+        })
+        .collect();
+    let found: Vec<Vec<(u32, u32)>> = map_with_scratch(state.parallel, &searched, |scratch, &f| {
+        let tri_f = triangle(mesh, f);
+        let box_f = Aabb::of_points(&tri_f);
+        let faces = mesh.faces();
+        let mut found = Vec::new();
+        let layer = layers[f as usize];
+        let in_sheet = |g: u32| in_sheet(f, g);
+        if !(in_sheet(f) && kept_orientation[layer as usize])
+            && turned_over(mesh, f, target_of, before)
+        {
+            found.push((f, f));
+        }
+        // Nor may the step fold two faces around a shared vertex onto each other: they
+        // overlap while sharing a vertex, which the pair test skips.
+        let ids_f = faces[f as usize];
+        for w in ids_f {
+            for g in mesh.faces_around(w) {
+                if g == f || (g < f && is_moving(g)) || in_sheet(g) {
+                    continue;
                 }
-            }
-            if in_sheet(f) && region.single_layer() {
-                return found;
-            }
-            region.candidates(&box_f, scratch, |local| {
-                let g = region.faces[local];
-                if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
-                    return;
-                }
-                if apart_faces_cross(tri_f, &box_f, triangle(mesh, g)) {
+                let tri_g = triangle(mesh, g);
+                if neighbours_overlap(tri_f, ids_f, tri_g, faces[g as usize]) {
                     found.push((f.min(g), f.max(g)));
                 }
-            });
-            found
+            }
+        }
+        if in_sheet(f) && region.single_layer() {
+            return found;
+        }
+        region.candidates(&box_f, scratch, |local| {
+            let g = region.faces[local];
+            if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
+                return;
+            }
+            if apart_faces_cross(tri_f, &box_f, triangle(mesh, g)) {
+                found.push((f.min(g), f.max(g)));
+            }
         });
+        found
+    });
     found.into_iter().flatten().collect()
 }

@@ -6,6 +6,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::sheet::Cone;
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps};
 use crate::geom::Aabb;
@@ -68,7 +69,7 @@ pub struct Region {
     layers: Vec<u32>,
     /// Per layer id: whether the region's faces of that layer are a sheet where the mesh is
     /// now (`super::sheet`); `None` once a vertex moved since it was found.
-    sheets: Option<Vec<bool>>,
+    sheets: Option<Vec<Option<Cone>>>,
     /// The first look this step found no sheet.
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
@@ -87,8 +88,12 @@ impl Region {
         targets: &[Vec3],
         target_of: &[u32],
     ) {
-        self.gather_unfiled(state, mesh, selection, targets, target_of);
-        self.file_faces();
+        self.gather_unfiled(state, mesh, selection, targets);
+        let before: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| mesh.positions()[v as usize])
+            .collect();
+        self.file_faces(mesh, (selection, targets, target_of), &before);
     }
 
     /// [`Region::gather`] without filing the faces in the local grid: the searches that need
@@ -99,7 +104,6 @@ impl Region {
         mesh: &Mesh,
         selection: &[(u32, f32)],
         targets: &[Vec3],
-        target_of: &[u32],
     ) {
         let positions = mesh.positions();
         let mut bounds = Aabb::EMPTY;
@@ -141,19 +145,6 @@ impl Region {
                 }
             }
         }
-        self.boxes.clear();
-        self.boxes.extend(self.faces.iter().map(|&f| {
-            mesh.faces()[f as usize].iter().fold(Aabb::EMPTY, |b, &v| {
-                let p = positions[v as usize];
-                let slot = target_of[v as usize];
-                let b = b.including(p);
-                if slot == INVALID {
-                    b
-                } else {
-                    b.including(targets[slot as usize])
-                }
-            })
-        }));
         let mut present = vec![false; mesh.layer_count()];
         for &f in &self.faces {
             present[mesh.face_layers()[f as usize] as usize] = true;
@@ -169,9 +160,27 @@ impl Region {
         self.filed = false;
     }
 
-    /// Files the faces in the local grid, once per gathering.
-    pub(super) fn file_faces(&mut self) {
-        if let (false, Some(cell)) = (self.filed, self.cell) {
+    /// Boxes the faces (around where each vertex starts the step and, if it moves, its
+    /// target; `before` holds the selection's starts) and files them in the local grid, once
+    /// per gathering.
+    pub(super) fn file_faces(&mut self, mesh: &Mesh, moves: StepMoves<'_>, before: &[Vec3]) {
+        if self.filed {
+            return;
+        }
+        let (_, targets, target_of) = moves;
+        let positions = mesh.positions();
+        self.boxes.clear();
+        self.boxes.extend(self.faces.iter().map(|&f| {
+            mesh.faces()[f as usize]
+                .iter()
+                .fold(Aabb::EMPTY, |b, &v| match target_of[v as usize] {
+                    INVALID => b.including(positions[v as usize]),
+                    slot => b
+                        .including(before[slot as usize])
+                        .including(targets[slot as usize]),
+                })
+        }));
+        if let Some(cell) = self.cell {
             self.grid.build(&self.boxes, self.reach, cell);
         }
         self.filed = true;
@@ -208,7 +217,7 @@ impl Region {
         } else {
             Vec::new()
         });
-        self.no_sheet_this_step = !self.sheets.iter().flatten().any(|&sheet| sheet);
+        self.no_sheet_this_step = !self.sheets.iter().flatten().any(Option::is_some);
     }
 
     /// Whether the first look this step found a layer that is a sheet, whose searches
@@ -224,9 +233,12 @@ impl Region {
 
     /// Whether `layer` is a sheet where the mesh is now, as far as known.
     pub(super) fn is_sheet(&self, layer: u32) -> bool {
-        self.sheets
-            .as_ref()
-            .is_some_and(|sheets| sheets.get(layer as usize) == Some(&true))
+        self.sheet_cone(layer).is_some()
+    }
+
+    /// The normal cone of `layer` where the mesh is now, if it is a sheet, as far as known.
+    pub(super) fn sheet_cone(&self, layer: u32) -> Option<&Cone> {
+        self.sheets.as_ref()?.get(layer as usize)?.as_ref()
     }
 
     /// Whether every face of the region is of one layer.

@@ -214,8 +214,8 @@ pub fn clamp_in_region(
     (selection, targets, target_of): StepMoves<'_>,
     before: &[Vec3],
 ) -> Backstop {
-    region.gather_unfiled(state, mesh, selection, targets, target_of);
-    clamp_moves(state, region, mesh, selection, targets, before);
+    region.gather_unfiled(state, mesh, selection, targets);
+    clamp_moves(state, region, mesh, (selection, targets, target_of), before);
     Backstop::Search
 }
 
@@ -226,10 +226,10 @@ pub fn clamp_moves(
     state: &StrokeState<'_>,
     region: &mut Region,
     mesh: &mut Mesh,
-    selection: &[(u32, f32)],
-    targets: &[Vec3],
+    moves: StepMoves<'_>,
     before: &[Vec3],
 ) {
+    let (selection, targets, _) = moves;
     {
         let positions = mesh.positions_mut();
         for (&(v, _), &q) in selection.iter().zip(targets) {
@@ -250,7 +250,7 @@ pub fn clamp_moves(
             .collect();
         region.find_sheets(state, mesh);
         if region.worth_searching() {
-            region.file_faces();
+            region.file_faces(mesh, moves, before);
         }
         let region_view: &Region = region;
         let mesh_view: &Mesh = mesh;

@@ -45,43 +45,49 @@ use crate::mesh::{INVALID, Mesh, face_of, next, prev};
 /// Relative margin on the distance bound: far above `f32` rounding in the clamp's distances.
 const MARGIN: f64 = 1e-3;
 
-/// Per layer id: whether the region's faces of that layer, where the mesh is now, form a sheet
-/// (the module's conditions), for the `layers` present in the region.
+/// Per layer id: the normal cone of the region's faces of that layer where the mesh is now, if
+/// they form a sheet (the module's conditions), for the `layers` present in the region.
 pub(super) fn find_sheets(
     state: &StrokeState<'_>,
     mesh: &Mesh,
     region: &Region,
     layers: &[u32],
-) -> Vec<bool> {
-    let mut sheets = vec![false; mesh.layer_count()];
-    let face_layers = mesh.face_layers();
-    if let [layer] = layers {
-        sheets[*layer as usize] = is_sheet(state, mesh, region, &region.faces);
-        return sheets;
-    }
+) -> Vec<Option<Cone>> {
+    let mut sheets = vec![None; mesh.layer_count()];
     for &layer in layers {
-        let of_layer: Vec<u32> = region
-            .faces
-            .iter()
-            .copied()
-            .filter(|&f| face_layers[f as usize] == layer)
-            .collect();
-        sheets[layer as usize] = is_sheet(state, mesh, region, &of_layer);
+        let faces = faces_of_layer(mesh, region, layer);
+        sheets[layer as usize] = sheet_cone(state, mesh, region, &faces);
     }
     sheets
 }
 
-fn is_sheet(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]) -> bool {
-    let Some(cone) = normal_cone(mesh, faces, state.parallel) else {
-        return false;
-    };
+/// The region's faces of `layer`, in the region's order.
+pub(super) fn faces_of_layer<'r>(
+    mesh: &Mesh,
+    region: &'r Region,
+    layer: u32,
+) -> std::borrow::Cow<'r, [u32]> {
+    if region.single_layer() {
+        return std::borrow::Cow::Borrowed(&region.faces);
+    }
+    let layers = mesh.face_layers();
+    let faces = region.faces.iter().copied();
+    std::borrow::Cow::Owned(faces.filter(|&f| layers[f as usize] == layer).collect())
+}
+
+fn sheet_cone(
+    state: &StrokeState<'_>,
+    mesh: &Mesh,
+    region: &Region,
+    faces: &[u32],
+) -> Option<Cone> {
+    let now = |v: u32| mesh.positions()[v as usize];
+    let cone = normal_cone(mesh, faces, now, state.parallel)?;
     let d = state.collision_distance as f64 * (1.0 + MARGIN);
     if cone.cos * (state.ring + 1) as f64 * cone.min_altitude < d {
-        return false;
+        return None;
     }
-    let Some(boundary) = boundary_loop(mesh, region, faces) else {
-        return false;
-    };
+    let boundary = boundary_loop(mesh, region, faces)?;
     let far_enough = d / cone.cos;
     let edge_far = |&(u, w): &(u32, u32)| {
         let (p, q) = (mesh.positions()[u as usize], mesh.positions()[w as usize]);
@@ -89,23 +95,50 @@ fn is_sheet(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]
     };
     let ends = boundary.windows(2).map(|w| (w[0], w[1]));
     let closing = (boundary[boundary.len() - 1], boundary[0]);
-    ends.chain(std::iter::once(closing)).all(|e| edge_far(&e))
-        && projected_loop_is_simple(mesh, &boundary, cone.axis)
+    let sheet = ends.chain(std::iter::once(closing)).all(|e| edge_far(&e))
+        && projected_loop_is_simple(mesh, &boundary, cone.axis);
+    sheet.then_some(cone)
 }
 
-struct Cone {
+/// Whether no face of a sheet whose cone is `now` turned over since the step's start, when
+/// the same faces' normals at the start (`start` gives each vertex's start) lie in a cone
+/// too: every normal is then within the two cones' half-angles and their axes' angle of every
+/// other, which stays below 90° with room for rounding — the backstop's turned-over test
+/// (the normals' dot product at most 0) finds nothing.
+pub(super) fn kept_orientation(
+    state: &StrokeState<'_>,
+    mesh: &Mesh,
+    faces: &[u32],
+    now: &Cone,
+    start: impl Fn(u32) -> Vec3 + Sync,
+) -> bool {
+    let Some(then) = normal_cone(mesh, faces, start, state.parallel) else {
+        return false;
+    };
+    let spread = now.cos.acos() + then.cos.acos() + now.axis.angle_between(then.axis);
+    spread < 85f64.to_radians()
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Cone {
     axis: DVec3,
     /// The smallest `n·axis` over the faces' unit normals.
     cos: f64,
     min_altitude: f64,
 }
 
-/// The faces' normals' cone around their area-weighted mean, and their smallest altitude; none
-/// for a degenerate face or a cone as wide as a hemisphere.
-fn normal_cone(mesh: &Mesh, faces: &[u32], parallel: bool) -> Option<Cone> {
+/// The faces' normals' cone around their area-weighted mean, and their smallest altitude, with
+/// vertices where `position` puts them; none for a degenerate face or a cone as wide as a
+/// hemisphere.
+fn normal_cone(
+    mesh: &Mesh,
+    faces: &[u32],
+    position: impl Fn(u32) -> Vec3 + Sync,
+    parallel: bool,
+) -> Option<Cone> {
     // Per face: its normal (twice its area long) and its longest edge, squared.
     let shape = |&f: &u32| {
-        let [a, b, c] = mesh.face_positions(f as usize).map(|p| p.as_dvec3());
+        let [a, b, c] = mesh.faces()[f as usize].map(|v| position(v).as_dvec3());
         let (ab, bc, ca) = (b - a, c - b, a - c);
         let longest = ab
             .length_squared()

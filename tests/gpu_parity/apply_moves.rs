@@ -169,8 +169,7 @@ fn check_clamp_loop(scene: ProximityScene) {
             &state,
             &mut region,
             &mut on_cpu,
-            &selection,
-            &targets,
+            (&selection, &targets, &target_of),
             &before,
         );
         let mut on_gpu = mesh.clone();
