@@ -1,6 +1,8 @@
 //! The brush pipeline's phases on their own (CPU): selection through the grid, deformation,
 //! and collision (proximity clamping plus the exact backstop) for one draw dab pressing the
-//! upper layers of a 200K-face plaster scene into the base.
+//! upper layers of a 200K-face plaster scene into the base; and the collision phase alone,
+//! culled and not (`PipelineSettings::cull`), for a draw on a 1M-face flat sheet, an inflate
+//! on a 200K-face sphere and the plaster dab.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -87,5 +89,79 @@ fn phases(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, phases);
+/// One dab's collision phase, culled and searched, at the centre of a scene's top layer.
+fn collision_alone(c: &mut Criterion, kind: SceneKind, triangles: usize, brush: BrushKind) {
+    let mesh = generate(&SceneSpec {
+        kind,
+        triangles,
+        seed: 1,
+    })
+    .unwrap();
+    let edge = mesh.mean_edge_length();
+    let grid = SpatialHash::build(&mesh, edge).unwrap();
+    let top_layer = mesh.layer_count() as u32 - 1;
+    let active: Vec<bool> = (0..=top_layer).map(|l| l == top_layer).collect();
+    let (lo, hi) = mesh.bounds().unwrap();
+    let above = Vec3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, hi.z);
+    let center = (0..mesh.vertex_count())
+        .filter(|&v| mesh.vertex_layers()[v] == top_layer)
+        .map(|v| mesh.positions()[v])
+        .min_by(|a, b| a.distance(above).total_cmp(&b.distance(above)))
+        .unwrap();
+    let dab = Dab {
+        brush: Brush {
+            kind: brush,
+            radius: 0.05 * (hi - lo).x,
+            strength: 0.5,
+            falloff: Falloff::Blend { n: 3 },
+            // Pressing into what lies below.
+            invert: brush == BrushKind::Draw,
+        },
+        frame: DabFrame {
+            center,
+            normal: Vec3::Z,
+            plane_point: center,
+            motion: Vec3::ZERO,
+        },
+        pressure: 1.0,
+        share: 1.0,
+    };
+    let mut group = c.benchmark_group(format!("collision alone: {kind} {triangles} faces"));
+    group.sample_size(20);
+    for cull in [true, false] {
+        let state = StrokeState {
+            grid: Some(&grid),
+            active: &active,
+            parallel: true,
+            collision_distance: edge,
+            ring: exclusion_ring(&mesh, edge),
+            max_edge: mesh.edge_length_stats().max as f32,
+            cull,
+        };
+        let selection = select(&state, &mesh, &dab);
+        let targets = deform(&state, &mesh, &dab, &selection);
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        for (i, &(v, _)) in selection.iter().enumerate() {
+            target_of[v as usize] = i as u32;
+        }
+        let mut region = Region::default();
+        let name = if cull { "culled" } else { "searched" };
+        group.bench_function(format!("{brush:?} {name}"), |b| {
+            b.iter_batched_ref(
+                || mesh.clone(),
+                |m| collide(&state, &mut region, m, &selection, &targets, &target_of).clamped,
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+fn collision(c: &mut Criterion) {
+    collision_alone(c, SceneKind::Plane, 1_000_000, BrushKind::Draw);
+    collision_alone(c, SceneKind::Sphere, 200_000, BrushKind::Inflate);
+    collision_alone(c, SceneKind::Plaster, 200_000, BrushKind::Draw);
+}
+
+criterion_group!(benches, phases, collision);
 criterion_main!(benches);
