@@ -16,7 +16,7 @@ use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
-use crate::mesh::{Mesh, MeshVersion};
+use crate::mesh::{Mesh, MeshVersion, next, prev};
 use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
 
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
@@ -323,6 +323,22 @@ pub(super) fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
             .map(edge_max)
             .reduce(|| 0.0, f32::max),
     }
+}
+
+/// The longest edge at `vertices`: after they moved, the only edges whose length changed.
+pub(super) fn longest_edge_at(mesh: &Mesh, vertices: &[u32]) -> f32 {
+    let positions = mesh.positions();
+    vertices
+        .par_iter()
+        .map(|&v| {
+            let p = positions[v as usize];
+            mesh.adjacency()
+                .corners_around(v)
+                .flat_map(|c| [next(c), prev(c)])
+                .map(|c| p.distance(positions[mesh.corner_vertex(c) as usize]))
+                .fold(0.0f32, f32::max)
+        })
+        .reduce(|| 0.0, f32::max)
 }
 
 pub(super) fn millis(since: Instant) -> f64 {

@@ -11,7 +11,9 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::engine::{Pipeline, Prepared, Scratch, longest_edge, millis, remesh_touched};
+use super::engine::{
+    Pipeline, Prepared, Scratch, longest_edge, longest_edge_at, millis, remesh_touched,
+};
 use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
@@ -561,13 +563,8 @@ impl Active {
             .collect();
         let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         kernels.moved(mesh, &selected, largest_move(&before, &outcome.positions));
-        let mut moved_faces: Vec<u32> = moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
-        moved_faces.sort_unstable();
-        moved_faces.dedup();
         let prepared = &mut self.prepared;
-        prepared.max_edge = prepared
-            .max_edge
-            .max(longest_edge(mesh, Some(&moved_faces)));
+        prepared.max_edge = prepared.max_edge.max(longest_edge_at(mesh, &moved));
         call.phases.collision += millis(started);
 
         let started = Instant::now();
