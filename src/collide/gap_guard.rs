@@ -159,6 +159,9 @@ struct OtherLayers {
     grid: LocalFaceGrid,
 }
 
+/// Vertices per face past which the faces probe the global grid instead of filing them.
+const PROBE_INSTEAD: usize = 16;
+
 fn other_layers_near(
     state: &StrokeState<'_>,
     region: &Region,
@@ -187,6 +190,12 @@ fn other_layers_near(
         .copied()
         .filter(|&y| !one_layer || vertex_layers[y as usize] != first)
         .collect();
+    // Filing costs per vertex what a probe of the global grid costs per face over a few
+    // dozen cells: with few faces among many vertices, probing is cheaper (and finds the
+    // same).
+    if vertices.len() > PROBE_INSTEAD * faces.len() {
+        return None;
+    }
     let mut grid = LocalFaceGrid::default();
     if !vertices.is_empty() {
         let points: Vec<Aabb> = vertices

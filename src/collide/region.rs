@@ -67,6 +67,8 @@ pub struct Region {
     pub(super) ready: bool,
     /// The layers of the region's faces, ascending.
     layers: Vec<u32>,
+    /// The layers of the step's selection, ascending: those whose searches may be skipped.
+    moving_layers: Vec<u32>,
     /// Per layer id: whether the region's faces of that layer are a sheet where the mesh is
     /// now (`super::sheet`); `None` once a vertex moved since it was found.
     sheets: Option<Vec<Option<Cone>>>,
@@ -152,6 +154,14 @@ impl Region {
         self.layers.clear();
         self.layers
             .extend((0..present.len() as u32).filter(|&l| present[l as usize]));
+        // Only a moving vertex's own layer is ever skipped: only those layers are tested.
+        present.fill(false);
+        for &(v, _) in selection {
+            present[mesh.vertex_layers()[v as usize] as usize] = true;
+        }
+        self.moving_layers.clear();
+        self.moving_layers
+            .extend((0..present.len() as u32).filter(|&l| present[l as usize]));
         self.sheets = None;
         self.no_sheet_this_step = false;
         self.ready = true;
@@ -213,7 +223,7 @@ impl Region {
             return;
         }
         self.sheets = Some(if state.cull {
-            super::sheet::find_sheets(state, mesh, self, &self.layers)
+            super::sheet::find_sheets(state, mesh, self, &self.moving_layers)
         } else {
             Vec::new()
         });

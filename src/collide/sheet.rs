@@ -81,13 +81,15 @@ fn sheet_cone(
     region: &Region,
     faces: &[u32],
 ) -> Option<Cone> {
+    // The loop first: a layer with a rim in the region (a flake, a peeling patch) is no
+    // sheet, found without computing a normal.
+    let boundary = boundary_loop(mesh, region, faces)?;
     let now = |v: u32| mesh.positions()[v as usize];
     let cone = normal_cone(mesh, faces, now, state.parallel)?;
     let d = state.collision_distance as f64 * (1.0 + MARGIN);
     if cone.cos * (state.ring + 1) as f64 * cone.min_altitude < d {
         return None;
     }
-    let boundary = boundary_loop(mesh, region, faces)?;
     let far_enough = d / cone.cos;
     let edge_far = |&(u, w): &(u32, u32)| {
         let (p, q) = (mesh.positions()[u as usize], mesh.positions()[w as usize]);
