@@ -10,10 +10,30 @@ use slayer::brush::{Brush, BrushKind, Dab, DabFrame, Falloff};
 use slayer::collide::neighbourhood::exclusion_ring;
 use slayer::collide::{Region, StrokeState, collide};
 use slayer::grid::SpatialHash;
-use slayer::mesh::INVALID;
+use slayer::mesh::{INVALID, Mesh};
 use slayer::pipeline::step::{deform, select};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 use std::hint::black_box;
+
+/// The whole stroke's state for `mesh`, filed in `grid` (cell = the mean edge, which is also
+/// the collision distance), on all cores.
+fn stroke_state<'a>(
+    mesh: &Mesh,
+    grid: &'a SpatialHash,
+    active: &'a [bool],
+    cull: bool,
+) -> StrokeState<'a> {
+    let edge = grid.cell_size();
+    StrokeState {
+        grid: Some(grid),
+        active,
+        parallel: true,
+        collision_distance: edge,
+        ring: exclusion_ring(mesh, edge),
+        max_edge: mesh.edge_length_stats().max as f32,
+        cull,
+    }
+}
 
 fn phases(c: &mut Criterion) {
     let mesh = generate(&SceneSpec {
@@ -25,15 +45,7 @@ fn phases(c: &mut Criterion) {
     let edge = mesh.mean_edge_length();
     let grid = SpatialHash::build(&mesh, edge).unwrap();
     let active = vec![false, true, true];
-    let state = StrokeState {
-        grid: Some(&grid),
-        active: &active,
-        parallel: true,
-        collision_distance: edge,
-        ring: exclusion_ring(&mesh, edge),
-        max_edge: mesh.edge_length_stats().max as f32,
-        cull: true,
-    };
+    let state = stroke_state(&mesh, &grid, &active, true);
     // The middle of the paint layer, pushed down hard.
     let (lo, hi) = mesh.bounds().unwrap();
     let center = (lo + hi) * 0.5;
@@ -129,15 +141,7 @@ fn collision_alone(c: &mut Criterion, kind: SceneKind, triangles: usize, brush: 
     let mut group = c.benchmark_group(format!("collision alone: {kind} {triangles} faces"));
     group.sample_size(20);
     for cull in [true, false] {
-        let state = StrokeState {
-            grid: Some(&grid),
-            active: &active,
-            parallel: true,
-            collision_distance: edge,
-            ring: exclusion_ring(&mesh, edge),
-            max_edge: mesh.edge_length_stats().max as f32,
-            cull,
-        };
+        let state = stroke_state(&mesh, &grid, &active, cull);
         let selection = select(&state, &mesh, &dab);
         let targets = deform(&state, &mesh, &dab, &selection);
         let mut target_of = vec![INVALID; mesh.vertex_count()];

@@ -58,15 +58,8 @@ pub(super) fn undo_crossings(
         .map(|(&(v, _), _)| v)
         .collect();
     loop {
-        // Each face once, in the order met (the pairs found are sorted); the marks then say
-        // which faces are moving.
-        let marks = &mut region.face_marks;
-        marks.start(mesh.face_count());
-        let moving_faces: Vec<u32> = changed
-            .iter()
-            .flat_map(|&v| mesh.faces_around(v))
-            .filter(|&f| marks.insert(f as usize))
-            .collect();
+        // In the order met: the pairs found are sorted.
+        let moving_faces = region.faces_around_once(mesh, changed.iter().copied());
         if moving_faces.is_empty() {
             break;
         }
@@ -227,7 +220,7 @@ fn face_normal(t: [Vec3; 3]) -> Vec3 {
     (t[1] - t[0]).cross(t[2] - t[0])
 }
 
-/// The crossing pairs of `moving_faces` (marked in `region.face_marks`), searched in the gathered region: each
+/// The crossing pairs of `moving_faces` (the region's last listed faces), searched in the gathered region: each
 /// moving face against itself (turned over), the faces around its vertices (overlap beyond
 /// a shared vertex) and the region's faces whose boxes meet its box. A pair of two moving
 /// faces is tested from the lower one.
@@ -238,7 +231,7 @@ fn crossings(
     (moving_faces, kept_orientation): (&[u32], &[bool]),
     (target_of, before): (&[u32], &[Vec3]),
 ) -> Vec<(u32, u32)> {
-    let is_moving = |f: u32| region.face_marks.contains(f as usize);
+    let is_moving = |f: u32| region.is_listed(f);
     let layers = mesh.face_layers();
     // Two faces of a sheet never meet beyond what they share (`super::sheet`).
     let in_sheet = |f: u32, g: u32| {

@@ -49,14 +49,8 @@ pub(super) fn undo_gap_violations(
             .filter(|((v, _), p)| mesh.positions()[*v as usize] != **p)
             .map(|((v, _), _)| *v);
         let view: &Mesh = mesh;
-        // Each face once, in the order met: what is found does not depend on it.
-        let marks = &mut region.face_marks;
-        marks.start(view.face_count());
-        let faces: Vec<u32> = moved
-            .chain(went_back.iter().copied())
-            .flat_map(|v| view.faces_around(v))
-            .filter(|&f| marks.insert(f as usize))
-            .collect();
+        // In the order met: what is found does not depend on it.
+        let faces = region.faces_around_once(view, moved.chain(went_back.iter().copied()));
         let region: &Region = region;
         let others = other_layers_near(state, region, view, &faces, drift);
         if others.as_ref().is_some_and(|near| near.vertices.is_empty()) {

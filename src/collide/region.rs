@@ -75,7 +75,7 @@ pub struct Region {
     /// The first look this step found no sheet.
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
-    pub(super) face_marks: Stamps,
+    face_marks: Stamps,
 }
 
 impl Region {
@@ -147,21 +147,13 @@ impl Region {
                 }
             }
         }
-        let mut present = vec![false; mesh.layer_count()];
-        for &f in &self.faces {
-            present[mesh.face_layers()[f as usize] as usize] = true;
-        }
-        self.layers.clear();
-        self.layers
-            .extend((0..present.len() as u32).filter(|&l| present[l as usize]));
+        let face_layers = self.faces.iter().map(|&f| mesh.face_layers()[f as usize]);
+        layers_among(mesh.layer_count(), face_layers, &mut self.layers);
         // Only a moving vertex's own layer is ever skipped: only those layers are tested.
-        present.fill(false);
-        for &(v, _) in selection {
-            present[mesh.vertex_layers()[v as usize] as usize] = true;
-        }
-        self.moving_layers.clear();
-        self.moving_layers
-            .extend((0..present.len() as u32).filter(|&l| present[l as usize]));
+        let moving = selection
+            .iter()
+            .map(|&(v, _)| mesh.vertex_layers()[v as usize]);
+        layers_among(mesh.layer_count(), moving, &mut self.moving_layers);
         self.sheets = None;
         self.no_sheet_this_step = false;
         self.ready = true;
@@ -266,6 +258,27 @@ impl Region {
         &self.vertices
     }
 
+    /// The faces around `vertices`, each once, in the order met; [`Region::is_listed`] then
+    /// says whether a face is among them.
+    pub(super) fn faces_around_once(
+        &mut self,
+        mesh: &Mesh,
+        vertices: impl IntoIterator<Item = u32>,
+    ) -> Vec<u32> {
+        let marks = &mut self.face_marks;
+        marks.start(mesh.face_count());
+        vertices
+            .into_iter()
+            .flat_map(|v| mesh.faces_around(v))
+            .filter(|&f| marks.insert(f as usize))
+            .collect()
+    }
+
+    /// Whether `face` was among the last [`Region::faces_around_once`].
+    pub(super) fn is_listed(&self, face: u32) -> bool {
+        self.face_marks.contains(face as usize)
+    }
+
     /// Index of a mesh face in this region, if it is in it.
     pub(super) fn local(&self, face: u32) -> Option<usize> {
         self.gathered
@@ -309,4 +322,14 @@ pub(super) fn start_position(mesh: &Mesh, v: u32, target_of: &[u32], before: &[V
 
 pub(super) fn triangle(mesh: &Mesh, f: u32) -> [Vec3; 3] {
     mesh.face_positions(f as usize)
+}
+
+/// The distinct layer ids among `ids` (below `count`), ascending, into `out`.
+fn layers_among(count: usize, ids: impl Iterator<Item = u32>, out: &mut Vec<u32>) {
+    let mut present = vec![false; count];
+    for id in ids {
+        present[id as usize] = true;
+    }
+    out.clear();
+    out.extend((0..count as u32).filter(|&l| present[l as usize]));
 }
