@@ -137,6 +137,8 @@ impl Worker {
 
     /// Serves commands until the UI hangs up.
     pub fn run(mut self) {
+        // The undo copy, on this thread now rather than in the first stroke.
+        self.session.prepare_history();
         self.rebuild_picker();
         self.send_changes();
         self.send_status();
@@ -206,6 +208,7 @@ impl Worker {
         match crate::session::open_with(&path, &Default::default()) {
             Ok((session, report)) => {
                 self.session = session;
+                self.session.prepare_history();
                 // The file as opened is saved: `after_edit` counts the change of document.
                 self.saved_revision = self.revision + 1;
                 for line in report.lines() {

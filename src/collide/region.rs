@@ -79,6 +79,13 @@ pub struct Region {
 }
 
 impl Region {
+    /// Sizes the per-face arrays for `mesh` ahead of the first step (set-up, not a stroke's).
+    pub fn size_for(&mut self, mesh: &Mesh) {
+        self.gathered.size_for(mesh.face_count());
+        self.face_marks.size_for(mesh.face_count());
+        crate::grow::grow_to(&mut self.local_index, mesh.face_count(), 0);
+    }
+
     /// Collects the faces around the step's moves, ready for searching (public so that
     /// `tests/gpu_parity/` can check the GPU proximity mirror against
     /// [`pull_back`](super::pull_back)).
@@ -136,8 +143,7 @@ impl Region {
         // Faces of those vertices, each once. Their order does not matter: every result below
         // is a minimum or a sorted set.
         self.gathered.start(mesh.face_count());
-        self.local_index
-            .resize(mesh.face_count().max(self.local_index.len()), 0);
+        crate::grow::grow_to(&mut self.local_index, mesh.face_count(), 0);
         self.faces.clear();
         for &v in &self.vertices {
             for f in mesh.faces_around(v) {

@@ -11,15 +11,18 @@ pub struct Stamps {
 impl Stamps {
     /// Empties the set and makes room for indices below `len`.
     pub fn start(&mut self, len: usize) {
-        if self.marks.len() < len {
-            self.marks.resize(len, 0);
-        }
+        crate::grow::grow_to(&mut self.marks, len, 0);
         self.round = self.round.wrapping_add(1);
         if self.round == 0 {
             // After 2³² rounds the marks could alias: clear them once.
             self.marks.fill(0);
             self.round = 1;
         }
+    }
+
+    /// Makes room for indices below `len` without starting a round (set-up, ahead of use).
+    pub fn size_for(&mut self, len: usize) {
+        crate::grow::grow_to(&mut self.marks, len, 0);
     }
 
     /// Adds `index`; true when it was not in the set yet this round.

@@ -189,12 +189,11 @@ impl SpatialHash {
     /// Files `vertex` at position `p`. O(1) amortized; a vertex already present is moved.
     pub fn insert(&mut self, vertex: u32, p: Vec3) {
         let v = vertex as usize;
-        if v >= self.cell_of.len() {
-            let n = (v + 1).max(self.cell_of.len() * 2);
-            self.cell_of.resize(n, ABSENT);
-            self.next.resize(n, INVALID);
-            self.prev.resize(n, INVALID);
-        }
+        // Grown gently (an eighth at a time, `crate::grow`): doubling would copy and fill
+        // all three arrays at the first vertex a stroke adds to a large mesh.
+        crate::grow::grow_to(&mut self.cell_of, v + 1, ABSENT);
+        crate::grow::grow_to(&mut self.next, v + 1, INVALID);
+        crate::grow::grow_to(&mut self.prev, v + 1, INVALID);
         if self.cell_of[v] != ABSENT {
             self.move_to(vertex, p);
             return;

@@ -17,6 +17,9 @@ use super::IoError;
 /// What ends every temporary file's name before `.PID`.
 const TEMP_MARK: &str = ".slayer-tmp.";
 
+/// Bytes gathered before each write to a staged file.
+const WRITE_BUFFER: usize = 1 << 20;
+
 /// Files written together: [`AtomicBatch::stage`] each, then [`AtomicBatch::commit`]. Dropping
 /// a batch without committing removes what it staged and leaves every target as it was.
 #[derive(Debug, Default)]
@@ -46,6 +49,16 @@ impl AtomicBatch {
 
     /// Writes `bytes` to a synced temporary file beside `path`; nothing visible changes yet.
     pub fn stage(&mut self, path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+        self.stage_with(path, |out| out.write_all(bytes))
+    }
+
+    /// Streams what `write` writes (buffered) to a synced temporary file beside `path`, so a
+    /// large file is never held whole in memory; nothing visible changes yet.
+    pub fn stage_with(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<(), IoError> {
         let folder = folder_of(path);
         if !self.swept.contains(&folder) {
             sweep_stale_temporaries(&folder);
@@ -57,12 +70,12 @@ impl AtomicBatch {
             target: path.to_path_buf(),
             temporary: temporary.clone(),
         });
-        let write = || -> io::Result<()> {
-            let mut file = fs::File::create(&temporary)?;
-            file.write_all(bytes)?;
-            file.sync_all()
+        let written = || -> io::Result<()> {
+            let mut out = io::BufWriter::with_capacity(WRITE_BUFFER, fs::File::create(&temporary)?);
+            write(&mut out)?;
+            out.into_inner().map_err(|e| e.into_error())?.sync_all()
         };
-        write().map_err(|source| io_error(path, source))
+        written().map_err(|source| io_error(path, source))
     }
 
     /// Renames every staged file over its target and syncs the folders. On a failed rename the

@@ -27,6 +27,7 @@ pub use obj::{LibraryReader, write_obj, write_obj_with_materials};
 pub use ply::write_ply;
 pub use stl::write_stl;
 
+use std::io::Write;
 use std::path::{Component, Path};
 
 use crate::mesh::Mesh;
@@ -162,16 +163,12 @@ fn refuse_unusable(
 /// `slayer check` can report them.
 pub fn load_mesh(path: &Path, options: &ImportOptions) -> Result<(Mesh, ImportReport), IoError> {
     let format = Format::of_path(path)?;
-    let bytes = read_bytes(path)?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let beside = |library: &str| read_library(folder, library);
-    load_mesh_bytes(
-        &bytes,
-        format,
-        &path.display().to_string(),
-        options,
-        &beside,
-    )
+    let name = path.display().to_string();
+    // The file's bytes go before the mesh is built: they would be a third of the peak.
+    let parsed = parse(&read_bytes(path)?, format, &name, &beside)?;
+    import::build(parsed, options, &name)
 }
 
 /// [`load_mesh`] on bytes already in memory; `libraries` reads the material libraries an OBJ
@@ -183,18 +180,38 @@ pub fn load_mesh_bytes(
     options: &ImportOptions,
     libraries: LibraryReader<'_>,
 ) -> Result<(Mesh, ImportReport), IoError> {
-    let parsed: Parsed = match format {
-        Format::Obj => obj::parse_obj(bytes, name, libraries)?,
-        Format::Ply => ply::parse_ply(bytes, name)?,
-        Format::Stl => stl::parse_stl(bytes, name)?,
-        Format::Glb | Format::Gltf => gltf::parse_gltf(bytes, name, libraries)?,
-    };
-    import::build(parsed, options, name)
+    import::build(parse(bytes, format, name, libraries)?, options, name)
+}
+
+fn parse(
+    bytes: &[u8],
+    format: Format,
+    name: &str,
+    libraries: LibraryReader<'_>,
+) -> Result<Parsed, IoError> {
+    match format {
+        Format::Obj => obj::parse_obj(bytes, name, libraries),
+        Format::Ply => ply::parse_ply(bytes, name),
+        Format::Stl => stl::parse_stl(bytes, name),
+        Format::Glb | Format::Gltf => gltf::parse_gltf(bytes, name, libraries),
+    }
 }
 
 /// A reader of material libraries for bytes that came from no folder.
 pub fn no_libraries(_: &str) -> Result<Vec<u8>, String> {
     Err("the mesh was not read from a folder".into())
+}
+
+/// Bytes a writer gathers before handing them on.
+const WRITE_CHUNK: usize = 1 << 16;
+
+/// Hands `buffer` on to `out` once it holds a chunk.
+fn flush_chunk(out: &mut impl Write, buffer: &mut Vec<u8>) -> std::io::Result<()> {
+    if buffer.len() >= WRITE_CHUNK {
+        out.write_all(buffer)?;
+        buffer.clear();
+    }
+    Ok(())
 }
 
 /// A file another names in `folder` (an OBJ's material library, a `.gltf`'s buffer): a relative
@@ -243,25 +260,23 @@ pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
 }
 
 /// Stages a mesh's file (and an OBJ's `.mtl`) in `batch`, to be written with other files as
-/// one unit.
+/// one unit. The file is streamed: a mesh is never held twice in memory, once as bytes.
 pub fn stage_mesh(batch: &mut AtomicBatch, mesh: &Mesh, path: &Path) -> Result<(), IoError> {
     match Format::of_path(path)? {
-        format @ (Format::Ply | Format::Stl | Format::Glb | Format::Gltf) => {
-            batch.stage(path, &encode_mesh(mesh, format))
-        }
+        Format::Ply => batch.stage_with(path, |mut out| write_ply(mesh, &mut out)),
+        Format::Stl => batch.stage_with(path, |mut out| write_stl(mesh, &mut out)),
+        Format::Glb => batch.stage_with(path, |mut out| write_glb(mesh, &mut out)),
+        Format::Gltf => batch.stage_with(path, |mut out| write_gltf(mesh, &mut out)),
         Format::Obj => {
             let library = path.with_extension("mtl");
             let library_name = library
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "materials.mtl".into());
-            let mut obj = Vec::new();
-            let mut mtl = Vec::new();
-            // Writing into a Vec cannot fail.
-            let _ = write_obj_with_materials(mesh, &mut obj, Some(&library_name));
-            let _ = write_mtl(mesh, &mut mtl);
-            batch.stage(path, &obj)?;
-            batch.stage(&library, &mtl)
+            batch.stage_with(path, |mut out| {
+                write_obj_with_materials(mesh, &mut out, Some(&library_name))
+            })?;
+            batch.stage_with(&library, |mut out| write_mtl(mesh, &mut out))
         }
     }
 }

@@ -8,8 +8,8 @@ use std::io::{self, Write};
 
 use glam::Vec3;
 
-use super::IoError;
 use super::import::{ImportReport, Parsed};
+use super::{IoError, WRITE_CHUNK, flush_chunk};
 use crate::material::{linear_to_srgb, srgb_to_linear};
 use crate::mesh::{Brdf, INVALID, LayerId, Mesh, Soup, VertexFlags};
 
@@ -685,12 +685,13 @@ fn layer_names(named: &[(u32, String)], face_layers: &[LayerId]) -> Vec<String> 
 
 /// Writes the live mesh as binary little-endian PLY.
 pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
-    let live: Vec<usize> = (0..mesh.vertex_count())
-        .filter(|&v| mesh.is_vertex_live(v as u32))
-        .collect();
     let mut file_index = vec![INVALID; mesh.vertex_count()];
-    for (i, &v) in live.iter().enumerate() {
-        file_index[v] = i as u32;
+    let mut live_vertices = 0u32;
+    for (v, index) in file_index.iter_mut().enumerate() {
+        if mesh.is_vertex_live(v as u32) {
+            *index = live_vertices;
+            live_vertices += 1;
+        }
     }
     let live_faces = mesh.live_face_count();
     writeln!(out, "ply")?;
@@ -699,7 +700,7 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     for (id, layer_name) in mesh.layer_names().iter().enumerate() {
         writeln!(out, "comment slayer layer {id} {layer_name}")?;
     }
-    writeln!(out, "element vertex {}", live.len())?;
+    writeln!(out, "element vertex {live_vertices}")?;
     for p in ["x", "y", "z", "nx", "ny", "nz"]
         .iter()
         .chain(&BRDF_PROPERTIES)
@@ -716,8 +717,9 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     writeln!(out, "property list uchar uint vertex_indices")?;
     writeln!(out, "property uint layer")?;
     writeln!(out, "end_header")?;
-    let mut buffer: Vec<u8> = Vec::with_capacity(live.len() * 60 + live_faces * 17);
-    for &v in &live {
+    // Rows gathered in a chunk at a time: the file is streamed, never held whole.
+    let mut buffer: Vec<u8> = Vec::with_capacity(WRITE_CHUNK + 256);
+    for v in (0..mesh.vertex_count()).filter(|&v| file_index[v] != INVALID) {
         let p = mesh.positions()[v];
         let n = mesh.normals()[v];
         for value in [p.x, p.y, p.z, n.x, n.y, n.z]
@@ -732,6 +734,7 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
         buffer.extend_from_slice(&mesh.vertex_layers()[v].to_le_bytes());
         let persistent = mesh.flags()[v] & VertexFlags::PERSISTENT;
         buffer.extend_from_slice(&persistent.bits().to_le_bytes());
+        flush_chunk(out, &mut buffer)?;
     }
     for (t, &layer) in mesh.faces().iter().zip(mesh.face_layers()) {
         if t[0] == INVALID {
@@ -742,6 +745,7 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
             buffer.extend_from_slice(&file_index[v as usize].to_le_bytes());
         }
         buffer.extend_from_slice(&layer.to_le_bytes());
+        flush_chunk(out, &mut buffer)?;
     }
     out.write_all(&buffer)
 }

@@ -7,9 +7,9 @@ use std::io::{self, Write};
 
 use glam::Vec3;
 
-use super::IoError;
 use super::import::Parsed;
 use super::weld::SoupBuilder as Builder;
+use super::{IoError, WRITE_CHUNK, flush_chunk};
 use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// The start of the 80-byte header of a binary STL slayer wrote; the layer names follow,
@@ -162,7 +162,7 @@ pub fn write_stl(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     let mut header = format!("{OWN_HEADER}{}", names.join("|")).into_bytes();
     header.resize(HEADER_BYTES, 0);
     let live = mesh.live_face_count();
-    let mut buffer = Vec::with_capacity(HEADER_BYTES + 4 + live * TRIANGLE_BYTES);
+    let mut buffer = Vec::with_capacity(WRITE_CHUNK + HEADER_BYTES + TRIANGLE_BYTES);
     buffer.extend_from_slice(&header);
     buffer.extend_from_slice(&(live as u32).to_le_bytes());
     for (f, (tri, &layer)) in mesh.faces().iter().zip(mesh.face_layers()).enumerate() {
@@ -177,6 +177,7 @@ pub fn write_stl(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
             }
         }
         buffer.extend_from_slice(&(layer.min(u16::MAX as u32) as u16).to_le_bytes());
+        flush_chunk(out, &mut buffer)?;
     }
     out.write_all(&buffer)
 }

@@ -72,47 +72,70 @@ impl CornerTable {
         }
         let vertex = |c: u32| faces[c as usize / 3][c as usize % 3];
 
-        // Each corner names the edge opposite it, directed next → prev. Sorting by the undirected
-        // key groups the (at most two) corners that face each other.
-        let mut keyed: Vec<(u64, u32)> = (0..corner_count as u32)
-            .into_par_iter()
-            .filter(|&c| vertex(c) != INVALID)
-            .map(|c| {
-                let (a, b) = (vertex(next(c)), vertex(prev(c)));
-                let key = ((a.min(b) as u64) << 32) | a.max(b) as u64;
-                (key, c)
-            })
-            .collect();
-        keyed.par_sort_unstable();
+        // Each corner names the edge opposite it, directed next → prev. Corners are filed by
+        // the lower vertex of that edge (a counting sort: 4 bytes a corner, where sorting
+        // (key, corner) pairs took 16, the largest allocation of loading a big mesh), then
+        // within each vertex's few by the higher one, which groups the (at most two) corners
+        // that face each other. Vertices are taken in order, so the first bad edge reported
+        // is the one with the smallest key.
+        let ends = |c: u32| {
+            let (a, b) = (vertex(next(c)), vertex(prev(c)));
+            (a.min(b), a.max(b))
+        };
+        let mut offsets = vec![0u32; vertex_count + 1];
+        for c in (0..corner_count as u32).filter(|&c| vertex(c) != INVALID) {
+            offsets[ends(c).0 as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut filed = vec![INVALID; offsets[vertex_count] as usize];
+        let mut cursor = offsets.clone();
+        for c in (0..corner_count as u32).filter(|&c| vertex(c) != INVALID) {
+            let low = ends(c).0 as usize;
+            filed[cursor[low] as usize] = c;
+            cursor[low] += 1;
+        }
+        drop(cursor);
 
         let mut opposite = vec![INVALID; corner_count];
-        let mut start = 0;
-        while start < keyed.len() {
-            let key = keyed[start].0;
-            let mut end = start + 1;
-            while end < keyed.len() && keyed[end].0 == key {
-                end += 1;
-            }
-            let (a, b) = ((key >> 32) as u32, key as u32);
-            match end - start {
-                1 => {}
-                2 => {
-                    let (c0, c1) = (keyed[start].1, keyed[start + 1].1);
-                    if vertex(next(c0)) == vertex(next(c1)) {
-                        return Err(MeshError::InconsistentOrientation {
-                            a: vertex(next(c0)),
-                            b: vertex(prev(c0)),
-                            face_a: face_of(c0) as usize,
-                            face_b: face_of(c1) as usize,
+        for v in 0..vertex_count {
+            let bucket = &mut filed[offsets[v] as usize..offsets[v + 1] as usize];
+            bucket.sort_unstable_by_key(|&c| (ends(c).1, c));
+            let mut start = 0;
+            while start < bucket.len() {
+                let high = ends(bucket[start]).1;
+                let mut end = start + 1;
+                while end < bucket.len() && ends(bucket[end]).1 == high {
+                    end += 1;
+                }
+                match end - start {
+                    1 => {}
+                    2 => {
+                        let (c0, c1) = (bucket[start], bucket[start + 1]);
+                        if vertex(next(c0)) == vertex(next(c1)) {
+                            return Err(MeshError::InconsistentOrientation {
+                                a: vertex(next(c0)),
+                                b: vertex(prev(c0)),
+                                face_a: face_of(c0) as usize,
+                                face_b: face_of(c1) as usize,
+                            });
+                        }
+                        opposite[c0 as usize] = c1;
+                        opposite[c1 as usize] = c0;
+                    }
+                    n => {
+                        return Err(MeshError::NonManifoldEdge {
+                            a: v as u32,
+                            b: high,
+                            faces: n,
                         });
                     }
-                    opposite[c0 as usize] = c1;
-                    opposite[c1 as usize] = c0;
                 }
-                n => return Err(MeshError::NonManifoldEdge { a, b, faces: n }),
+                start = end;
             }
-            start = end;
         }
+        drop(filed);
 
         let mut table = CornerTable {
             opposite,

@@ -66,6 +66,36 @@ impl Mesh {
         self.adjacency.vertex_corner[vertex as usize] = c;
     }
 
+    /// Makes room for remeshing to add an eighth more vertices and faces without moving any
+    /// array (a mesh made or read does it), so the first split of the first stroke does not
+    /// copy the whole mesh. Room that is never used costs address space, not memory.
+    pub fn reserve_for_edits(&mut self) {
+        let (v, f) = (self.positions.len() / 8 + 1024, self.faces.len() / 8 + 1024);
+        self.positions.reserve_exact(v);
+        self.normals.reserve_exact(v);
+        self.brdfs.reserve_exact(v);
+        self.vertex_layers.reserve_exact(v);
+        self.flags.reserve_exact(v);
+        self.adjacency.vertex_corner.reserve_exact(v);
+        self.faces.reserve_exact(f);
+        self.face_layers.reserve_exact(f);
+        self.adjacency.opposite.reserve_exact(3 * f);
+    }
+
+    /// Makes room for one more vertex and two more faces, growing gently ([`crate::grow`]).
+    fn room_for_split(&mut self) {
+        use crate::grow::room_for as room;
+        room(&mut self.positions, 1);
+        room(&mut self.normals, 1);
+        room(&mut self.brdfs, 1);
+        room(&mut self.vertex_layers, 1);
+        room(&mut self.flags, 1);
+        room(&mut self.adjacency.vertex_corner, 1);
+        room(&mut self.faces, 2);
+        room(&mut self.face_layers, 2);
+        room(&mut self.adjacency.opposite, 6);
+    }
+
     fn push_face(&mut self, vertices: [u32; 3], layer: u32) -> u32 {
         let f = self.faces.len() as u32;
         self.faces.push(vertices);
@@ -97,6 +127,7 @@ impl Mesh {
         let layer = self.face_layers[face_of(c0) as usize];
         let o = self.adjacency.opposite[c0 as usize];
 
+        self.room_for_split();
         let m = self.positions.len() as u32;
         let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
         self.positions.push(pa.lerp(pb, t));

@@ -163,6 +163,7 @@ impl Mesh {
             version: MeshVersion::default(),
         };
         mesh.recompute_normals();
+        mesh.reserve_for_edits();
         Ok(mesh)
     }
 
@@ -279,7 +280,9 @@ impl Mesh {
             });
         }
         self.version.attributes += 1;
-        self.brdfs = brdfs;
+        // Copied into the array already there, which keeps the room made for edits.
+        self.brdfs.clear();
+        self.brdfs.extend_from_slice(&brdfs);
         Ok(())
     }
 

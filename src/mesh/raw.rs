@@ -34,7 +34,7 @@ impl Mesh {
     /// Reads what [`Mesh::write_raw`] wrote and checks it as [`Mesh::validate`] does, so a
     /// forged file gives an error naming the broken element, never a mesh the engine trips on.
     pub fn read_raw(input: &mut Reader) -> Result<Mesh, RawMeshError> {
-        let mesh = Mesh {
+        let mut mesh = Mesh {
             positions: input.array("positions")?,
             normals: input.array("normals")?,
             brdfs: input.array("brdfs")?,
@@ -50,6 +50,7 @@ impl Mesh {
             version: MeshVersion::default(),
         };
         mesh.validate()?;
+        mesh.reserve_for_edits();
         Ok(mesh)
     }
 }

@@ -16,8 +16,8 @@ use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
-use crate::mesh::{Mesh, MeshVersion, next, prev};
-use crate::remesh::{RemeshReport, RemeshSettings, remesh_region};
+use crate::mesh::{INVALID, Mesh, MeshVersion, next, prev};
+use crate::remesh::{RemeshReport, RemeshSets, RemeshSettings, remesh_region_with};
 
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
 /// remeshing run here on the CPU; selection, deformation and (on a GPU) the proximity passes
@@ -46,6 +46,20 @@ pub(super) struct Scratch {
     pub touched: Vec<bool>,
     /// Vertices met already, to list each once without sorting duplicates away.
     pub vertex_marks: crate::collide::Stamps,
+    /// The remesher's per-vertex sets.
+    pub remesh: RemeshSets,
+}
+
+impl Scratch {
+    /// Sizes every per-vertex and per-face array for `mesh` (growing gently, never
+    /// shrinking), so that a stroke allocates none of them.
+    pub fn size_for(&mut self, mesh: &Mesh) {
+        crate::grow::grow_to(&mut self.target_of, mesh.vertex_count(), INVALID);
+        crate::grow::grow_to(&mut self.touched, mesh.vertex_count(), false);
+        self.vertex_marks.size_for(mesh.vertex_count());
+        self.region.size_for(mesh);
+        self.remesh.size_for(mesh);
+    }
 }
 
 /// What lasts between strokes: the grid and the collision set-up, with the mesh version they
@@ -175,6 +189,7 @@ impl Pipeline {
     /// so calling this only moves the one-time cost out of the first stroke.
     pub fn prepare(&mut self, mesh: &Mesh) -> Result<(), PipelineError> {
         self.prepare_state(mesh)?;
+        self.scratch.size_for(mesh);
         if let Some(prepared) = &self.prepared {
             self.kernels.warm_up(mesh, prepared.grid.cell_size());
         }
@@ -289,7 +304,7 @@ impl Pipeline {
 /// vertices it changed (ascending).
 pub(super) fn remesh_touched(
     mesh: &mut Mesh,
-    (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
+    (grid, kernels, sets): (&mut SpatialHash, &mut dyn StepKernels, &mut RemeshSets),
     seeds: &[u32],
     (edge, distance, ring): (f32, f32, u32),
 ) -> (RemeshReport, Vec<u32>) {
@@ -299,7 +314,7 @@ pub(super) fn remesh_touched(
         ..RemeshSettings::new(edge)
     };
     let since = mesh.version();
-    let (report, changed) = remesh_region(mesh, grid, seeds, &settings);
+    let (report, changed) = remesh_region_with(mesh, grid, seeds, &settings, sets);
     kernels.remeshed(mesh, since, &changed);
     (report, changed)
 }

@@ -78,6 +78,10 @@ struct Active {
     /// What a mirrored grab's image caught at its first sample.
     captured_image: Option<Vec<(u32, f32)>>,
     touched_list: Vec<u32>,
+    /// Vertices remeshing changed during the stroke, and the edge bound when it began: at
+    /// its end the bound is brought back to what the stroke left ([`Active::tighten_edge_bound`]).
+    remeshed: Vec<u32>,
+    edge_bound_at_start: f32,
     report: StrokeReport,
 }
 
@@ -105,10 +109,10 @@ impl<'a> StrokeInProgress<'a> {
     ) -> Result<StrokeInProgress<'a>, PipelineError> {
         Pipeline::check_stroke(mesh, &stroke)?;
         let (prepared, phases) = pipeline.take_prepared(mesh)?;
+        let edge_bound_at_start = prepared.max_edge;
         let edge = pipeline.edge_length.unwrap_or(1.0);
         let mut scratch = std::mem::take(&mut pipeline.scratch);
-        scratch.target_of.resize(mesh.vertex_count(), INVALID);
-        scratch.touched.resize(mesh.vertex_count(), false);
+        scratch.size_for(mesh);
         let mut active = vec![false; mesh.layer_count()];
         for &l in &stroke.layers {
             active[l as usize] = true;
@@ -140,6 +144,8 @@ impl<'a> StrokeInProgress<'a> {
                 captured: None,
                 captured_image: None,
                 touched_list: Vec::new(),
+                remeshed: Vec::new(),
+                edge_bound_at_start,
                 report: StrokeReport {
                     phases,
                     ..StrokeReport::default()
@@ -187,6 +193,7 @@ impl<'a> StrokeInProgress<'a> {
         kernels.given(self.mesh, active.samples_run, &[]);
         let remeshed =
             active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
+        active.tighten_edge_bound(self.mesh, &remeshed);
         let mut report = std::mem::take(&mut active.report);
         report.changed = last_call.changed;
         report.changed.extend(remeshed);
@@ -268,6 +275,26 @@ impl Active {
         }
         self.resampler = trial;
         Ok(resampled)
+    }
+
+    /// The running edge bound only grows during a stroke (a grab stretches edges that its
+    /// remeshing then splits). At the end, every edge the stroke changed has an end it moved
+    /// or remeshing changed, and every other edge is as it was, within the bound the stroke
+    /// began with: the bound becomes the larger of that and the longest changed edge. Without
+    /// this, a grab's passing stretch would stay in the bound until a rescan of the whole mesh.
+    fn tighten_edge_bound(&mut self, mesh: &Mesh, remeshed_at_end: &[u32]) {
+        let changed: Vec<u32> = (self.touched_list.iter())
+            .chain(&self.remeshed)
+            .chain(remeshed_at_end)
+            .copied()
+            .filter(|&v| {
+                (v as usize) < mesh.vertex_count()
+                    && !mesh.is_vertex_dead(v)
+                    && mesh.adjacency().vertex_corner[v as usize] != INVALID
+            })
+            .collect();
+        let longest = longest_edge_at(mesh, &changed);
+        self.prepared.max_edge = self.edge_bound_at_start.max(longest);
     }
 
     /// Whether the kernels may run the samples of a call ahead: each is one step that nothing
@@ -602,12 +629,16 @@ impl Active {
             self.lengths.collision_distance,
             self.prepared.ring,
         );
-        let (pass, changed) =
-            remesh_touched(mesh, (&mut self.prepared.grid, kernels), moved, lengths);
+        let (pass, changed) = remesh_touched(
+            mesh,
+            (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
+            moved,
+            lengths,
+        );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.report.remesh.add(&pass);
-        self.scratch.target_of.resize(mesh.vertex_count(), INVALID);
-        self.scratch.touched.resize(mesh.vertex_count(), false);
+        self.remeshed.extend_from_slice(&changed);
+        self.scratch.size_for(mesh);
         call.changed.extend_from_slice(&changed);
         call.topology_changed |= pass.splits + pass.collapses + pass.flips > 0;
         call.phases.remesh += millis(started);
@@ -668,8 +699,12 @@ impl Active {
             self.prepared.ring,
         );
         let seeds = &self.touched_list;
-        let (pass, changed) =
-            remesh_touched(mesh, (&mut self.prepared.grid, kernels), seeds, lengths);
+        let (pass, changed) = remesh_touched(
+            mesh,
+            (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
+            seeds,
+            lengths,
+        );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.report.remesh.add(&pass);
         self.report.phases.remesh += millis(started);

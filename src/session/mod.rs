@@ -5,7 +5,10 @@
 //! history entry when it ends — a stroke, a paint stroke, a mask edit, a layer tool — so
 //! nothing a user does escapes undo. An entry keeps only the rows that changed
 //! ([`MeshDelta`]), found by comparing the mesh with the copy the session keeps of it as the
-//! last entry left it (`recorded`): one copy of the mesh, however long the history.
+//! last entry left it (`recorded`): one copy of the mesh, however long the history, made when
+//! the first edit starts (or by [`Session::prepare_history`]), so a session that is only opened,
+//! converted or measured never holds two. [`Session::without_history`] keeps none at all: a
+//! batch that writes a mesh file, whose history would be thrown away, needs no copy.
 //!
 //! ```
 //! use slayer::pipeline::{Pipeline, PipelineSettings};
@@ -114,7 +117,11 @@ pub struct Session {
     pub brush: BrushSettings,
     history: History,
     /// The mesh as the history's last done entry left it: the next edit is compared with it.
-    recorded: Mesh,
+    /// `None` until the first edit (the mesh is then as recorded) or when the session keeps no
+    /// history.
+    recorded: Option<Mesh>,
+    /// Whether edits are recorded (undoable).
+    keeps_history: bool,
 }
 
 /// Why a session operation was refused; the session is unchanged.
@@ -145,11 +152,42 @@ impl Session {
         history: History,
     ) -> Session {
         Session {
-            recorded: mesh.clone(),
+            recorded: None,
+            keeps_history: true,
             mesh,
             layers,
             brush,
             history,
+        }
+    }
+
+    /// A session that records nothing: edits cannot be undone, and no copy of the mesh is
+    /// kept (half the memory of a session with history, for batch work that writes a mesh).
+    pub fn without_history(mesh: Mesh) -> Session {
+        let mut session = Session::new(mesh);
+        session.drop_history();
+        session
+    }
+
+    /// From now on records nothing, and lets go of the history and of the copy of the mesh:
+    /// [`Session::without_history`] for a session already open.
+    pub fn drop_history(&mut self) {
+        self.keeps_history = false;
+        self.recorded = None;
+        self.history = History::with_cap(self.history.cap_bytes());
+    }
+
+    /// Whether edits are recorded as undoable history entries.
+    pub fn keeps_history(&self) -> bool {
+        self.keeps_history
+    }
+
+    /// Makes the copy of the mesh the next edit is compared with now rather than when that
+    /// edit starts (an app calls it after opening a large file, so the first stroke does not
+    /// wait for the copy). Nothing to do without history or once made.
+    pub fn prepare_history(&mut self) {
+        if self.keeps_history && self.recorded.is_none() {
+            self.recorded = Some(self.mesh.clone());
         }
     }
 
@@ -186,6 +224,7 @@ impl Session {
     /// returned [`Edit`] is committed or dropped (even one that changed nothing: every action
     /// is one entry).
     pub fn edit(&mut self, label: &str) -> Edit<'_> {
+        self.prepare_history();
         Edit {
             label: label.to_string(),
             session: self,
@@ -297,7 +336,10 @@ impl Session {
     pub fn undo(&mut self) -> Option<Stepped> {
         let entry = self.history.step_back()?;
         entry.undo(&mut self.mesh, &mut self.layers);
-        entry.mesh.undo(&mut self.recorded);
+        // Without a copy the mesh was as recorded, and stays so.
+        if let Some(recorded) = &mut self.recorded {
+            entry.mesh.undo(recorded);
+        }
         Some(Stepped {
             label: entry.label.clone(),
             touched_vertices: entry.touched_vertices(),
@@ -308,7 +350,9 @@ impl Session {
     pub fn redo(&mut self) -> Option<Stepped> {
         let entry = self.history.step_forward()?;
         entry.redo(&mut self.mesh, &mut self.layers);
-        entry.mesh.redo(&mut self.recorded);
+        if let Some(recorded) = &mut self.recorded {
+            entry.mesh.redo(recorded);
+        }
         Some(Stepped {
             label: entry.label.clone(),
             touched_vertices: entry.touched_vertices(),
@@ -327,14 +371,28 @@ impl Session {
     }
 
     /// Records what changed since the last entry as one entry labelled `label`.
+    /// Without history nothing is recorded, and whether the mesh changed is not known: it
+    /// is reported changed.
     fn record(&mut self, label: &str) -> Recorded {
-        let delta = MeshDelta::between(&self.recorded, &self.mesh);
+        let Some(recorded) = self.recorded.as_mut().filter(|_| self.keeps_history) else {
+            return Recorded {
+                changed: true,
+                ..Recorded::default()
+            };
+        };
+        let delta = MeshDelta::between(recorded, &self.mesh);
         let changed = !delta.is_empty();
-        delta.redo(&mut self.recorded);
+        delta.redo(recorded);
         self.push(Entry::new(label, delta, None), changed)
     }
 
     fn push(&mut self, entry: Entry, changed: bool) -> Recorded {
+        if !self.keeps_history {
+            return Recorded {
+                changed,
+                ..Recorded::default()
+            };
+        }
         let bytes = entry.bytes();
         let dropped = self.history.push(entry);
         Recorded {

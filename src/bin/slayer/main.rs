@@ -20,6 +20,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+/// Heap accounting for the figures `bench` and `sculpt --stats` report (bytes per face).
+#[global_allocator]
+static HEAP: slayer::memory::Counting = slayer::memory::Counting;
+
 #[derive(Parser)]
 #[command(
     name = "slayer",

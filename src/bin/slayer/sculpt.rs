@@ -35,7 +35,12 @@ pub struct Args<'a> {
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     slayer::session::check_save_path(args.output)?;
     refuse_overwriting_input(args)?;
-    let mut session = crate::open::open(args.input, args.strict)?;
+    // A mesh file keeps no history: the session need not keep a copy of the mesh to undo to.
+    let mut session = if slayer::session::is_session_path(args.output) {
+        crate::open::open(args.input, args.strict)?
+    } else {
+        crate::open::open_without_history(args.input, args.strict)?
+    };
     let text = slayer::files::read_input_text(args.strokes, slayer::files::MAX_INPUT_BYTES)
         .with_context(|| format!("{}", args.strokes.display()))?;
     let name = args.strokes.display().to_string();
@@ -46,6 +51,8 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         }
     }
     let strokes = file.resolve(session.mesh(), &name)?;
+    let load_peak = slayer::memory::peak_bytes();
+    slayer::memory::reset_peak();
     check_dabs(&strokes, args.max_dabs, &name)?;
     let mut pipeline = crate::backend::choose(
         args.backend,
@@ -57,6 +64,13 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         },
     )?
     .pipeline;
+    // What is proportional to the mesh (the grid, per-vertex scratch) is built here, once,
+    // and reported as set-up: a stroke's cost follows the brush.
+    let started = std::time::Instant::now();
+    pipeline
+        .prepare(session.mesh())
+        .with_context(|| format!("{}: preparing the mesh for sculpting", args.input.display()))?;
+    let setup_ms = started.elapsed().as_secs_f64() * 1e3;
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
     for (i, stroke) in strokes.iter().enumerate() {
@@ -83,17 +97,32 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     if let Some(why) = pipeline.kernel_failure() {
         eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
     }
+    let backend = pipeline.name();
+    let strokes_peak = slayer::memory::peak_bytes();
+    // The grid and scratch are done with: their memory goes back before validating.
+    drop(pipeline);
     let mesh = session.mesh();
     mesh.validate()
         .context("the sculpted mesh failed validation (not written)")?;
     let mut batch = AtomicBatch::new();
     slayer::session::stage(&mut batch, &session, args.output, true)?;
+    // The whole run's peak: loading, strokes, checking and writing the output.
+    let peak = [load_peak, slayer::memory::peak_bytes()]
+        .into_iter()
+        .flatten()
+        .max();
+    let faces = mesh.live_face_count();
     if let Some(path) = args.stats {
         let json = serde_json::json!({
-            "backend": pipeline.name(),
+            "backend": backend,
             "strokes": reports,
             "vertices": mesh.live_vertex_count(),
-            "faces": mesh.live_face_count(),
+            "faces": faces,
+            "setup_ms": setup_ms,
+            "peak_heap_bytes": peak,
+            "load_peak_heap_bytes": load_peak,
+            "strokes_peak_heap_bytes": strokes_peak,
+            "peak_bytes_per_face": peak.map(|p| p as f64 / faces.max(1) as f64),
         });
         batch.stage(path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     }
@@ -102,9 +131,15 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let clamped: usize = reports.iter().map(|r| r.clamped).sum();
     let total_ms: f64 = reports.iter().map(|r| r.phases.total()).sum();
     println!(
-        "{} strokes, {samples} samples, {clamped} collisions, {:.3} ms per sample -> {}",
+        "{} strokes, {samples} samples, {clamped} collisions, {:.3} ms per sample (set-up {setup_ms:.0} ms{}) -> {}",
         strokes.len(),
         total_ms / samples.max(1) as f64,
+        peak.map(|p| format!(
+            ", peak heap {} MiB, {:.0} bytes per face",
+            p >> 20,
+            p as f64 / faces.max(1) as f64
+        ))
+        .unwrap_or_default(),
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)
