@@ -82,6 +82,9 @@ pub struct SceneResult {
     pub ms_per_sample: f64,
     pub ms_per_stroke: f64,
     pub ms_per_remesh: f64,
+    /// The most heap bytes live at once from the set-up to the last stroke: the mesh, the
+    /// grid, the scratch and the strokes' own (`None` where the program does not count).
+    pub peak_heap_bytes: Option<usize>,
     pub intersections: usize,
     /// Share of the edges at vertices the strokes moved or made (the remeshed regions) with
     /// length in [4/5·L, 4/3·L].
@@ -196,6 +199,8 @@ pub struct ScalingRow {
     pub samples: usize,
     pub steps: usize,
     pub moves: usize,
+    /// The most heap held while sculpting ([`SceneResult::peak_heap_bytes`]).
+    pub peak_heap_bytes: Option<usize>,
     /// GPU backends: the most GPU memory they held after any stroke.
     pub gpu_memory: Option<GpuMemory>,
 }
@@ -210,9 +215,13 @@ pub fn run_strokes(
     (check_intersections, samples_per_call): (bool, Option<usize>),
 ) -> Result<SceneResult, PipelineError> {
     let (vertices, faces) = (mesh.live_vertex_count(), mesh.live_face_count());
+    crate::memory::reset_peak();
     // Where the strokes went: vertices that moved or were made; the edge band is measured there.
     let start_positions = mesh.positions().to_vec();
     let start_faces = mesh.faces().to_vec();
+    // The bench's own copies, left out of the engine's peak below.
+    let copies = std::mem::size_of_val(start_positions.as_slice())
+        + std::mem::size_of_val(start_faces.as_slice());
     let mean_edge_length = mesh.edge_length_stats().mean;
     let started = std::time::Instant::now();
     pipeline.prepare(mesh)?;
@@ -239,6 +248,9 @@ pub fn run_strokes(
         remesh.add(&report.remesh);
         progress(i + 1);
     }
+    // The most heap the mesh, the set-up and the strokes held at once (`None` unless the
+    // program counts, as `slayer` does).
+    let peak_heap_bytes = crate::memory::peak_bytes().map(|p| p.saturating_sub(copies));
     let sampling_ms = phases.total() - phases.remesh;
     let gpu_calls = uploads_before
         .zip(pipeline.uploads())
@@ -291,6 +303,7 @@ pub fn run_strokes(
         min_angle_before,
         min_angle_after,
         setup_ms,
+        peak_heap_bytes,
         collisions,
         reverted,
         moves,

@@ -155,8 +155,16 @@ pub fn scaling_table(rows: &[ScalingRow]) -> String {
     let on_gpu = rows.iter().any(|r| r.gpu_memory.is_some());
     let _ = write!(
         out,
-        "{:>10} {:>10} {:>10} {:>12} {:>8} {:>8} {:>9}",
-        "faces", "ms/sample", "ms/remesh", "vs smallest", "samples", "steps", "moves"
+        "{:>10} {:>10} {:>10} {:>12} {:>8} {:>8} {:>9} {:>9} {:>11}",
+        "faces",
+        "ms/sample",
+        "ms/remesh",
+        "vs smallest",
+        "samples",
+        "steps",
+        "moves",
+        "heap MiB",
+        "bytes/face"
     );
     let _ = writeln!(out, "{}", if on_gpu { "   gpu MiB" } else { "" });
     for r in rows {
@@ -171,6 +179,15 @@ pub fn scaling_table(rows: &[ScalingRow]) -> String {
             r.steps,
             r.moves
         );
+        let _ = match r.peak_heap_bytes {
+            Some(bytes) => write!(
+                out,
+                " {:>9.0} {:>11.0}",
+                bytes as f64 / (1u64 << 20) as f64,
+                bytes as f64 / r.faces.max(1) as f64
+            ),
+            None => write!(out, " {:>9} {:>11}", "-", "-"),
+        };
         if on_gpu {
             let held = r.gpu_memory.and_then(|m| m.allocated_bytes);
             let _ = match held {

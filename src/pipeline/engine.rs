@@ -222,6 +222,12 @@ impl Pipeline {
         self.kernels.gpu_memory(mesh)
     }
 
+    /// The running upper bound on the mesh's edge lengths that bounds the collision searches
+    /// (known once prepared); never below the longest edge.
+    pub fn edge_bound(&self) -> Option<f32> {
+        self.prepared.as_ref().map(|p| p.max_edge)
+    }
+
     /// The edge length `L` the pipeline works with (known after the first stroke).
     pub fn edge_length(&self) -> Option<f32> {
         self.edge_length

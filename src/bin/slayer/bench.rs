@@ -115,16 +115,16 @@ fn bench_scene(
         cull,
         ..PipelineSettings::default()
     };
-    let start = mesh.clone();
+    // The CPU's starting mesh again for the GPU run (only then: it would double the memory).
+    let start = (chosen == Backend::Both).then(|| mesh.clone());
     let mut first = match chosen {
         Backend::Both => backend::cpu(settings),
         single => backend::choose(single, settings)?,
     };
     let result = sculpt_with_progress(kind.name(), &mut mesh, &strokes, &mut first.pipeline, feed)?;
     report_fallback(&first.pipeline);
-    let gpu = if chosen == Backend::Both {
+    let gpu = if let Some(mut on_gpu) = start {
         let mut second = backend::gpu(settings)?;
-        let mut on_gpu = start;
         let name = format!("{} (gpu)", kind.name());
         let gpu_result =
             sculpt_with_progress(&name, &mut on_gpu, &strokes, &mut second.pipeline, feed)?;
@@ -300,6 +300,7 @@ fn scaling_rows(options: &Options, backend: Backend) -> anyhow::Result<Vec<Scali
             samples: r.samples,
             steps: r.steps,
             moves: r.moves,
+            peak_heap_bytes: r.peak_heap_bytes,
             gpu_memory: r.gpu_memory,
         });
     }
