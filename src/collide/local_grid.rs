@@ -9,8 +9,12 @@ use glam::{IVec3, Vec3};
 
 use crate::geom::Aabb;
 
-/// Cells per axis at most; larger regions get larger cells.
+/// Cells per axis at most for a grid of few faces; larger regions get larger cells…
 const MAX_CELLS_PER_AXIS: f32 = 64.0;
+/// …unless the grid files many faces: then up to this many cells a face. A whole-mesh remesh
+/// files every face; held to 64 cells an axis, a 1M-face torus had cells 7 edges wide and
+/// every query read hundreds of faces.
+const MAX_CELLS_PER_FACE: usize = 8;
 
 #[derive(Debug, Clone, Default)]
 pub struct LocalFaceGrid {
@@ -29,7 +33,19 @@ impl LocalFaceGrid {
     /// `cell` is the preferred cell side.
     pub fn build(&mut self, boxes: &[Aabb], region: Aabb, cell: f32) {
         let extent = (region.max - region.min).max(Vec3::splat(cell));
-        let cell = cell.max(extent.max_element() / MAX_CELLS_PER_AXIS);
+        let axis_cap = MAX_CELLS_PER_AXIS.powi(3) as usize;
+        let mut cell = cell;
+        if boxes.len() * MAX_CELLS_PER_FACE <= axis_cap {
+            cell = cell.max(extent.max_element() / MAX_CELLS_PER_AXIS);
+        } else {
+            let cells = |cell: f32| {
+                let dims = (extent / cell).floor() + Vec3::ONE;
+                dims.x as f64 * dims.y as f64 * dims.z as f64
+            };
+            while cells(cell) > (boxes.len() * MAX_CELLS_PER_FACE) as f64 {
+                cell *= 1.25;
+            }
+        }
         self.origin = region.min;
         self.inv_cell = 1.0 / cell;
         self.dims = ((extent * self.inv_cell).floor().as_ivec3() + IVec3::ONE).max(IVec3::ONE);
