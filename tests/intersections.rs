@@ -233,6 +233,46 @@ fn the_smallest_layer_gap_is_measured() {
     );
 }
 
+/// On generated plaster (three layers, bumpy, some of its layers near each other), the grid's
+/// gap is the all-pairs minimum over every vertex and every face of another layer, bit for bit.
+#[test]
+fn the_smallest_layer_gap_matches_all_pairs() {
+    use slayer::geom::point_triangle_distance_squared;
+    use slayer::scene::{SceneKind, SceneSpec, generate};
+    let mesh = generate(&SceneSpec {
+        kind: SceneKind::Plaster,
+        triangles: 3_000,
+        seed: 4,
+    })
+    .unwrap();
+    let l = mesh.mean_edge_length();
+    for reach in [1.0 * l, 3.0 * l, 8.0 * l] {
+        let mut nearest: Option<f32> = None;
+        for v in 0..mesh.vertex_count() {
+            let p = mesh.positions()[v];
+            for f in 0..mesh.face_count() {
+                if mesh.face_layers()[f] == mesh.vertex_layers()[v] {
+                    continue;
+                }
+                let [a, b, c] = mesh.face_positions(f);
+                let d2 = point_triangle_distance_squared(p, a, b, c);
+                if d2 <= reach * reach {
+                    nearest = Some(nearest.map_or(d2, |n: f32| n.min(d2)));
+                }
+            }
+        }
+        let expected = nearest.map(f32::sqrt).filter(|&g| g <= reach);
+        let gap = slayer::collide::smallest_layer_gap(&mesh, reach).unwrap();
+        assert_eq!(gap, expected, "reach {reach}");
+        if reach > 4.0 * l {
+            assert!(
+                gap.is_some(),
+                "the layers are within 8 L of each other somewhere"
+            );
+        }
+    }
+}
+
 /// `check --against` counts the faces turned over since the original (their normal points
 /// against the original's): none for the original itself, some once a vertex is pulled
 /// across the faces around it.

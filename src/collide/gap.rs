@@ -2,6 +2,7 @@
 //! but that every vertex stays the collision distance `d` from every other layer's faces, so
 //! tests check the gap as well as the crossings, and `slayer check` reports it.
 
+use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::geom::point_triangle_distance_squared;
@@ -19,19 +20,39 @@ pub fn smallest_layer_gap(mesh: &Mesh, reach: f32) -> Result<Option<f32>, GridEr
     let grid = SpatialHash::build(mesh, reach)?;
     let vertex_faces = mesh.vertex_faces();
     let (positions, layers) = (mesh.positions(), mesh.vertex_layers());
+    let box_reach = reach + max_edge;
+    let r2 = reach * reach;
+    // A face within `reach` of `p` has a vertex within `reach + max_edge`: the faces of the
+    // other layers' vertices in that box, each perhaps more than once (a minimum does not
+    // mind), and no face of the vertex's own layer, which is most of what is near. A face
+    // whose box is farther than the nearest found so far cannot be nearer.
     let gap = (0..mesh.vertex_count())
         .into_par_iter()
         .filter(|&v| mesh.is_vertex_live(v as u32))
-        .flat_map_iter(|v| {
+        .map(|v| {
             let p = positions[v];
-            grid.faces_within(positions, mesh.faces(), &vertex_faces, p, reach, max_edge)
-                .into_iter()
-                .filter(move |&f| mesh.face_layers()[f as usize] != layers[v])
-                .map(move |f| {
+            let mut nearest = f32::INFINITY;
+            grid.for_each_in_box(p - box_reach, p + box_reach, |u| {
+                if layers[u as usize] == layers[v] {
+                    return;
+                }
+                for &f in vertex_faces.of(u) {
                     let [a, b, c] = mesh.face_positions(f as usize);
-                    point_triangle_distance_squared(p, a, b, c)
-                })
+                    let outside = (a.min(b).min(c) - p)
+                        .max(p - a.max(b).max(c))
+                        .max(Vec3::ZERO);
+                    if outside.length_squared() > nearest.min(r2) {
+                        continue;
+                    }
+                    let d2 = point_triangle_distance_squared(p, a, b, c);
+                    if d2 <= r2 {
+                        nearest = nearest.min(d2);
+                    }
+                }
+            });
+            nearest
         })
-        .min_by(f32::total_cmp);
+        .min_by(f32::total_cmp)
+        .filter(|d| d.is_finite());
     Ok(gap.map(f32::sqrt).filter(|&g| g <= reach))
 }
