@@ -181,6 +181,32 @@ proptest! {
     }
 }
 
+/// A session without history (what `sculpt` uses for a mesh output) sculpts the same mesh as
+/// one with history, records nothing and has nothing to undo; a session whose history is
+/// dropped part-way lets go of what it held.
+#[test]
+fn a_session_without_history_sculpts_the_same_and_records_nothing() {
+    let mesh = scene(SceneKind::Plaster, 3_000);
+    let strokes = torture_strokes(&mesh, (3, 6), 9);
+    let mut with = Session::new(mesh.clone());
+    let mut without = Session::without_history(mesh);
+    assert!(with.keeps_history() && !without.keeps_history());
+    for stroke in &strokes {
+        let mut pipeline = Pipeline::new(PipelineSettings::default());
+        let (_, recorded) = with.apply_stroke(&mut pipeline, stroke).unwrap();
+        assert!(recorded.bytes > 0);
+        let mut pipeline = Pipeline::new(PipelineSettings::default());
+        let (_, recorded) = without.apply_stroke(&mut pipeline, stroke).unwrap();
+        assert_eq!((recorded.bytes, recorded.dropped), (0, 0));
+    }
+    assert_eq!(with.mesh().digest(), without.mesh().digest());
+    assert!(without.history().entries().is_empty());
+    assert!(without.undo().is_none());
+    with.drop_history();
+    assert!(with.history().entries().is_empty());
+    assert!(with.undo().is_none());
+}
+
 #[test]
 fn the_memory_cap_drops_the_oldest_entries_and_says_so() {
     let input = scene(SceneKind::Plaster, 4_000);
