@@ -24,28 +24,27 @@ impl Counting {
         let live = LIVE.fetch_add(by, Relaxed) + by;
         PEAK.fetch_max(live, Relaxed);
     }
+
+    /// Counts a fresh block `p` of `size` bytes, if the allocation succeeded.
+    fn allocated(p: *mut u8, size: usize) -> *mut u8 {
+        if !p.is_null() {
+            INSTALLED.store(true, Relaxed);
+            Counting::grew(size);
+        }
+        p
+    }
 }
 
 // SAFETY: every call is forwarded to `System` unchanged; the counters are plain atomics.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         // SAFETY: forwarded with the caller's layout.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            INSTALLED.store(true, Relaxed);
-            Counting::grew(layout.size());
-        }
-        p
+        Counting::allocated(unsafe { System.alloc(layout) }, layout.size())
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         // SAFETY: forwarded with the caller's layout.
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
-            INSTALLED.store(true, Relaxed);
-            Counting::grew(layout.size());
-        }
-        p
+        Counting::allocated(unsafe { System.alloc_zeroed(layout) }, layout.size())
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {

@@ -2,10 +2,9 @@
 //! but that every vertex stays the collision distance `d` from every other layer's faces, so
 //! tests check the gap as well as the crossings, and `slayer check` reports it.
 
-use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::geom::point_triangle_distance_squared;
+use crate::geom::{Aabb, point_triangle_distance_squared};
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::Mesh;
 
@@ -38,10 +37,7 @@ pub fn smallest_layer_gap(mesh: &Mesh, reach: f32) -> Result<Option<f32>, GridEr
                 }
                 for &f in vertex_faces.of(u) {
                     let [a, b, c] = mesh.face_positions(f as usize);
-                    let outside = (a.min(b).min(c) - p)
-                        .max(p - a.max(b).max(c))
-                        .max(Vec3::ZERO);
-                    if outside.length_squared() > nearest.min(r2) {
+                    if Aabb::of_points(&[a, b, c]).distance_squared_to(p) > nearest.min(r2) {
                         continue;
                     }
                     let d2 = point_triangle_distance_squared(p, a, b, c);

@@ -11,7 +11,7 @@ pub struct Stamps {
 impl Stamps {
     /// Empties the set and makes room for indices below `len`.
     pub fn start(&mut self, len: usize) {
-        crate::grow::grow_to(&mut self.marks, len, 0);
+        self.size_for(len);
         self.round = self.round.wrapping_add(1);
         if self.round == 0 {
             // After 2³² rounds the marks could alias: clear them once.

@@ -77,8 +77,16 @@ impl Aabb {
     /// True when some point of the box is closer than `distance` to `p`.
     #[inline]
     pub fn within(&self, p: Vec3, distance: f32) -> bool {
-        let outside = (self.min - p).max(p - self.max).max(Vec3::ZERO);
-        outside.length_squared() < distance * distance
+        self.distance_squared_to(p) < distance * distance
+    }
+
+    /// The squared distance from `p` to the nearest point of the box (0 inside).
+    #[inline]
+    pub fn distance_squared_to(&self, p: Vec3) -> f32 {
+        (self.min - p)
+            .max(p - self.max)
+            .max(Vec3::ZERO)
+            .length_squared()
     }
 
     pub fn overlaps(&self, other: &Aabb) -> bool {

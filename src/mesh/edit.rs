@@ -66,24 +66,11 @@ impl Mesh {
         self.adjacency.vertex_corner[vertex as usize] = c;
     }
 
-    /// Makes room for remeshing to add an eighth more vertices and faces without moving any
-    /// array (a mesh made or read does it), so the first split of the first stroke does not
-    /// copy the whole mesh. Room that is never used costs address space, not memory.
-    pub fn reserve_for_edits(&mut self) {
-        let (v, f) = (self.positions.len() / 8 + 1024, self.faces.len() / 8 + 1024);
-        self.positions.reserve_exact(v);
-        self.normals.reserve_exact(v);
-        self.brdfs.reserve_exact(v);
-        self.vertex_layers.reserve_exact(v);
-        self.flags.reserve_exact(v);
-        self.adjacency.vertex_corner.reserve_exact(v);
-        self.faces.reserve_exact(f);
-        self.face_layers.reserve_exact(f);
-        self.adjacency.opposite.reserve_exact(3 * f);
-    }
-
-    /// Makes room for one more vertex and two more faces, growing gently ([`crate::grow`]).
-    fn room_for_split(&mut self) {
+    /// Makes room for one more split (a vertex and two faces); a full array grows by an eighth
+    /// ([`crate::grow`]). A mesh made or read calls it, so its arrays have an eighth's room and
+    /// the first split of the first stroke copies nothing; room never used costs address
+    /// space, not memory.
+    pub(super) fn reserve_for_edits(&mut self) {
         use crate::grow::room_for as room;
         room(&mut self.positions, 1);
         room(&mut self.normals, 1);
@@ -127,7 +114,7 @@ impl Mesh {
         let layer = self.face_layers[face_of(c0) as usize];
         let o = self.adjacency.opposite[c0 as usize];
 
-        self.room_for_split();
+        self.reserve_for_edits();
         let m = self.positions.len() as u32;
         let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
         self.positions.push(pa.lerp(pb, t));

@@ -111,8 +111,8 @@ impl<'a> StrokeInProgress<'a> {
         let (prepared, phases) = pipeline.take_prepared(mesh)?;
         let edge_bound_at_start = prepared.max_edge;
         let edge = pipeline.edge_length.unwrap_or(1.0);
-        let mut scratch = std::mem::take(&mut pipeline.scratch);
-        scratch.size_for(mesh);
+        // Sized for `mesh` by `take_prepared`.
+        let scratch = std::mem::take(&mut pipeline.scratch);
         let mut active = vec![false; mesh.layer_count()];
         for &l in &stroke.layers {
             active[l as usize] = true;
@@ -287,11 +287,7 @@ impl Active {
             .chain(&self.remeshed)
             .chain(remeshed_at_end)
             .copied()
-            .filter(|&v| {
-                (v as usize) < mesh.vertex_count()
-                    && !mesh.is_vertex_dead(v)
-                    && mesh.adjacency().vertex_corner[v as usize] != INVALID
-            })
+            .filter(|&v| mesh.is_vertex_live(v))
             .collect();
         let longest = longest_edge_at(mesh, &changed);
         self.prepared.max_edge = self.edge_bound_at_start.max(longest);
