@@ -28,3 +28,4 @@ pub mod remesh;
 pub mod render;
 pub mod scene;
 pub mod session;
+pub mod tools;

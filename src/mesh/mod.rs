@@ -5,6 +5,7 @@
 //! layers". Vertices are struct-of-arrays so each attribute uploads to the GPU as one buffer;
 //! adjacency is a corner table; deletion marks elements dead and [`Mesh::compact`] removes them.
 
+mod assemble;
 mod attributes;
 mod components;
 mod corner_table;

@@ -29,12 +29,14 @@
 
 mod file;
 mod history;
+mod tools;
 
 pub use file::{
     SessionFileError, VERSION, check_save_path, is_session_path, open, open_with, read_session,
     save, stage, write_session,
 };
 pub use history::{DEFAULT_HISTORY_CAP_BYTES, Entry, History};
+pub use tools::Deleted;
 
 use serde::{Deserialize, Serialize};
 
@@ -228,6 +230,7 @@ impl Session {
         Edit {
             label: label.to_string(),
             session: self,
+            layers_before: None,
             done: false,
         }
     }
@@ -370,10 +373,14 @@ impl Session {
         }
     }
 
-    /// Records what changed since the last entry as one entry labelled `label`.
+    /// Records what changed since the last entry as one entry labelled `label` (with the
+    /// layer settings, where `layers_before` says what they were and they changed).
     /// Without history nothing is recorded, and whether the mesh changed is not known: it
     /// is reported changed.
-    fn record(&mut self, label: &str) -> Recorded {
+    fn record(&mut self, label: &str, layers_before: Option<Vec<LayerSettings>>) -> Recorded {
+        let layers = layers_before
+            .filter(|before| *before != self.layers)
+            .map(|before| (before, self.layers.clone()));
         let Some(recorded) = self.recorded.as_mut().filter(|_| self.keeps_history) else {
             return Recorded {
                 changed: true,
@@ -381,9 +388,9 @@ impl Session {
             };
         };
         let delta = MeshDelta::between(recorded, &self.mesh);
-        let changed = !delta.is_empty();
+        let changed = !delta.is_empty() || layers.is_some();
         delta.redo(recorded);
-        self.push(Entry::new(label, delta, None), changed)
+        self.push(Entry::new(label, delta, layers), changed)
     }
 
     fn push(&mut self, entry: Entry, changed: bool) -> Recorded {
@@ -408,6 +415,8 @@ impl Session {
 pub struct Edit<'a> {
     session: &'a mut Session,
     label: String,
+    /// The layer settings as the edit found them, once it asked to change them.
+    layers_before: Option<Vec<LayerSettings>>,
     done: bool,
 }
 
@@ -417,17 +426,26 @@ impl Edit<'_> {
         &mut self.session.mesh
     }
 
+    /// The mesh and the layer settings, for an edit that adds or removes layers (the layer
+    /// tools): the settings change with the mesh, in the same entry.
+    pub fn mesh_and_layers(&mut self) -> (&mut Mesh, &mut Vec<LayerSettings>) {
+        if self.layers_before.is_none() {
+            self.layers_before = Some(self.session.layers.clone());
+        }
+        (&mut self.session.mesh, &mut self.session.layers)
+    }
+
     /// Records the change as one history entry.
     pub fn commit(mut self) -> Recorded {
         self.done = true;
-        self.session.record(&self.label)
+        self.session.record(&self.label, self.layers_before.take())
     }
 }
 
 impl Drop for Edit<'_> {
     fn drop(&mut self) {
         if !self.done {
-            self.session.record(&self.label);
+            self.session.record(&self.label, self.layers_before.take());
         }
     }
 }

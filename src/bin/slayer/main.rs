@@ -7,6 +7,7 @@ mod convert;
 mod demo;
 mod gui;
 mod history;
+mod layer;
 mod open;
 mod progress;
 mod remesh;
@@ -313,6 +314,10 @@ enum Command {
         #[arg(long, default_value = "auto", value_parser = ["auto", "shared", "own"])]
         device: String,
     },
+    /// Layer tools: list the layers and their components, duplicate (offset copy or shell),
+    /// delete.
+    #[command(subcommand)]
+    Layer(layer::LayerCommand),
     /// List the GPU adapters wgpu can see, best first.
     Adapters {
         #[arg(long)]
@@ -326,7 +331,9 @@ fn main() -> ExitCode {
     // Where the user asked for JSON, a failure is JSON too.
     let json_errors = matches!(
         cli.command,
-        Command::Check { json: true, .. } | Command::Adapters { json: true }
+        Command::Check { json: true, .. }
+            | Command::Adapters { json: true }
+            | Command::Layer(layer::LayerCommand::List { json: true, .. })
     );
     match dispatch(cli.command, cli.strict) {
         Ok(code) => code,
@@ -363,6 +370,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             against,
         } => check::run(&file, json, against.as_deref(), strict),
         Command::Adapters { json } => adapters(json),
+        Command::Layer(command) => layer::run(command, strict),
         Command::Convert {
             input,
             output,

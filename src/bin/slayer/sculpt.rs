@@ -165,7 +165,7 @@ fn refuse_overwriting_input(args: &Args<'_>) -> anyhow::Result<()> {
 
 /// Whether `a` and `b` name one file: by device and inode when both exist (links and other
 /// spellings of one path included), by canonical path otherwise.
-fn same_file(a: &Path, b: &Path) -> bool {
+pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;

@@ -1,0 +1,259 @@
+//! `slayer layer list|duplicate|delete`: the layer tools from the command line. A tool that
+//! fails writes nothing; a `.slayer` output keeps it (and any mask strokes) as history entries.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use clap::{Args, Subcommand};
+use slayer::mesh::LayerId;
+use slayer::pipeline::{Pipeline, PipelineSettings};
+use slayer::session::Session;
+use slayer::tools::{DeleteTarget, DuplicateSettings, Selection};
+
+#[derive(Subcommand)]
+pub enum LayerCommand {
+    /// Print each layer with its faces and its connected components (the numbers that
+    /// `--component` takes).
+    List {
+        /// Mesh or session file.
+        file: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Copy a layer, its masked part or a component into a new layer lifted off it along the
+    /// normals, clear of everything (a flake above the plaster, a second skin of bark).
+    Duplicate {
+        #[command(flatten)]
+        files: Files,
+        /// The layer to copy (name or number); with --masked only its masked part.
+        #[arg(long, conflicts_with = "component")]
+        layer: Option<String>,
+        /// The connected component to copy (numbered as `slayer layer list` prints them).
+        #[arg(long)]
+        component: Option<u32>,
+        /// Copy only the layer's masked faces (all three vertices masked).
+        #[arg(long, requires = "layer")]
+        masked: bool,
+        /// A stroke file applied first (mask strokes, typically), to mask what --masked copies.
+        #[arg(long, value_name = "FILE", requires = "masked")]
+        mask_strokes: Option<PathBuf>,
+        /// How far the copy is lifted, in mean edge lengths (the collision distance is 1).
+        #[arg(long, default_value_t = 2.0)]
+        offset: f32,
+        /// Make a closed shell this thick (in mean edge lengths) instead of a sheet.
+        #[arg(long)]
+        thickness: Option<f32>,
+        /// The new layer's name (default: the source's, with " copy").
+        #[arg(long)]
+        name: Option<String>,
+        /// The new layer's material: a preset name (plaster, paint, rust, ...); default: the
+        /// source layer's.
+        #[arg(long)]
+        material: Option<String>,
+    },
+    /// Delete a layer or connected components, and compact the mesh.
+    Delete {
+        #[command(flatten)]
+        files: Files,
+        /// A whole layer (name or number); the layers after it move down by one.
+        #[arg(long, group = "target")]
+        layer: Option<String>,
+        /// One component (numbered as `slayer layer list` prints them).
+        #[arg(long, group = "target")]
+        component: Option<u32>,
+        /// The N components with the fewest faces.
+        #[arg(long, group = "target", value_name = "N")]
+        smallest: Option<usize>,
+        /// Every component with fewer faces than this.
+        #[arg(long, group = "target", value_name = "FACES")]
+        under: Option<usize>,
+    },
+}
+
+/// The input and output of a tool.
+#[derive(Args)]
+pub struct Files {
+    /// Mesh (.obj, .ply, .stl, .glb, .gltf) or session (.slayer).
+    input: PathBuf,
+    /// Mesh or session (.slayer, which keeps the tool as an undoable history entry).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Allow the output to be the input file itself.
+    #[arg(long)]
+    in_place: bool,
+}
+
+pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
+    match command {
+        LayerCommand::List { file, json } => list(&file, json, strict),
+        LayerCommand::Duplicate {
+            files,
+            layer,
+            component,
+            masked,
+            mask_strokes,
+            offset,
+            thickness,
+            name,
+            material,
+        } => {
+            let mut session = open(&files, strict)?;
+            let selection = match (layer, component) {
+                (Some(layer), _) => {
+                    let layer = one_layer(session.mesh(), &layer)?;
+                    if masked {
+                        Selection::Masked(layer)
+                    } else {
+                        Selection::Layer(layer)
+                    }
+                }
+                (None, Some(component)) => Selection::Component(component),
+                (None, None) => bail!("say what to copy: --layer or --component"),
+            };
+            if let Some(strokes) = &mask_strokes {
+                apply_strokes(&mut session, strokes)?;
+            }
+            let settings =
+                duplicate_settings(&session, selection, (offset, thickness), (name, material))?;
+            let (report, _) = session.duplicate(selection, &settings)?;
+            save(&session, &files)?;
+            println!(
+                "new layer {} `{}`: {} faces, lifted {:.3} ({} vertices stopped short by what is in the way), {:.0} ms -> {}",
+                report.layer,
+                settings.name,
+                report.faces,
+                report.smallest_lift,
+                report.clamped,
+                report.millis,
+                files.output.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        LayerCommand::Delete {
+            files,
+            layer,
+            component,
+            smallest,
+            under,
+        } => {
+            let mut session = open(&files, strict)?;
+            let target = match (layer, component, smallest, under) {
+                (Some(layer), ..) => DeleteTarget::Layer(one_layer(session.mesh(), &layer)?),
+                (_, Some(c), ..) => DeleteTarget::Component(c),
+                (_, _, Some(n), _) => DeleteTarget::Smallest(n),
+                (_, _, _, Some(faces)) => DeleteTarget::Under(faces),
+                _ => bail!("say what to delete: --layer, --component, --smallest or --under"),
+            };
+            let (deleted, _) = session.delete(target)?;
+            save(&session, &files)?;
+            println!(
+                "deleted {} components ({} faces){} -> {}",
+                deleted.components,
+                deleted.faces,
+                deleted
+                    .layer
+                    .map(|l| format!(", layer {l}"))
+                    .unwrap_or_default(),
+                files.output.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn list(file: &Path, json: bool, strict: bool) -> anyhow::Result<ExitCode> {
+    let session = crate::open::open_without_history(file, strict)?;
+    let summaries = slayer::tools::layer_summaries(session.mesh());
+    if json {
+        println!("{}", serde_json::to_string_pretty(&summaries)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    for layer in &summaries {
+        println!(
+            "layer {} `{}`: {} faces, {} vertices, {} components",
+            layer.layer,
+            slayer::files::escape(&layer.name),
+            layer.faces,
+            layer.vertices,
+            layer.components.len()
+        );
+        for c in &layer.components {
+            let closed = if c.closed { "closed" } else { "open" };
+            println!("  component {}: {} faces, {closed}", c.component, c.faces);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Opens the input, refusing an output that is the input without `--in-place`; a mesh output
+/// needs no history.
+fn open(files: &Files, strict: bool) -> anyhow::Result<Session> {
+    slayer::session::check_save_path(&files.output)?;
+    if !files.in_place && crate::sculpt::same_file(&files.input, &files.output) {
+        bail!(
+            "{}: the output is the input file; give another --output, or --in-place to replace \
+             the input",
+            files.output.display()
+        );
+    }
+    if slayer::session::is_session_path(&files.output) {
+        crate::open::open(&files.input, strict)
+    } else {
+        crate::open::open_without_history(&files.input, strict)
+    }
+}
+
+fn save(session: &Session, files: &Files) -> anyhow::Result<()> {
+    session
+        .mesh()
+        .validate()
+        .context("the result failed validation (not written)")?;
+    slayer::session::save(session, &files.output, true)
+        .with_context(|| format!("writing {}", files.output.display()))
+}
+
+fn one_layer(mesh: &slayer::mesh::Mesh, name: &str) -> anyhow::Result<LayerId> {
+    Ok(crate::render::resolve_layers(mesh, &[name.to_string()])?[0])
+}
+
+/// Applies a stroke file's strokes (on the CPU) as history entries.
+fn apply_strokes(session: &mut Session, path: &Path) -> anyhow::Result<()> {
+    let text = slayer::files::read_input_text(path, slayer::files::MAX_INPUT_BYTES)
+        .with_context(|| format!("{}", path.display()))?;
+    let name = path.display().to_string();
+    let file = slayer::brush::StrokeFile::parse(&text, &name)?;
+    let strokes = file.resolve(session.mesh(), &name)?;
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    for (i, stroke) in strokes.iter().enumerate() {
+        session
+            .apply_stroke(&mut pipeline, stroke)
+            .with_context(|| format!("{name}: strokes[{i}]"))?;
+    }
+    Ok(())
+}
+
+/// The tool's settings in world units, from the CLI's edge lengths and names.
+fn duplicate_settings(
+    session: &Session,
+    selection: Selection,
+    (offset, thickness): (f32, Option<f32>),
+    (name, material): (Option<String>, Option<String>),
+) -> anyhow::Result<DuplicateSettings> {
+    let mesh = session.mesh();
+    let faces = slayer::tools::selected_faces(mesh, selection)?;
+    let source = mesh.face_layers()[faces[0] as usize];
+    let material = match material {
+        Some(name) => {
+            slayer::material::preset(&name)
+                .with_context(|| format!("--material: no preset `{name}`"))?
+                .brdf
+        }
+        None => session.layers()[source as usize].material,
+    };
+    let name = name.unwrap_or_else(|| format!("{} copy", mesh.layer_names()[source as usize]));
+    let mut settings = DuplicateSettings::for_mesh(mesh, &name, material);
+    settings.offset = offset * settings.edge;
+    settings.thickness = thickness.map(|t| t * settings.edge);
+    Ok(settings)
+}

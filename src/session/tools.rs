@@ -1,0 +1,77 @@
+//! The layer tools (`crate::tools`) as history entries: each is planned and checked on the
+//! mesh as it is, and only a tool that succeeds opens an entry, which holds the mesh's rows and
+//! the layer settings together, so one undo takes a new or deleted layer back whole.
+
+use std::time::Instant;
+
+use super::{LayerSettings, ProximityPolicy, Recorded, Session};
+use crate::mesh::LayerId;
+use crate::tools::{
+    DeleteTarget, DuplicateReport, DuplicateSettings, Selection, ToolError, plan_delete,
+    plan_duplicate,
+};
+
+/// What a delete removed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Deleted {
+    pub components: usize,
+    pub faces: usize,
+    /// The layer removed, for [`DeleteTarget::Layer`].
+    pub layer: Option<LayerId>,
+}
+
+impl Session {
+    /// Copies `selection` into a new layer lifted off it (visible, active, colliding, in
+    /// `settings.material`), as one history entry; on an error nothing changes.
+    pub fn duplicate(
+        &mut self,
+        selection: Selection,
+        settings: &DuplicateSettings,
+    ) -> Result<(DuplicateReport, Recorded), ToolError> {
+        let started = Instant::now();
+        let (piece, mut report) = plan_duplicate(&self.mesh, selection, settings)?;
+        let mut edit = self.edit("duplicate layer");
+        let (mesh, layers) = edit.mesh_and_layers();
+        report.layer = mesh.append(&piece);
+        layers.push(LayerSettings {
+            visible: true,
+            active: true,
+            policy: ProximityPolicy::Collide,
+            material: settings.material,
+        });
+        let recorded = edit.commit();
+        report.millis = started.elapsed().as_secs_f64() * 1e3;
+        Ok((report, recorded))
+    }
+
+    /// Deletes `target` and compacts the mesh, as one history entry; on an error (a target
+    /// that does not exist, or one that would leave no face) nothing changes.
+    pub fn delete(&mut self, target: DeleteTarget) -> Result<(Deleted, Recorded), ToolError> {
+        let (doomed, components) = plan_delete(&self.mesh, target)?;
+        let faces = doomed.iter().filter(|&&d| d).count();
+        let label = match target {
+            DeleteTarget::Layer(_) => "delete layer",
+            _ => "delete components",
+        };
+        let mut edit = self.edit(label);
+        let (mesh, layers) = edit.mesh_and_layers();
+        let layer = match target {
+            DeleteTarget::Layer(layer) => {
+                mesh.remove_layer(layer);
+                layers.remove(layer as usize);
+                Some(layer)
+            }
+            _ => {
+                mesh.remove_faces(&doomed);
+                None
+            }
+        };
+        let recorded = edit.commit();
+        let deleted = Deleted {
+            components,
+            faces,
+            layer,
+        };
+        Ok((deleted, recorded))
+    }
+}

@@ -1,0 +1,367 @@
+//! The layer tools (offset duplicate, delete) on the three materials and a closed sphere: a
+//! valid mesh with nothing crossing, the layers and components expected, a copy at the mesh's
+//! edge length and the offset from its source, and every tool undone bit for bit.
+
+mod common;
+
+use glam::Vec3;
+use slayer::collide::find_intersections;
+use slayer::geom::point_triangle_distance_squared;
+use slayer::mesh::{LayerId, Mesh};
+use slayer::scene::{SceneKind, SceneSpec, generate};
+use slayer::session::Session;
+use slayer::tools::{DeleteTarget, DuplicateSettings, Selection, ToolError};
+
+fn scene(kind: SceneKind, triangles: usize) -> Mesh {
+    generate(&SceneSpec {
+        kind,
+        triangles,
+        seed: 1,
+    })
+    .unwrap()
+}
+
+/// A live vertex of `layer` with no vertex of a layer above it (nor the layer's rim) within
+/// `clear` across the xy plane: where a lifted copy meets nothing.
+fn open_spot(mesh: &Mesh, layer: LayerId, clear: f32) -> u32 {
+    let layers = mesh.vertex_layers();
+    let live = |v: u32| mesh.is_vertex_live(v);
+    let blockers: Vec<Vec3> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| {
+            live(v)
+                && (layers[v as usize] > layer
+                    || (layers[v as usize] == layer && mesh.is_boundary_vertex(v)))
+        })
+        .map(|v| mesh.positions()[v as usize])
+        .collect();
+    (0..mesh.vertex_count() as u32)
+        .filter(|&v| live(v) && layers[v as usize] == layer)
+        .find(|&v| {
+            let p = mesh.positions()[v as usize];
+            blockers
+                .iter()
+                .all(|b| (b.truncate() - p.truncate()).length() > clear)
+        })
+        .unwrap_or_else(|| panic!("no open spot on layer {layer}"))
+}
+
+/// Masks the vertices of `layer` within `radius` of `centre`'s vertex, as a session edit.
+fn mask_disc(session: &mut Session, layer: LayerId, centre: u32, radius: f32) {
+    let mut edit = session.edit("mask disc");
+    let mesh = edit.mesh();
+    let c = mesh.positions()[centre as usize];
+    let inside: Vec<bool> = (0..mesh.vertex_count())
+        .map(|v| mesh.vertex_layers()[v] == layer && mesh.positions()[v].distance(c) <= radius)
+        .collect();
+    for (flags, inside) in mesh.flags_mut().iter_mut().zip(inside) {
+        if inside {
+            flags.set_mask(1.0);
+        }
+    }
+    edit.commit();
+}
+
+/// The distance from `p` to the nearest live face of `layer`.
+fn distance_to_layer(mesh: &Mesh, layer: LayerId, p: Vec3) -> f32 {
+    (0..mesh.face_count())
+        .filter(|&f| !mesh.is_face_dead(f) && mesh.face_layers()[f] == layer)
+        .map(|f| {
+            let [a, b, c] = mesh.face_positions(f);
+            point_triangle_distance_squared(p, a, b, c)
+        })
+        .fold(f32::INFINITY, f32::min)
+        .sqrt()
+}
+
+/// Runs a duplicate through the session and checks what every duplicate must be; returns the
+/// new layer's vertices.
+fn duplicate_and_check(
+    session: &mut Session,
+    selection: Selection,
+    settings: &DuplicateSettings,
+    source: LayerId,
+) -> Vec<u32> {
+    let before = session.mesh().digest();
+    let layers_before = session.mesh().layer_count();
+    let (report, recorded) = session.duplicate(selection, settings).unwrap();
+    assert!(recorded.changed);
+    let mesh = session.mesh();
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(mesh).total(), 0, "nothing crosses");
+    assert_eq!(mesh.layer_count(), layers_before + 1);
+    assert_eq!(report.layer as usize, layers_before);
+    assert_eq!(session.layers().len(), layers_before + 1);
+    let copy = mesh.with_layers(&[report.layer]).unwrap();
+    let cv = copy.edge_length_stats().coefficient_of_variation();
+    assert!(cv <= 0.15, "the copy's edge cv is {cv}");
+    let ratio = copy.mean_edge_length() / settings.edge;
+    assert!((0.8..1.25).contains(&ratio), "the copy's edge is {ratio} L");
+    let new: Vec<u32> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| mesh.is_vertex_live(v) && mesh.vertex_layers()[v as usize] == report.layer)
+        .collect();
+    for &v in &new {
+        let brdf = mesh.brdfs()[v as usize];
+        assert!(brdf.is_finite());
+        assert_eq!(brdf, settings.material);
+    }
+    assert!(mesh.brdfs().iter().all(|b| b.is_finite()));
+    let after = mesh.digest();
+    session.undo().unwrap();
+    assert_eq!(session.mesh().digest(), before, "undo restores the mesh");
+    assert_eq!(session.layers().len(), layers_before);
+    session.redo().unwrap();
+    assert_eq!(session.mesh().digest(), after, "redo makes it again");
+    let _ = source;
+    new
+}
+
+/// Every vertex of the copy lies within [0.9, 1.1] × the offset of its source layer.
+fn assert_offset(mesh: &Mesh, new: &[u32], source: LayerId, offset: f32) {
+    for &v in new.iter().step_by(new.len().div_ceil(400).max(1)) {
+        let d = distance_to_layer(mesh, source, mesh.positions()[v as usize]);
+        assert!(
+            (0.9 * offset..=1.1 * offset).contains(&d),
+            "vertex {v} is {} offsets from its source",
+            d / offset
+        );
+    }
+}
+
+#[test]
+fn a_masked_part_of_each_material_is_copied_above_itself() {
+    // Bark's plates are narrow between their cracks: a smaller disc.
+    for (kind, layer, edges) in [
+        (SceneKind::Plaster, 1, 4.0),
+        (SceneKind::Bark, 2, 2.5),
+        (SceneKind::Metal, 1, 4.0),
+    ] {
+        let mut session = Session::new(scene(kind, 20_000));
+        let edge = session.mesh().mean_edge_length();
+        let radius = edges * edge;
+        let centre = open_spot(session.mesh(), layer, radius + 1.5 * edge);
+        mask_disc(&mut session, layer, centre, radius);
+        let material = slayer::material::RED_PAINT.brdf;
+        let settings = DuplicateSettings::for_mesh(session.mesh(), "copy", material);
+        let new = duplicate_and_check(&mut session, Selection::Masked(layer), &settings, layer);
+        let mesh = session.mesh();
+        let components = mesh.components();
+        let new_layer = mesh.layer_count() as u32 - 1;
+        assert_eq!(
+            components.per_layer(mesh.layer_count())[new_layer as usize],
+            1,
+            "{kind:?}"
+        );
+        assert_offset(mesh, &new, layer, settings.offset);
+    }
+}
+
+#[test]
+fn a_closed_sphere_is_copied_as_a_sheet_and_as_a_shell() {
+    let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
+    let settings = DuplicateSettings::for_mesh(session.mesh(), "skin", slayer::material::RUST.brdf);
+    let new = duplicate_and_check(&mut session, Selection::Layer(0), &settings, 0);
+    assert_offset(session.mesh(), &new, 0, settings.offset);
+
+    let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
+    let mut shell = settings.clone();
+    shell.thickness = Some(1.5 * settings.edge);
+    shell.name = "shell".into();
+    duplicate_and_check(&mut session, Selection::Component(0), &shell, 0);
+    let mesh = session.mesh();
+    let closed: Vec<_> = mesh
+        .closed_components()
+        .into_iter()
+        .filter(|c| c.layer == 1)
+        .collect();
+    assert_eq!(
+        closed.len(),
+        2,
+        "a shell of a closed surface is two closed surfaces"
+    );
+    // The outer faces outward, the inner inward: their volumes have opposite signs.
+    assert!(closed[0].volume * closed[1].volume < 0.0);
+}
+
+#[test]
+fn a_sheet_thickened_is_one_closed_shell() {
+    let mut session = Session::new(scene(SceneKind::Plaster, 20_000));
+    let edge = session.mesh().mean_edge_length();
+    let centre = open_spot(session.mesh(), 1, 6.0 * edge);
+    mask_disc(&mut session, 1, centre, 4.0 * edge);
+    let mut settings =
+        DuplicateSettings::for_mesh(session.mesh(), "chip", slayer::material::PAINT.brdf);
+    settings.thickness = Some(2.0 * edge);
+    duplicate_and_check(&mut session, Selection::Masked(1), &settings, 1);
+    let mesh = session.mesh();
+    let shells: Vec<_> = mesh
+        .closed_components()
+        .into_iter()
+        .filter(|c| c.layer == 3)
+        .collect();
+    assert_eq!(
+        shells.len(),
+        1,
+        "sheet, band and inner sheet make one closed surface"
+    );
+    assert!(shells[0].volume > 0.0, "it winds outward");
+}
+
+#[test]
+fn a_copy_that_cannot_be_placed_is_refused_and_changes_nothing() {
+    let mut session = Session::new(scene(SceneKind::Plaster, 20_000));
+    let before = session.mesh().digest();
+    let entries = session.history().entries().len();
+    let mut settings =
+        DuplicateSettings::for_mesh(session.mesh(), "copy", slayer::material::PAINT.brdf);
+    // The base lifted into the paint above it, as a shell thicker than the room there.
+    settings.thickness = Some(20.0 * settings.edge);
+    let refused = session
+        .duplicate(Selection::Layer(0), &settings)
+        .unwrap_err();
+    assert!(matches!(refused, ToolError::NoRoom { .. }), "{refused}");
+    settings.thickness = None;
+    settings.offset = f32::NAN;
+    assert!(matches!(
+        session.duplicate(Selection::Layer(0), &settings),
+        Err(ToolError::BadLength { .. })
+    ));
+    assert!(matches!(
+        session.duplicate(
+            Selection::Masked(1),
+            &DuplicateSettings::for_mesh(session.mesh(), "x", slayer::material::PAINT.brdf)
+        ),
+        Err(ToolError::EmptySelection(_))
+    ));
+    assert_eq!(session.mesh().digest(), before);
+    assert_eq!(
+        session.history().entries().len(),
+        entries,
+        "nothing recorded"
+    );
+}
+
+#[test]
+fn deleting_components_and_layers_compacts_and_undoes() {
+    let mut session = Session::new(scene(SceneKind::Plaster, 20_000));
+    let mesh = session.mesh();
+    let (start, layers, components) =
+        (mesh.digest(), mesh.layer_count(), mesh.components().count());
+    let (deleted, _) = session.delete(DeleteTarget::Smallest(3)).unwrap();
+    assert_eq!(deleted.components, 3);
+    let mesh = session.mesh();
+    mesh.validate().unwrap();
+    assert_eq!(mesh.components().count(), components - 3);
+    assert_eq!(mesh.live_face_count(), mesh.face_count(), "compacted");
+    let small = mesh.components().size.iter().filter(|&&s| s < 40).count();
+    let (deleted, _) = session.delete(DeleteTarget::Under(40)).unwrap();
+    assert_eq!(deleted.components, small);
+    let names: Vec<String> = session.mesh().layer_names().to_vec();
+    session.delete(DeleteTarget::Layer(1)).unwrap();
+    let mesh = session.mesh();
+    mesh.validate().unwrap();
+    assert_eq!(mesh.layer_count(), layers - 1);
+    assert_eq!(mesh.layer_names(), &[names[0].clone(), names[2].clone()]);
+    assert_eq!(session.layers().len(), layers - 1);
+    assert!(
+        mesh.face_layers()
+            .iter()
+            .all(|&l| (l as usize) < layers - 1)
+    );
+    assert_eq!(find_intersections(mesh).total(), 0);
+    for _ in 0..3 {
+        session.undo().unwrap();
+    }
+    assert_eq!(
+        session.mesh().digest(),
+        start,
+        "three undos restore the scene"
+    );
+    assert_eq!(session.layers().len(), layers);
+
+    let refused = session.delete(DeleteTarget::Component(999)).unwrap_err();
+    assert!(matches!(refused, ToolError::NoSuchComponent { .. }));
+    let mut sphere = Session::new(scene(SceneKind::Sphere, 2_000));
+    let refused = sphere.delete(DeleteTarget::Layer(0)).unwrap_err();
+    assert!(matches!(refused, ToolError::WouldEmpty(_)), "{refused}");
+    assert!(sphere.history().entries().is_empty());
+}
+
+#[test]
+fn the_command_line_lists_duplicates_and_deletes() {
+    use common::{arg, slayer, text};
+    let dir = common::scratch("layer-tools");
+    let input = dir.join("plaster.ply");
+    common::write_scene("plaster", 20_000, &[], &input);
+    let out = slayer(&["layer", "list", arg(&input), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let listed: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(listed.as_array().unwrap().len(), 3);
+    assert_eq!(listed[1]["name"], "paint");
+
+    let session = dir.join("copy.slayer");
+    let out = slayer(&[
+        "layer",
+        "duplicate",
+        arg(&input),
+        "-o",
+        arg(&session),
+        "--layer",
+        "paint",
+        "--material",
+        "rust",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("new layer 3 `paint copy`"),
+        "{}",
+        text(&out.stdout)
+    );
+    let undone = dir.join("undone.ply");
+    let out = slayer(&["undo", arg(&session), "-o", arg(&undone)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (a, b) = (
+        slayer::io::read_mesh(&input).unwrap(),
+        slayer::io::read_mesh(&undone).unwrap(),
+    );
+    assert_eq!(
+        a.digest(),
+        b.digest(),
+        "undoing the tool gives the input back"
+    );
+
+    let deleted = dir.join("deleted.ply");
+    let out = slayer(&[
+        "layer",
+        "delete",
+        arg(&session),
+        "-o",
+        arg(&deleted),
+        "--layer",
+        "flakes",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let mesh = slayer::io::read_mesh(&deleted).unwrap();
+    assert_eq!(mesh.layer_names(), &["plaster", "paint", "paint copy"]);
+
+    let refused = slayer(&[
+        "layer",
+        "delete",
+        arg(&input),
+        "-o",
+        arg(&input),
+        "--smallest",
+        "1",
+    ]);
+    common::assert_one_line_error(&refused, &["the output is the input file"]);
+    let refused = slayer(&[
+        "layer",
+        "duplicate",
+        arg(&input),
+        "-o",
+        arg(&dir.join("x.ply")),
+        "--component",
+        "99",
+    ]);
+    common::assert_one_line_error(&refused, &["component 99 does not exist"]);
+    assert!(!dir.join("x.ply").exists());
+}
