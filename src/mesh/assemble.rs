@@ -93,8 +93,8 @@ impl Mesh {
                 o == INVALID || doomed[o as usize / 3]
             })
         });
-        for face in 0..self.face_count() {
-            if !doomed[face] || self.is_face_dead(face) {
+        for (face, _) in doomed.iter().enumerate().filter(|(_, doomed)| **doomed) {
+            if self.is_face_dead(face) {
                 continue;
             }
             if !closed {

@@ -23,7 +23,8 @@ use super::{ToolError, check_length};
 use crate::collide::find_intersections;
 use crate::geom::Aabb;
 use crate::mesh::{Brdf, LayerId, Mesh};
-use crate::remesh::{RemeshSettings, remesh_all};
+use crate::grid::{GridError, SpatialHash};
+use crate::remesh::{RemeshSettings, remesh_region};
 
 /// The final check's allowance on `d` for rounding.
 const CLEARANCE_SLACK: f32 = 1e-3;
@@ -210,15 +211,24 @@ fn finish(
         let mut remeshed = piece.clone();
         let mut remesh = RemeshSettings::new(settings.edge);
         remesh.collision_distance = settings.collision_distance;
-        if remesh_all(&mut remeshed, &remesh).is_ok() {
+            if remesh_out_of_band(&mut remeshed, &remesh).is_ok() {
             remeshed.compact();
-            if check_clear(&remeshed, obstacles, settings.collision_distance).is_ok() {
+                    if check_clear(&remeshed, obstacles, settings.collision_distance).is_ok() {
                 return Ok((remeshed, true));
             }
         }
     }
     check_clear(&piece, obstacles, settings.collision_distance)?;
     Ok((piece, false))
+}
+
+/// Remeshes where lifting (or thickening) left edges the remesher would change: the rest of
+/// the copy is its source's, already at `L`, and is left as it is.
+fn remesh_out_of_band(piece: &mut Mesh, settings: &RemeshSettings) -> Result<(), GridError> {
+    let mut grid = SpatialHash::build(piece, settings.target_edge)?;
+    let every: Vec<u32> = (0..piece.vertex_count() as u32).collect();
+    remesh_region(piece, &mut grid, &every, settings);
+    Ok(())
 }
 
 /// Every vertex of `piece` at least `d` (less rounding) from the obstacles, and no face of it

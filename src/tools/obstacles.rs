@@ -2,6 +2,7 @@
 //! new vertices are kept clear of and the new faces are tested against exactly.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use crate::collide::LocalFaceGrid;
 use crate::geom::{Aabb, point_triangle_distance_squared, triangles_intersect};
@@ -94,22 +95,21 @@ impl Obstacles {
 
     /// How many pairs of one of `triangles` and a face here intersect (exact test).
     pub(super) fn intersecting_pairs(&self, triangles: &[[Vec3; 3]]) -> usize {
-        let mut pairs = 0;
-        let mut seen: Vec<u32> = Vec::new();
-        for tri in triangles {
-            let b = Aabb::of_points(tri);
-            seen.clear();
-            self.grid.for_each_candidate(&b, |i| seen.push(i));
-            seen.sort_unstable();
-            seen.dedup();
-            pairs += seen
-                .iter()
-                .filter(|&&i| {
-                    self.boxes[i as usize].overlaps(&b)
-                        && triangles_intersect(*tri, self.triangles[i as usize])
-                })
-                .count();
-        }
-        pairs
+        triangles
+            .par_iter()
+            .map_init(Vec::new, |seen: &mut Vec<u32>, tri| {
+                let b = Aabb::of_points(tri);
+                seen.clear();
+                self.grid.for_each_candidate(&b, |i| seen.push(i));
+                seen.sort_unstable();
+                seen.dedup();
+                seen.iter()
+                    .filter(|&&i| {
+                        self.boxes[i as usize].overlaps(&b)
+                            && triangles_intersect(*tri, self.triangles[i as usize])
+                    })
+                    .count()
+            })
+            .sum()
     }
 }
