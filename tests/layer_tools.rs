@@ -10,7 +10,7 @@ use slayer::geom::point_triangle_distance_squared;
 use slayer::mesh::{LayerId, Mesh};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 use slayer::session::Session;
-use slayer::tools::{DeleteTarget, DuplicateSettings, Selection, ToolError};
+use slayer::tools::{CutSettings, DeleteTarget, DuplicateSettings, Selection, ToolError};
 
 fn scene(kind: SceneKind, triangles: usize) -> Mesh {
     generate(&SceneSpec {
@@ -364,4 +364,112 @@ fn the_command_line_lists_duplicates_and_deletes() {
     ]);
     common::assert_one_line_error(&refused, &["component 99 does not exist"]);
     assert!(!dir.join("x.ply").exists());
+}
+
+/// A stroke across `layer` along x at the middle of its y range, through its own vertices
+/// (points on the surface, as a pick would give), from `from` to `to` of its x range.
+fn stroke_across(mesh: &Mesh, layer: LayerId, (from, to): (f32, f32)) -> Vec<Vec3> {
+    let edge = mesh.mean_edge_length();
+    let on_layer: Vec<Vec3> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| mesh.is_vertex_live(v) && mesh.vertex_layers()[v as usize] == layer)
+        .map(|v| mesh.positions()[v as usize])
+        .collect();
+    let (lo, hi) = on_layer
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p), b.max(p))
+        });
+    let y = 0.5 * (lo.y + hi.y);
+    let mut band: Vec<Vec3> = on_layer
+        .into_iter()
+        .filter(|p| (p.y - y).abs() < 0.6 * edge)
+        .collect();
+    band.sort_by(|a, b| a.x.total_cmp(&b.x));
+    let (x0, x1) = (lo.x + from * (hi.x - lo.x), lo.x + to * (hi.x - lo.x));
+    band.into_iter()
+        .filter(|p| (x0..=x1).contains(&p.x))
+        .step_by(3)
+        .collect()
+}
+
+/// Cuts through the session and checks what every cut must be.
+fn cut_and_check(
+    session: &mut Session,
+    stroke: &[Vec3],
+    layers: &[LayerId],
+) -> slayer::tools::CutReport {
+    let before = session.mesh().digest();
+    let settings = CutSettings::for_mesh(session.mesh(), layers);
+    let (report, _) = session.cut(stroke, &settings).unwrap();
+    let mesh = session.mesh();
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(mesh).total(), 0, "the sides are apart");
+    assert!(report.path_edges > 0 && report.duplicated > 0, "{report:?}");
+    assert!(
+        report.farthest_from_stroke <= 0.5 * settings.edge,
+        "the path strays {} edges from the stroke",
+        report.farthest_from_stroke / settings.edge
+    );
+    assert!(mesh.brdfs().iter().all(|b| b.is_finite()));
+    assert!(
+        mesh.face_layers()
+            .iter()
+            .all(|&l| (l as usize) < mesh.layer_count())
+    );
+    let after = mesh.digest();
+    session.undo().unwrap();
+    assert_eq!(session.mesh().digest(), before, "undo restores the mesh");
+    session.redo().unwrap();
+    assert_eq!(session.mesh().digest(), after);
+    report
+}
+
+#[test]
+fn a_closed_cut_detaches_a_piece_and_an_open_one_makes_a_slit() {
+    let sphere = scene(SceneKind::Sphere, 5_000);
+    let ring: Vec<Vec3> = (0..=24)
+        .map(|k| {
+            let a = k as f32 / 24.0 * std::f32::consts::TAU;
+            Vec3::new(0.2 * a.cos(), 0.2 * a.sin(), 0.46)
+        })
+        .collect();
+    let mut session = Session::new(sphere.clone());
+    let report = cut_and_check(&mut session, &ring, &[0]);
+    assert_eq!((report.components_before, report.components_after), (1, 2));
+    assert_eq!(
+        session.mesh().closed_components().len(),
+        0,
+        "both pieces are open"
+    );
+
+    let mut session = Session::new(sphere);
+    let line = [Vec3::new(-0.3, -0.05, 0.45), Vec3::new(0.3, 0.1, 0.45)];
+    let report = cut_and_check(&mut session, &line, &[0]);
+    assert_eq!(report.components_after, 1, "a slit keeps the sphere whole");
+    assert!(report.splits > 0, "edges were split to follow the stroke");
+}
+
+#[test]
+fn each_material_is_cut_across_its_top_layer() {
+    for (kind, layer) in [
+        (SceneKind::Plaster, 1),
+        (SceneKind::Bark, 1),
+        (SceneKind::Metal, 0),
+    ] {
+        let mut session = Session::new(scene(kind, 20_000));
+        let stroke = stroke_across(session.mesh(), layer, (0.2, 0.8));
+        let report = cut_and_check(&mut session, &stroke, &[layer]);
+        let faces = session.mesh().faces_per_layer();
+        assert!(faces[layer as usize] > 0, "{kind:?}: {report:?}");
+    }
+    // A stroke nowhere near the layer is refused and changes nothing.
+    let mut session = Session::new(scene(SceneKind::Plaster, 20_000));
+    let before = session.mesh().digest();
+    let far = [Vec3::splat(50.0), Vec3::splat(51.0)];
+    let refused = session
+        .cut(&far, &CutSettings::for_mesh(session.mesh(), &[0]))
+        .unwrap_err();
+    assert!(matches!(refused, ToolError::EmptySelection(_)), "{refused}");
+    assert_eq!(session.mesh().digest(), before);
+    assert!(session.history().entries().is_empty());
 }

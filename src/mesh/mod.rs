@@ -17,6 +17,7 @@ mod extract;
 mod measure;
 mod raw;
 mod repair;
+mod slit;
 mod validate;
 mod vertex_faces;
 

@@ -7,8 +7,8 @@ use std::time::Instant;
 use super::{LayerSettings, ProximityPolicy, Recorded, Session};
 use crate::mesh::LayerId;
 use crate::tools::{
-    DeleteTarget, DuplicateReport, DuplicateSettings, Selection, ToolError, plan_delete,
-    plan_duplicate,
+    CutReport, CutSettings, DeleteTarget, DuplicateReport, DuplicateSettings, Selection, ToolError,
+    plan_delete, plan_duplicate,
 };
 
 /// What a delete removed.
@@ -42,6 +42,20 @@ impl Session {
         let recorded = edit.commit();
         report.millis = started.elapsed().as_secs_f64() * 1e3;
         Ok((report, recorded))
+    }
+
+    /// Cuts `settings.layers` open along `stroke` (points on or near the surface), as one
+    /// history entry; on an error nothing changes.
+    pub fn cut(
+        &mut self,
+        stroke: &[glam::Vec3],
+        settings: &CutSettings,
+    ) -> Result<(CutReport, Recorded), ToolError> {
+        // The cut changes the mesh only once it is made and checked; the entry compares the
+        // mesh with the history's copy, made before it.
+        self.prepare_history();
+        let report = crate::tools::cut(&mut self.mesh, stroke, settings)?;
+        Ok((report, self.edit("cut").commit()))
     }
 
     /// Deletes `target` and compacts the mesh, as one history entry; on an error (a target

@@ -22,8 +22,8 @@ use super::shell::thicken;
 use super::{ToolError, check_length};
 use crate::collide::find_intersections;
 use crate::geom::Aabb;
-use crate::mesh::{Brdf, LayerId, Mesh};
 use crate::grid::{GridError, SpatialHash};
+use crate::mesh::{Brdf, LayerId, Mesh};
 use crate::remesh::{RemeshSettings, remesh_region};
 
 /// The final check's allowance on `d` for rounding.
@@ -211,9 +211,9 @@ fn finish(
         let mut remeshed = piece.clone();
         let mut remesh = RemeshSettings::new(settings.edge);
         remesh.collision_distance = settings.collision_distance;
-            if remesh_out_of_band(&mut remeshed, &remesh).is_ok() {
+        if remesh_out_of_band(&mut remeshed, &remesh).is_ok() {
             remeshed.compact();
-                    if check_clear(&remeshed, obstacles, settings.collision_distance).is_ok() {
+            if check_clear(&remeshed, obstacles, settings.collision_distance).is_ok() {
                 return Ok((remeshed, true));
             }
         }

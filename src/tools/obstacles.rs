@@ -5,11 +5,15 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::collide::LocalFaceGrid;
-use crate::geom::{Aabb, point_triangle_distance_squared, triangles_intersect};
+use crate::geom::{
+    Aabb, closest_point_on_triangle, point_triangle_distance_squared, triangles_intersect,
+};
 use crate::mesh::{LayerId, Mesh};
 
 /// The live faces of a mesh whose boxes meet a region.
 pub(super) struct Obstacles {
+    /// The mesh's index of each face here.
+    faces: Vec<u32>,
     triangles: Vec<[Vec3; 3]>,
     layers: Vec<LayerId>,
     boxes: Vec<Aabb>,
@@ -20,6 +24,7 @@ impl Obstacles {
     /// The faces of `mesh` whose boxes meet `region`, in a grid of cell `cell`.
     pub(super) fn near(mesh: &Mesh, region: Aabb, cell: f32) -> Obstacles {
         let mut obstacles = Obstacles {
+            faces: Vec::new(),
             triangles: Vec::new(),
             layers: Vec::new(),
             boxes: Vec::new(),
@@ -32,6 +37,7 @@ impl Obstacles {
             let tri = mesh.face_positions(f);
             let b = Aabb::of_points(&tri);
             if b.overlaps(&region) {
+                obstacles.faces.push(f as u32);
                 obstacles.triangles.push(tri);
                 obstacles.layers.push(mesh.face_layers()[f]);
                 obstacles.boxes.push(b);
@@ -69,6 +75,26 @@ impl Obstacles {
             }
         });
         best
+    }
+
+    /// The face of `layer` nearest to `p` within `reach`, and its point nearest to `p`.
+    pub(super) fn nearest_face(&self, p: Vec3, reach: f32, layer: LayerId) -> Option<(u32, Vec3)> {
+        let query = Aabb::of_points(&[p]).expanded(reach);
+        let mut best: Option<(u32, Vec3, f32)> = None;
+        self.grid.for_each_candidate(&query, |i| {
+            let i = i as usize;
+            if self.layers[i] != layer || !self.boxes[i].within(p, reach) {
+                return;
+            }
+            let [a, b, c] = self.triangles[i];
+            let q = closest_point_on_triangle(p, a, b, c);
+            let d2 = q.distance_squared(p);
+            let better = best.is_none_or(|(f, _, d)| (d2, self.faces[i]) < (d, f));
+            if d2 < reach * reach && better {
+                best = Some((self.faces[i], q, d2));
+            }
+        });
+        best.map(|(f, q, _)| (f, q))
     }
 
     /// Whether a face of `layer` lies within `reach` of `p` and nearer to `p` than to

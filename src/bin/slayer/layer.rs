@@ -52,6 +52,19 @@ pub enum LayerCommand {
         #[arg(long)]
         material: Option<String>,
     },
+    /// Cut layers open along the strokes of a stroke file (each stroke one cut, its samples
+    /// the path): snapped to the edges, opened by the collision distance. A closed or
+    /// rim-to-rim cut detaches a piece, an open one makes a slit.
+    Cut {
+        #[command(flatten)]
+        files: Files,
+        /// Stroke file whose samples trace the cuts.
+        #[arg(long, value_name = "FILE")]
+        strokes: PathBuf,
+        /// The layers to cut (names or numbers, comma-separated); default: every layer.
+        #[arg(long, value_delimiter = ',')]
+        layers: Vec<String>,
+    },
     /// Delete a layer or connected components, and compact the mesh.
     Delete {
         #[command(flatten)]
@@ -130,6 +143,11 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
+        LayerCommand::Cut {
+            files,
+            strokes,
+            layers,
+        } => cut(&files, &strokes, &layers, strict),
         LayerCommand::Delete {
             files,
             layer,
@@ -160,6 +178,41 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+fn cut(files: &Files, strokes: &Path, layers: &[String], strict: bool) -> anyhow::Result<ExitCode> {
+    let mut session = open(files, strict)?;
+    let mesh = session.mesh();
+    let layers = if layers.is_empty() {
+        (0..mesh.layer_count() as LayerId).collect()
+    } else {
+        crate::render::resolve_layers(mesh, layers)?
+    };
+    let settings = slayer::tools::CutSettings::for_mesh(mesh, &layers);
+    let text = slayer::files::read_input_text(strokes, slayer::files::MAX_INPUT_BYTES)
+        .with_context(|| format!("{}", strokes.display()))?;
+    let name = strokes.display().to_string();
+    let file = slayer::brush::StrokeFile::parse(&text, &name)?;
+    for (i, stroke) in file.resolve(session.mesh(), &name)?.iter().enumerate() {
+        let path: Vec<_> = stroke.samples.iter().map(|s| s.position).collect();
+        let (report, _) = session
+            .cut(&path, &settings)
+            .with_context(|| format!("{name}: strokes[{i}]"))?;
+        println!(
+            "cut {}: {} edges ({} split to follow the stroke, within {:.2} edges of it), {} vertices duplicated, components {} -> {}, {:.0} ms",
+            i,
+            report.path_edges,
+            report.splits,
+            report.farthest_from_stroke / settings.edge,
+            report.duplicated,
+            report.components_before,
+            report.components_after,
+            report.millis
+        );
+    }
+    save(&session, files)?;
+    println!("-> {}", files.output.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn list(file: &Path, json: bool, strict: bool) -> anyhow::Result<ExitCode> {

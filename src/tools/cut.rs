@@ -1,0 +1,374 @@
+//! Cutting a layer along a stroke (sLayer, "Editing Tools": the cut "snaps the stroke to
+//! existing triangle edges"): the stroke is projected onto the layer, edges it crosses far
+//! from a vertex are split where it crosses them, the projected points are joined by shortest
+//! paths of edges, and the surface is cut open along that path. A closed or rim-to-rim cut
+//! detaches a piece; an open one makes a slit.
+//!
+//! The two sides of a cut would lie on each other, touching along the whole path (a
+//! collision at distance 0 for every later stroke, and a crossing for the exact test), so the
+//! cut is opened: every vertex it duplicated moves half the collision distance into its own
+//! side, as far as its faces allow, and the band is remeshed to `L`.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+use std::time::Instant;
+
+use glam::Vec3;
+
+use super::obstacles::Obstacles;
+use super::select::check_layer;
+use super::{ToolError, check_length};
+use crate::geom::Aabb;
+use crate::grid::SpatialHash;
+use crate::mesh::{LayerId, Mesh};
+use crate::remesh::{RemeshSettings, remesh_region};
+
+/// A stroke point is snapped to a vertex this close (× L); farther, the nearest edge of its
+/// face is split under it.
+const SNAP_SHARE: f32 = 0.4;
+/// A shortest path between two snapped points may cost this many times their distance (plus
+/// two edges) before the stroke is taken to have left the surface there.
+const DETOUR: f32 = 3.0;
+/// Halvings of a vertex's opening move before it is left where it is.
+const OPENING_TRIES: u32 = 4;
+
+/// How to cut.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutSettings {
+    /// The layers cut, each on its own.
+    pub layers: Vec<LayerId>,
+    /// The mesh's edge length `L`.
+    pub edge: f32,
+    /// The two sides are opened this far apart.
+    pub collision_distance: f32,
+    /// Stroke points farther than this from a layer do not cut it.
+    pub reach: f32,
+}
+
+impl CutSettings {
+    /// `layers` cut at the mesh's edge length, opened by one edge, stroke points up to four
+    /// edges off the surface.
+    pub fn for_mesh(mesh: &Mesh, layers: &[LayerId]) -> CutSettings {
+        let edge = mesh.mean_edge_length();
+        CutSettings {
+            layers: layers.to_vec(),
+            edge,
+            collision_distance: edge,
+            reach: 4.0 * edge,
+        }
+    }
+}
+
+/// What a cut did.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct CutReport {
+    /// Edges the cut runs along.
+    pub path_edges: usize,
+    /// Edges split so that the path follows the stroke.
+    pub splits: usize,
+    /// Vertices duplicated (one per extra side of a vertex on the cut).
+    pub duplicated: usize,
+    /// The farthest a vertex of the path lies from the stroke as projected onto the layer.
+    pub farthest_from_stroke: f32,
+    /// Connected components before and after.
+    pub components_before: usize,
+    pub components_after: usize,
+    pub millis: f64,
+}
+
+/// Cuts each of `settings.layers` along `stroke`. Fails, leaving the mesh as it was, on bad
+/// settings or a stroke that comes nowhere near the layers; a cut that the exact test would
+/// find crossing anything is not made.
+pub fn cut(
+    mesh: &mut Mesh,
+    stroke: &[Vec3],
+    settings: &CutSettings,
+) -> Result<CutReport, ToolError> {
+    let started = Instant::now();
+    check_settings(mesh, stroke, settings)?;
+    let mut work = mesh.clone();
+    let mut report = CutReport {
+        components_before: work.components().count(),
+        ..CutReport::default()
+    };
+    let points = resample(stroke, settings.edge / 4.0);
+    for &layer in &settings.layers {
+        cut_layer(&mut work, &points, layer, settings, &mut report);
+    }
+    if report.path_edges == 0 {
+        return Err(ToolError::EmptySelection(
+            "the stroke crosses no edge of the layers it was to cut (is it on them?)".into(),
+        ));
+    }
+    let crossings = crate::collide::find_intersections(&work).total();
+    if crossings > 0 {
+        return Err(ToolError::WouldIntersect {
+            with_mesh: crossings,
+            within_copy: 0,
+        });
+    }
+    report.components_after = work.components().count();
+    *mesh = work;
+    report.millis = started.elapsed().as_secs_f64() * 1e3;
+    Ok(report)
+}
+
+fn check_settings(mesh: &Mesh, stroke: &[Vec3], settings: &CutSettings) -> Result<(), ToolError> {
+    let extent = mesh.extent().unwrap_or(0.0);
+    check_length("the edge length", settings.edge, extent)?;
+    check_length(
+        "the collision distance",
+        settings.collision_distance,
+        extent,
+    )?;
+    check_length("the reach", settings.reach, extent)?;
+    for &layer in &settings.layers {
+        check_layer(mesh, layer)?;
+    }
+    if stroke.len() < 2 || stroke.iter().any(|p| !p.is_finite()) {
+        return Err(ToolError::EmptySelection(
+            "a cut needs a stroke of at least two finite points".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The polyline through `stroke` with points no farther apart than `spacing`.
+fn resample(stroke: &[Vec3], spacing: f32) -> Vec<Vec3> {
+    let mut points = vec![stroke[0]];
+    for pair in stroke.windows(2) {
+        let steps = ((pair[1] - pair[0]).length() / spacing)
+            .ceil()
+            .clamp(1.0, 1e5) as usize;
+        points.extend((1..=steps).map(|k| pair[0].lerp(pair[1], k as f32 / steps as f32)));
+    }
+    points
+}
+
+/// Cuts one layer: project, split under the stroke, snap, join by shortest paths, cut open.
+fn cut_layer(
+    mesh: &mut Mesh,
+    points: &[Vec3],
+    layer: LayerId,
+    settings: &CutSettings,
+    report: &mut CutReport,
+) {
+    let region = Aabb::of_points(points).expanded(settings.reach + settings.edge);
+    let obstacles = Obstacles::near(mesh, region, 1.5 * settings.edge);
+    let projected: Vec<Option<(u32, Vec3)>> = points
+        .iter()
+        .map(|&p| obstacles.nearest_face(p, settings.reach, layer))
+        .collect();
+    let split_vertices = split_under(mesh, &projected, settings.edge, report);
+    let snapped: Vec<Option<u32>> = projected
+        .iter()
+        .map(|hit| hit.map(|(face, q)| snap(mesh, face, q, &split_vertices)))
+        .collect();
+    let mut edges = Vec::new();
+    for pair in snapped.windows(2) {
+        let (Some(a), Some(b)) = (pair[0], pair[1]) else {
+            continue;
+        };
+        if a != b
+            && let Some(path) = shortest_path(mesh, a, b, settings.edge)
+        {
+            edges.extend(path.windows(2).map(|w| [w[0], w[1]]));
+        }
+    }
+    let stroke_on_layer: Vec<Vec3> = projected.iter().flatten().map(|&(_, q)| q).collect();
+    for v in edges.iter().flatten() {
+        let p = mesh.positions()[*v as usize];
+        report.farthest_from_stroke = report
+            .farthest_from_stroke
+            .max(distance_to_polyline(p, &stroke_on_layer));
+    }
+    report.path_edges += edges.len();
+    let copies = mesh.split_along(&edges);
+    report.duplicated += copies.len();
+    open(mesh, &copies, settings);
+}
+
+/// Splits, under each projected point farther than `SNAP_SHARE · L` from its face's vertices,
+/// the face's edge nearest to it (once per edge); returns each split edge's new vertex by the
+/// edge's end vertices.
+fn split_under(
+    mesh: &mut Mesh,
+    projected: &[Option<(u32, Vec3)>],
+    edge: f32,
+    report: &mut CutReport,
+) -> HashMap<(u32, u32), u32> {
+    let mut made = HashMap::new();
+    for &(face, q) in projected.iter().flatten() {
+        let tri = mesh.faces()[face as usize];
+        let near = tri
+            .iter()
+            .map(|&v| mesh.positions()[v as usize].distance(q))
+            .fold(f32::INFINITY, f32::min);
+        if near <= SNAP_SHARE * edge {
+            continue;
+        }
+        let (a, b, t) = nearest_edge(mesh, tri, q);
+        let key = (a.min(b), a.max(b));
+        if made.contains_key(&key) || !(0.15..=0.85).contains(&t) {
+            continue;
+        }
+        // Splits keep every earlier edge's end vertices, so the pair still names an edge.
+        if let Some(corner) = mesh.find_edge(a, b) {
+            let (from, _) = mesh.edge_vertices(corner);
+            let along = if from == a { t } else { 1.0 - t };
+            made.insert(key, mesh.split_edge(corner, along));
+            report.splits += 1;
+        }
+    }
+    made
+}
+
+/// The edge of `tri` nearest to `q`: its ends and `q`'s parameter along it from the first.
+fn nearest_edge(mesh: &Mesh, tri: [u32; 3], q: Vec3) -> (u32, u32, f32) {
+    let p = |v: u32| mesh.positions()[v as usize];
+    (0..3)
+        .map(|k| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let ab = p(b) - p(a);
+            let t =
+                ((q - p(a)).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+            (a, b, t, (p(a) + ab * t).distance_squared(q))
+        })
+        .min_by(|x, y| x.3.total_cmp(&y.3))
+        .map(|(a, b, t, _)| (a, b, t))
+        .expect("a triangle has edges")
+}
+
+/// The vertex nearest to `q` among `face`'s (as it was projected on) and those split into
+/// its edges.
+fn snap(mesh: &Mesh, face: u32, q: Vec3, split: &HashMap<(u32, u32), u32>) -> u32 {
+    let tri = mesh.faces()[face as usize];
+    let mut candidates: Vec<u32> = tri.to_vec();
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        candidates.extend(split.get(&(a.min(b), a.max(b))));
+    }
+    // The face may itself have been split: its vertices' split edges count too.
+    for (&(a, b), &m) in split {
+        if tri.contains(&a) || tri.contains(&b) {
+            candidates.push(m);
+        }
+    }
+    let distance = |v: &u32| mesh.positions()[*v as usize].distance_squared(q);
+    candidates
+        .into_iter()
+        .min_by(|x, y| distance(x).total_cmp(&distance(y)).then(x.cmp(y)))
+        .expect("a face has vertices")
+}
+
+/// The shortest path of edges from `a` to `b` (Dijkstra, by length), or `None` where it would
+/// cost more than a detour allows (the two are not near on the surface).
+fn shortest_path(mesh: &Mesh, a: u32, b: u32, edge: f32) -> Option<Vec<u32>> {
+    let p = |v: u32| mesh.positions()[v as usize];
+    let budget = DETOUR * p(a).distance(p(b)) + 2.0 * edge;
+    let mut best: HashMap<u32, (f32, u32)> = HashMap::from([(a, (0.0, a))]);
+    let mut queue = BinaryHeap::from([(Reverse(0u32), a)]);
+    while let Some((Reverse(bits), v)) = queue.pop() {
+        let cost = f32::from_bits(bits);
+        if v == b {
+            let mut path = vec![b];
+            while *path.last().expect("non-empty") != a {
+                path.push(best[path.last().expect("non-empty")].1);
+            }
+            path.reverse();
+            return Some(path);
+        }
+        if cost > best[&v].0 {
+            continue;
+        }
+        for w in mesh.neighbours(v) {
+            let next = cost + p(v).distance(p(w));
+            if next <= budget && best.get(&w).is_none_or(|&(c, _)| next < c) {
+                best.insert(w, (next, v));
+                // Non-negative floats order as their bits do.
+                queue.push((Reverse(next.to_bits()), w));
+            }
+        }
+    }
+    None
+}
+
+fn distance_to_polyline(p: Vec3, line: &[Vec3]) -> f32 {
+    if line.len() == 1 {
+        return p.distance(line[0]);
+    }
+    line.windows(2)
+        .map(|s| {
+            let ab = s[1] - s[0];
+            let t =
+                ((p - s[0]).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+            p.distance(s[0] + ab * t)
+        })
+        .fold(f32::INFINITY, f32::min)
+}
+
+/// Moves both sides of every duplicated vertex half the collision distance into their own
+/// side (less where a face would turn over), then remeshes the band.
+fn open(mesh: &mut Mesh, copies: &[[u32; 2]], settings: &CutSettings) {
+    if copies.is_empty() {
+        return;
+    }
+    let mut moved: Vec<u32> = copies.iter().flatten().copied().collect();
+    moved.sort_unstable();
+    moved.dedup();
+    let on_cut: std::collections::HashSet<u32> = moved.iter().copied().collect();
+    for &v in &moved {
+        open_vertex(mesh, v, &on_cut, settings.collision_distance / 2.0);
+    }
+    let mut touched = moved.clone();
+    for &v in &moved {
+        touched.extend(mesh.neighbours(v));
+    }
+    touched.sort_unstable();
+    touched.dedup();
+    mesh.recompute_normals_at(&touched);
+    let mut remesh = RemeshSettings::new(settings.edge);
+    remesh.collision_distance = settings.collision_distance;
+    if let Ok(mut grid) = SpatialHash::build(mesh, settings.edge) {
+        remesh_region(mesh, &mut grid, &touched, &remesh);
+    }
+}
+
+/// Moves `v` up to `distance` along the surface, away from the cut, toward its neighbours
+/// off the cut; halves the move while a face around it would turn over.
+fn open_vertex(mesh: &mut Mesh, v: u32, on_cut: &std::collections::HashSet<u32>, distance: f32) {
+    let p = mesh.positions()[v as usize];
+    let normal = mesh.normals()[v as usize];
+    let inside: Vec<Vec3> = mesh
+        .neighbours(v)
+        .into_iter()
+        .filter(|w| !on_cut.contains(w))
+        .map(|w| mesh.positions()[w as usize])
+        .collect();
+    if inside.is_empty() {
+        return;
+    }
+    let centre = inside.iter().sum::<Vec3>() / inside.len() as f32;
+    let toward = centre - p;
+    let Some(direction) = (toward - normal * toward.dot(normal)).try_normalize() else {
+        return;
+    };
+    let faces: Vec<u32> = mesh.faces_around(v).collect();
+    let before: Vec<Vec3> = faces
+        .iter()
+        .map(|&f| mesh.face_normal(f as usize))
+        .collect();
+    let mut step = distance;
+    for _ in 0..OPENING_TRIES {
+        mesh.positions_mut()[v as usize] = p + direction * step;
+        let kept = faces
+            .iter()
+            .zip(&before)
+            .all(|(&f, n)| mesh.face_normal(f as usize).dot(*n) > 0.5);
+        if kept {
+            return;
+        }
+        step /= 2.0;
+    }
+    mesh.positions_mut()[v as usize] = p;
+}
