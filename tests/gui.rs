@@ -4,6 +4,7 @@
 use std::time::{Duration, Instant};
 
 use eframe::egui::{self, Event, Key, Modifiers, PointerButton, Pos2};
+use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use glam::Vec3;
 use slayer::app::{AppSetup, SlayerApp};
@@ -486,4 +487,41 @@ fn closing_with_unsaved_changes_asks_and_save_and_quit_saves() {
     assert_eq!(session.mesh().digest(), digest(&harness));
     assert_eq!(session.history().entries().len(), 1, "with its history");
     std::fs::remove_file(saved).ok();
+}
+
+/// The layer tools from the layer's menu: right-click a name, duplicate, then delete the copy;
+/// undo takes both back, bit for bit.
+#[test]
+fn a_layer_is_duplicated_and_deleted_from_its_menu() {
+    let mut harness = app(plaster());
+    let start = digest(&harness);
+    harness.get_by_label("paint").click_secondary();
+    for _ in 0..3 {
+        harness.step();
+    }
+    harness.get_by_label("duplicate, lifted off it").click();
+    settle(&mut harness, "the copy is a layer", |app| {
+        app.status.layers.len() == 4
+    });
+    assert_eq!(harness.state().status.layers[3].0, "paint copy");
+    let with_copy = digest(&harness);
+    assert_ne!(with_copy, start);
+    harness.get_by_label("paint copy").click_secondary();
+    for _ in 0..3 {
+        harness.step();
+    }
+    harness.get_by_label("delete layer").click();
+    settle(&mut harness, "the copy is gone", |app| {
+        app.status.layers.len() == 3
+    });
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    settle(&mut harness, "the delete is undone", |app| {
+        app.status.layers.len() == 4
+    });
+    assert_eq!(digest(&harness), with_copy);
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    settle(&mut harness, "the copy is undone", |app| {
+        app.status.layers.len() == 3
+    });
+    assert_eq!(digest(&harness), start);
 }

@@ -286,9 +286,11 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
                     }
                 }
                 _ => {
-                    if ui.selectable_label(false, name).double_clicked() {
+                    let label = ui.selectable_label(false, name);
+                    if label.double_clicked() {
                         app.rename = Some((l, name.clone()));
                     }
+                    layer_menu(app, &label, l);
                 }
             }
             ui.label(RichText::new("collide").weak())
@@ -307,10 +309,29 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
         .filter(|(l, (_, s))| *l < 32 && !s.visible)
         .fold(0, |bits, (l, _)| bits | 1 << l);
     ui.label(
-        RichText::new("double-click a name to rename it")
+        RichText::new("double-click a name to rename it, right-click it for the layer tools")
             .weak()
             .small(),
     );
+}
+
+/// The layer tools on a layer's name: duplicate (its masked part, or all of it) in the brush's
+/// material, delete.
+fn layer_menu(app: &mut SlayerApp, label: &egui::Response, layer: u32) {
+    label.context_menu(|ui| {
+        if ui
+            .button("duplicate, lifted off it")
+            .on_hover_text("copies the masked part (all of it if nothing is masked) into a new layer 2 edges above, in the brush's material")
+            .clicked()
+        {
+            app.send(Command::DuplicateLayer(layer, app.tools.material));
+            ui.close();
+        }
+        if ui.button("delete layer").clicked() {
+            app.send(Command::DeleteLayer(layer));
+            ui.close();
+        }
+    });
 }
 
 fn history_section(app: &mut SlayerApp, ui: &mut Ui) {

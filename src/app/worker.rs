@@ -16,9 +16,10 @@ use glam::Vec3;
 use super::pick::{Hit, Picker, Ray};
 use super::upload::{MeshUpdate, Mirror};
 use crate::brush::{BrushKind, Sample, StrokeSettings};
-use crate::mesh::{LayerId, Mesh};
+use crate::mesh::{Brdf, LayerId, Mesh};
 use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress, StrokeReport};
 use crate::session::{LayerSettings, Session};
+use crate::tools::{DeleteTarget, DuplicateSettings, Selection, selected_faces};
 
 /// While a batch of points runs, the UI hears what changed at least this often, so the
 /// picture follows the stroke even when the engine is behind the pointer.
@@ -47,6 +48,10 @@ pub enum Command {
     Redo,
     SetLayer(LayerId, LayerSettings),
     RenameLayer(LayerId, String),
+    /// Copies the layer's masked part (all of it where nothing is masked) into a new layer
+    /// lifted off it, in this material.
+    DuplicateLayer(LayerId, Brdf),
+    DeleteLayer(LayerId),
     ClearMask,
     InvertMask,
     Save(PathBuf),
@@ -174,6 +179,14 @@ impl Worker {
                 let result = self.session.rename_layer(layer, &name);
                 self.after_refusable(result.map(|_| ()).map_err(|e| e.to_string()));
             }
+            Command::DuplicateLayer(layer, material) => {
+                let result = self.duplicate(layer, material);
+                self.after_tool(result);
+            }
+            Command::DeleteLayer(layer) => {
+                let result = self.session.delete(DeleteTarget::Layer(layer));
+                self.after_tool(result.map(|_| ()).map_err(|e| e.to_string()));
+            }
             Command::ClearMask => {
                 self.session.clear_mask();
                 self.after_edit(true);
@@ -231,6 +244,32 @@ impl Worker {
             self.send_changes();
         }
         self.send_status();
+    }
+
+    fn duplicate(&mut self, layer: LayerId, material: Brdf) -> Result<(), String> {
+        let mesh = self.session.mesh();
+        let masked = selected_faces(mesh, Selection::Masked(layer)).is_ok();
+        let selection = if masked {
+            Selection::Masked(layer)
+        } else {
+            Selection::Layer(layer)
+        };
+        let name = mesh
+            .layer_names()
+            .get(layer as usize)
+            .cloned()
+            .unwrap_or_default();
+        let settings = DuplicateSettings::for_mesh(mesh, &format!("{name} copy"), material);
+        let result = self.session.duplicate(selection, &settings);
+        result.map(|_| ()).map_err(|e| e.to_string())
+    }
+
+    /// After a layer tool: a refusal is said, a change shown (layers and topology both).
+    fn after_tool(&mut self, result: Result<(), String>) {
+        match result {
+            Ok(()) => self.after_edit(true),
+            Err(why) => self.after_refusable(Err(why)),
+        }
     }
 
     fn after_refusable(&mut self, result: Result<(), String>) {
