@@ -473,3 +473,115 @@ fn each_material_is_cut_across_its_top_layer() {
     assert_eq!(session.mesh().digest(), before);
     assert!(session.history().entries().is_empty());
 }
+
+/// A closed outline of `n` points on a circle of `radius` around `centre`'s vertex, on `layer`'s
+/// surface as the vertices near each point give it.
+fn outline_around(mesh: &Mesh, layer: LayerId, centre: u32, radius: f32, n: usize) -> Vec<Vec3> {
+    let c = mesh.positions()[centre as usize];
+    (0..=n)
+        .map(|k| {
+            let a = k as f32 / n as f32 * std::f32::consts::TAU;
+            let target = c + Vec3::new(radius * a.cos(), radius * a.sin(), 0.0);
+            (0..mesh.vertex_count() as u32)
+                .filter(|&v| mesh.is_vertex_live(v) && mesh.vertex_layers()[v as usize] == layer)
+                .map(|v| mesh.positions()[v as usize])
+                .min_by(|p, q| {
+                    (p.truncate() - target.truncate())
+                        .length()
+                        .total_cmp(&(q.truncate() - target.truncate()).length())
+                })
+                .unwrap()
+        })
+        .collect()
+}
+
+/// Runs a patch through the session and checks what every patch must be.
+fn patch_and_check(session: &mut Session, outline: &[Vec3], layer: LayerId) {
+    let before = session.mesh().digest();
+    let layers = session.mesh().layer_count();
+    let settings =
+        DuplicateSettings::for_mesh(session.mesh(), "patch", slayer::material::RUST.brdf);
+    let (report, _) = session.patch(outline, layer, &settings).unwrap();
+    let mesh = session.mesh();
+    mesh.validate().unwrap();
+    assert_eq!(find_intersections(mesh).total(), 0);
+    assert_eq!(mesh.layer_count(), layers + 1);
+    assert_eq!(
+        mesh.components().per_layer(layers + 1)[layers],
+        1,
+        "one sheet"
+    );
+    let copy = mesh.with_layers(&[report.layer]).unwrap();
+    let cv = copy.edge_length_stats().coefficient_of_variation();
+    assert!(cv <= 0.15, "the patch's edge cv is {cv}");
+    let new: Vec<u32> = (0..mesh.vertex_count() as u32)
+        .filter(|&v| mesh.is_vertex_live(v) && mesh.vertex_layers()[v as usize] == report.layer)
+        .collect();
+    assert!(
+        new.iter()
+            .all(|&v| mesh.brdfs()[v as usize] == settings.material)
+    );
+    assert_offset(mesh, &new, layer, settings.offset);
+    let after = mesh.digest();
+    session.undo().unwrap();
+    assert_eq!(session.mesh().digest(), before);
+    session.redo().unwrap();
+    assert_eq!(session.mesh().digest(), after);
+}
+
+#[test]
+fn a_closed_stroke_becomes_a_coons_patch_above_the_surface() {
+    let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
+    let ring: Vec<Vec3> = (0..=16)
+        .map(|k| {
+            let a = k as f32 / 16.0 * std::f32::consts::TAU;
+            Vec3::new(0.2 * a.cos(), 0.2 * a.sin(), 0.45)
+        })
+        .collect();
+    patch_and_check(&mut session, &ring, 0);
+    for (kind, layer) in [
+        (SceneKind::Plaster, 1),
+        (SceneKind::Bark, 2),
+        (SceneKind::Metal, 1),
+    ] {
+        let mut session = Session::new(scene(kind, 20_000));
+        let edge = session.mesh().mean_edge_length();
+        let radius = if kind == SceneKind::Bark { 2.5 } else { 4.0 } * edge;
+        let centre = open_spot(session.mesh(), layer, radius + 1.5 * edge);
+        let outline = outline_around(session.mesh(), layer, centre, radius, 12);
+        patch_and_check(&mut session, &outline, layer);
+    }
+}
+
+#[test]
+fn degenerate_outlines_are_refused_with_the_reason() {
+    let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
+    let before = session.mesh().digest();
+    let settings =
+        DuplicateSettings::for_mesh(session.mesh(), "patch", slayer::material::RUST.brdf);
+    let circle = |r: f32, turns: f32| -> Vec<Vec3> {
+        (0..=16)
+            .map(|k| {
+                let a = k as f32 / 16.0 * std::f32::consts::TAU * turns;
+                Vec3::new(r * a.cos(), r * a.sin(), 0.48)
+            })
+            .collect()
+    };
+    let figure_eight: Vec<Vec3> = (0..=32)
+        .map(|k| {
+            let a = k as f32 / 32.0 * std::f32::consts::TAU;
+            Vec3::new(0.2 * a.sin(), 0.1 * (2.0 * a).sin(), 0.45)
+        })
+        .collect();
+    for (outline, why) in [
+        (circle(0.02, 1.0), "too short"),
+        (circle(0.2, 0.6), "not closed"),
+        (figure_eight, "crosses itself"),
+        (vec![Vec3::ZERO; 2], "at least four"),
+    ] {
+        let refused = session.patch(&outline, 0, &settings).unwrap_err();
+        assert!(refused.to_string().contains(why), "{why}: {refused}");
+    }
+    assert_eq!(session.mesh().digest(), before);
+    assert!(session.history().entries().is_empty());
+}

@@ -8,7 +8,7 @@ use super::{LayerSettings, ProximityPolicy, Recorded, Session};
 use crate::mesh::LayerId;
 use crate::tools::{
     CutReport, CutSettings, DeleteTarget, DuplicateReport, DuplicateSettings, Selection, ToolError,
-    plan_delete, plan_duplicate,
+    plan_delete, plan_duplicate, plan_patch,
 };
 
 /// What a delete removed.
@@ -29,10 +29,36 @@ impl Session {
         settings: &DuplicateSettings,
     ) -> Result<(DuplicateReport, Recorded), ToolError> {
         let started = Instant::now();
-        let (piece, mut report) = plan_duplicate(&self.mesh, selection, settings)?;
-        let mut edit = self.edit("duplicate layer");
+        let (piece, report) = plan_duplicate(&self.mesh, selection, settings)?;
+        self.add_layer("duplicate layer", &piece, report, settings, started)
+    }
+
+    /// Makes a new layer of the Coons patch filling the closed `outline` drawn on `layer`,
+    /// lifted off it (visible, active, colliding, in `settings.material`), as one history
+    /// entry; on an error nothing changes.
+    pub fn patch(
+        &mut self,
+        outline: &[glam::Vec3],
+        layer: LayerId,
+        settings: &DuplicateSettings,
+    ) -> Result<(DuplicateReport, Recorded), ToolError> {
+        let started = Instant::now();
+        let (piece, report) = plan_patch(&self.mesh, outline, layer, settings)?;
+        self.add_layer("patch layer", &piece, report, settings, started)
+    }
+
+    /// Appends `piece` as a new layer with its settings, as one history entry.
+    fn add_layer(
+        &mut self,
+        label: &str,
+        piece: &crate::mesh::Mesh,
+        mut report: DuplicateReport,
+        settings: &DuplicateSettings,
+        started: Instant,
+    ) -> Result<(DuplicateReport, Recorded), ToolError> {
+        let mut edit = self.edit(label);
         let (mesh, layers) = edit.mesh_and_layers();
-        report.layer = mesh.append(&piece);
+        report.layer = mesh.append(piece);
         layers.push(LayerSettings {
             visible: true,
             active: true,

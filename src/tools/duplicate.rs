@@ -105,7 +105,20 @@ pub fn plan_duplicate(
     check_settings(mesh, settings)?;
     let faces = selected_faces(mesh, selection)?;
     let source = mesh.face_layers()[faces[0] as usize];
-    let (mut piece, _) = mesh.extract_faces(&faces, &settings.name)?;
+    let (piece, _) = mesh.extract_faces(&faces, &settings.name)?;
+    lift_off(mesh, piece, source, settings)
+}
+
+/// Lifts `piece` (lying on `source`'s surface, facing as it does) off it along the normals
+/// by the offset, as far as nothing is in the way, then finishes it: thickened if asked,
+/// remeshed, painted and checked exactly against `mesh`. The report's `layer` is the one it
+/// would become.
+pub(super) fn lift_off(
+    mesh: &Mesh,
+    mut piece: Mesh,
+    source: LayerId,
+    settings: &DuplicateSettings,
+) -> Result<(Mesh, DuplicateReport), ToolError> {
     let d = settings.collision_distance;
     let total = settings.offset + settings.thickness.unwrap_or(0.0);
     let piece_box = piece
@@ -150,7 +163,7 @@ pub fn plan_duplicate(
     Ok((piece, report))
 }
 
-fn check_settings(mesh: &Mesh, settings: &DuplicateSettings) -> Result<(), ToolError> {
+pub(super) fn check_settings(mesh: &Mesh, settings: &DuplicateSettings) -> Result<(), ToolError> {
     let extent = mesh.extent().unwrap_or(0.0);
     check_length("the offset", settings.offset, extent)?;
     if let Some(thickness) = settings.thickness {

@@ -1,24 +1,27 @@
 //! Layer tools: the edits that make and remove layers, beside the brushes that shape them (the
-//! sLayer paper's "Editing Tools": offset duplication, cutting along a stroke, and deleting
-//! detached pieces).
+//! sLayer paper's "Editing Tools": offset duplication, a Coons patch from a closed stroke,
+//! cutting along a stroke, and deleting detached pieces).
 //!
 //! Every tool is planned on the mesh as it is and checked before anything changes: a tool
 //! that fails returns its error and leaves the mesh untouched. `Session` runs them as history
 //! entries (undoable, bit for bit), `slayer layer` from the command line.
 //!
-//! Floors: `select` ← `obstacles` ← `duplicate`, `shell`, `cut`; `delete` beside them. Nothing here
+//! Floors: `select` ← `obstacles` ← `shell` ← `duplicate` ← `patch`; `obstacles` ← `cut`;
+//! `delete` beside them. Nothing here
 //! imports the pipeline, the session or the GPU.
 
 mod cut;
 mod delete;
 mod duplicate;
 mod obstacles;
+mod patch;
 mod select;
 mod shell;
 
 pub use cut::{CutReport, CutSettings, cut};
 pub use delete::{DeleteTarget, plan_delete};
 pub use duplicate::{DuplicateReport, DuplicateSettings, duplicate, plan_duplicate};
+pub use patch::{patch, plan_patch};
 pub use select::{ComponentSummary, LayerSummary, Selection, layer_summaries, selected_faces};
 
 use crate::mesh::{LayerId, MeshError};
@@ -73,6 +76,8 @@ pub enum ToolError {
         with_mesh: usize,
         within_copy: usize,
     },
+    #[error("{0}")]
+    BadStroke(String),
     #[error("deleting {0} would leave no face; a mesh keeps at least one")]
     WouldEmpty(String),
 }

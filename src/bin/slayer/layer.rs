@@ -52,6 +52,30 @@ pub enum LayerCommand {
         #[arg(long)]
         material: Option<String>,
     },
+    /// Make a new layer of the Coons patch that fills each closed stroke of a stroke file
+    /// (its samples the outline, drawn on --layer), lifted off the surface like a duplicate.
+    Patch {
+        #[command(flatten)]
+        files: Files,
+        /// Stroke file whose strokes outline the patches (each closed: it ends where it began).
+        #[arg(long, value_name = "FILE")]
+        strokes: PathBuf,
+        /// The layer the outlines are drawn on (name or number).
+        #[arg(long)]
+        layer: String,
+        /// How far the patch is lifted, in mean edge lengths (the collision distance is 1).
+        #[arg(long, default_value_t = 2.0)]
+        offset: f32,
+        /// Make a closed shell this thick (in mean edge lengths) instead of a sheet.
+        #[arg(long)]
+        thickness: Option<f32>,
+        /// The new layer's name.
+        #[arg(long, default_value = "patch")]
+        name: String,
+        /// The new layer's material: a preset name (plaster, paint, rust, ...).
+        #[arg(long, default_value = "paint")]
+        material: String,
+    },
     /// Cut layers open along the strokes of a stroke file (each stroke one cut, its samples
     /// the path): snapped to the edges, opened by the collision distance. A closed or
     /// rim-to-rim cut detaches a piece, an open one makes a slit.
@@ -148,6 +172,36 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             strokes,
             layers,
         } => cut(&files, &strokes, &layers, strict),
+        LayerCommand::Patch {
+            files,
+            strokes,
+            layer,
+            offset,
+            thickness,
+            name,
+            material,
+        } => {
+            let mut session = open(&files, strict)?;
+            let layer = one_layer(session.mesh(), &layer)?;
+            let material = slayer::material::preset(&material)
+                .with_context(|| format!("--material: no preset `{material}`"))?
+                .brdf;
+            let mut settings = DuplicateSettings::for_mesh(session.mesh(), &name, material);
+            settings.offset = offset * settings.edge;
+            settings.thickness = thickness.map(|t| t * settings.edge);
+            for (i, outline) in stroke_paths(&session, &strokes)?.iter().enumerate() {
+                let (report, _) = session
+                    .patch(outline, layer, &settings)
+                    .with_context(|| format!("{}: strokes[{i}]", strokes.display()))?;
+                println!(
+                    "patch {i}: new layer {} `{name}`, {} faces, lifted {:.3} ({} vertices stopped short), {:.0} ms",
+                    report.layer, report.faces, report.smallest_lift, report.clamped, report.millis
+                );
+            }
+            save(&session, &files)?;
+            println!("-> {}", files.output.display());
+            Ok(ExitCode::SUCCESS)
+        }
         LayerCommand::Delete {
             files,
             layer,
@@ -189,14 +243,10 @@ fn cut(files: &Files, strokes: &Path, layers: &[String], strict: bool) -> anyhow
         crate::render::resolve_layers(mesh, layers)?
     };
     let settings = slayer::tools::CutSettings::for_mesh(mesh, &layers);
-    let text = slayer::files::read_input_text(strokes, slayer::files::MAX_INPUT_BYTES)
-        .with_context(|| format!("{}", strokes.display()))?;
     let name = strokes.display().to_string();
-    let file = slayer::brush::StrokeFile::parse(&text, &name)?;
-    for (i, stroke) in file.resolve(session.mesh(), &name)?.iter().enumerate() {
-        let path: Vec<_> = stroke.samples.iter().map(|s| s.position).collect();
+    for (i, path) in stroke_paths(&session, strokes)?.iter().enumerate() {
         let (report, _) = session
-            .cut(&path, &settings)
+            .cut(path, &settings)
             .with_context(|| format!("{name}: strokes[{i}]"))?;
         println!(
             "cut {}: {} edges ({} split to follow the stroke, within {:.2} edges of it), {} vertices duplicated, components {} -> {}, {:.0} ms",
@@ -213,6 +263,19 @@ fn cut(files: &Files, strokes: &Path, layers: &[String], strict: bool) -> anyhow
     save(&session, files)?;
     println!("-> {}", files.output.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Each stroke of a stroke file as the polyline of its samples.
+fn stroke_paths(session: &Session, path: &Path) -> anyhow::Result<Vec<Vec<glam::Vec3>>> {
+    let text = slayer::files::read_input_text(path, slayer::files::MAX_INPUT_BYTES)
+        .with_context(|| format!("{}", path.display()))?;
+    let name = path.display().to_string();
+    let file = slayer::brush::StrokeFile::parse(&text, &name)?;
+    let strokes = file.resolve(session.mesh(), &name)?;
+    Ok(strokes
+        .iter()
+        .map(|s| s.samples.iter().map(|s| s.position).collect())
+        .collect())
 }
 
 fn list(file: &Path, json: bool, strict: bool) -> anyhow::Result<ExitCode> {
