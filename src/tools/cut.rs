@@ -29,6 +29,8 @@ const SNAP_SHARE: f32 = 0.4;
 /// A shortest path between two snapped points may cost this many times their distance (plus
 /// two edges) before the stroke is taken to have left the surface there.
 const DETOUR: f32 = 3.0;
+/// What straying from the stroke costs a path, per unit of distance, beside its length.
+const STRAY_COST: f32 = 2.0;
 /// Halvings of a vertex's opening move before it is left where it is.
 const OPENING_TRIES: u32 = 4;
 
@@ -102,10 +104,7 @@ pub fn cut(
     }
     let crossings = crate::collide::find_intersections(&work).total();
     if crossings > 0 {
-        return Err(ToolError::WouldIntersect {
-            with_mesh: crossings,
-            within_copy: 0,
-        });
+        return Err(ToolError::CutNotOpened { pairs: crossings });
     }
     report.components_after = work.components().count();
     *mesh = work;
@@ -155,15 +154,39 @@ fn cut_layer(
 ) {
     let region = Aabb::of_points(points).expanded(settings.reach + settings.edge);
     let obstacles = Obstacles::near(mesh, region, 1.5 * settings.edge);
-    let projected: Vec<Option<(u32, Vec3)>> = points
+    let nearest: Vec<Option<(u32, Vec3)>> = points
         .iter()
         .map(|&p| obstacles.nearest_face(p, settings.reach, layer))
         .collect();
+    // A point off the layer's edge finds its nearest face on the rim, to one side of it: it
+    // does not cut there. Over the surface, the nearest point lies straight under it.
+    let projected: Vec<Option<(u32, Vec3)>> = points
+        .iter()
+        .zip(&nearest)
+        .map(|(&p, hit)| {
+            hit.filter(|&(face, q)| {
+                let n = mesh.face_normal(face as usize);
+                let d = p - q;
+                (d - n * d.dot(n)).length() <= SNAP_SHARE * settings.edge
+            })
+        })
+        .collect();
     let split_vertices = split_under(mesh, &projected, settings.edge, report);
-    let snapped: Vec<Option<u32>> = projected
+    let mut snapped: Vec<Option<u32>> = projected
         .iter()
         .map(|hit| hit.map(|(face, q)| snap(mesh, face, q, &split_vertices)))
         .collect();
+    // Where the stroke runs off the layer, the cut runs on to the rim vertex nearest to
+    // where it left, so that a stroke across a piece detaches it.
+    for i in 0..snapped.len() {
+        let beside = |j: Option<usize>| {
+            j.and_then(|j| projected.get(j))
+                .is_some_and(Option::is_some)
+        };
+        if snapped[i].is_none() && (beside(i.checked_sub(1)) || beside(Some(i + 1))) {
+            snapped[i] = nearest[i].and_then(|(face, q)| rim_vertex(mesh, face, q, settings.edge));
+        }
+    }
     let mut edges = Vec::new();
     for pair in snapped.windows(2) {
         let (Some(a), Some(b)) = (pair[0], pair[1]) else {
@@ -175,7 +198,7 @@ fn cut_layer(
             edges.extend(path.windows(2).map(|w| [w[0], w[1]]));
         }
     }
-    let stroke_on_layer: Vec<Vec3> = projected.iter().flatten().map(|&(_, q)| q).collect();
+    let stroke_on_layer: Vec<Vec3> = nearest.iter().flatten().map(|&(_, q)| q).collect();
     for v in edges.iter().flatten() {
         let p = mesh.positions()[*v as usize];
         report.farthest_from_stroke = report
@@ -185,7 +208,7 @@ fn cut_layer(
     report.path_edges += edges.len();
     let copies = mesh.split_along(&edges);
     report.duplicated += copies.len();
-    open(mesh, &copies, settings);
+    open(mesh, &edges, &copies, settings);
 }
 
 /// Splits, under each projected point farther than `SNAP_SHARE · L` from its face's vertices,
@@ -261,11 +284,50 @@ fn snap(mesh: &Mesh, face: u32, q: Vec3, split: &HashMap<(u32, u32), u32>) -> u3
         .expect("a face has vertices")
 }
 
+/// A vertex on the mesh's rim within `SNAP_SHARE · L` of `q` (where the stroke left the
+/// layer, on or beside `face`), made by splitting the rim edge under `q` where no vertex is
+/// that near. The rim edges of the faces around `face`'s corners are searched: the splits
+/// under the stroke may have moved the edge to a neighbour.
+fn rim_vertex(mesh: &mut Mesh, face: u32, q: Vec3, edge: f32) -> Option<u32> {
+    let p = |mesh: &Mesh, v: u32| mesh.positions()[v as usize];
+    let mut rim_edges: Vec<u32> = Vec::new();
+    for v in mesh.faces()[face as usize] {
+        for f in mesh.faces_around(v).collect::<Vec<_>>() {
+            for k in 0..3 {
+                let corner = 3 * f + k;
+                if mesh.adjacency().opposite[corner as usize] == crate::mesh::INVALID {
+                    rim_edges.push(corner);
+                }
+            }
+        }
+    }
+    let (corner, t, _) = rim_edges
+        .into_iter()
+        .map(|corner| {
+            let (a, b) = mesh.edge_vertices(corner);
+            let ab = p(mesh, b) - p(mesh, a);
+            let t = ((q - p(mesh, a)).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE))
+                .clamp(0.0, 1.0);
+            (corner, t, (p(mesh, a) + ab * t).distance_squared(q))
+        })
+        .min_by(|x, y| x.2.total_cmp(&y.2).then(x.0.cmp(&y.0)))?;
+    let (a, b) = mesh.edge_vertices(corner);
+    let length = p(mesh, a).distance(p(mesh, b));
+    if t * length <= SNAP_SHARE * edge && t <= 0.5 {
+        Some(a)
+    } else if (1.0 - t) * length <= SNAP_SHARE * edge {
+        Some(b)
+    } else {
+        Some(mesh.split_edge(corner, t))
+    }
+}
+
 /// The shortest path of edges from `a` to `b` (Dijkstra, by length), or `None` where it would
 /// cost more than a detour allows (the two are not near on the surface).
 fn shortest_path(mesh: &Mesh, a: u32, b: u32, edge: f32) -> Option<Vec<u32>> {
     let p = |v: u32| mesh.positions()[v as usize];
-    let budget = DETOUR * p(a).distance(p(b)) + 2.0 * edge;
+    let line = [p(a), p(b)];
+    let budget = DETOUR * (p(a).distance(p(b)) + 2.0 * edge);
     let mut best: HashMap<u32, (f32, u32)> = HashMap::from([(a, (0.0, a))]);
     let mut queue = BinaryHeap::from([(Reverse(0u32), a)]);
     while let Some((Reverse(bits), v)) = queue.pop() {
@@ -282,7 +344,9 @@ fn shortest_path(mesh: &Mesh, a: u32, b: u32, edge: f32) -> Option<Vec<u32>> {
             continue;
         }
         for w in mesh.neighbours(v) {
-            let next = cost + p(v).distance(p(w));
+            // Each edge costs its length and how far it strays from the straight line, so
+            // that of equally short paths the one nearest the stroke is taken.
+            let next = cost + p(v).distance(p(w)) + STRAY_COST * distance_to_polyline(p(w), &line);
             if next <= budget && best.get(&w).is_none_or(|&(c, _)| next < c) {
                 best.insert(w, (next, v));
                 // Non-negative floats order as their bits do.
@@ -307,18 +371,64 @@ fn distance_to_polyline(p: Vec3, line: &[Vec3]) -> f32 {
         .fold(f32::INFINITY, f32::min)
 }
 
-/// Moves both sides of every duplicated vertex half the collision distance into their own
-/// side (less where a face would turn over), then remeshes the band.
-fn open(mesh: &mut Mesh, copies: &[[u32; 2]], settings: &CutSettings) {
+/// Moves both sides of every duplicated vertex half the collision distance apart, each across
+/// the path's smoothed direction toward its own side (less where a face would turn over),
+/// then remeshes the band. Across the smoothed direction, not toward each wedge: a path that
+/// zigzags between edges moves each side as one, so the two never cross.
+fn open(mesh: &mut Mesh, path: &[[u32; 2]], copies: &[[u32; 2]], settings: &CutSettings) {
     if copies.is_empty() {
         return;
     }
+    let along = path_directions(mesh, path);
     let mut moved: Vec<u32> = copies.iter().flatten().copied().collect();
     moved.sort_unstable();
     moved.dedup();
-    let on_cut: std::collections::HashSet<u32> = moved.iter().copied().collect();
-    for &v in &moved {
-        open_vertex(mesh, v, &on_cut, settings.collision_distance / 2.0);
+    let original: HashMap<u32, u32> = copies.iter().map(|&[o, c]| (c, o)).collect();
+    let targets: Vec<(u32, Vec3, Vec3)> = moved
+        .iter()
+        .filter_map(|&v| {
+            let direction = along.get(original.get(&v).unwrap_or(&v))?;
+            let across = mesh.normals()[v as usize]
+                .cross(*direction)
+                .try_normalize()?;
+            let p = mesh.positions()[v as usize];
+            let side: Vec3 = mesh
+                .faces_around(v)
+                .map(|f| mesh.face_positions(f as usize).iter().sum::<Vec3>() / 3.0 - p)
+                .sum();
+            let sign = if side.dot(across) >= 0.0 { 1.0 } else { -1.0 };
+            // Where the path's direction cannot open it (its end, on the rim), straight
+            // into its own side.
+            let into = (side - mesh.normals()[v as usize] * side.dot(mesh.normals()[v as usize]))
+                .normalize_or_zero();
+            let half = settings.collision_distance / 2.0;
+            Some((v, across * sign * half, into * half))
+        })
+        .collect();
+    let on_path: std::collections::HashSet<u32> =
+        path.iter().flatten().chain(&moved).copied().collect();
+    // Every face is held to its normal from before the opening: moves of its corners one
+    // after another must not add up to a fold.
+    let start: HashMap<u32, Vec3> = moved
+        .iter()
+        .flat_map(|&v| mesh.faces_around(v).collect::<Vec<_>>())
+        .map(|f| (f, mesh.face_normal(f as usize)))
+        .collect();
+    for (v, offset, fallback) in targets {
+        if !open_vertex(mesh, v, offset, &start) && !open_vertex(mesh, v, fallback, &start) {
+            // A wedge too thin to move into (a cut's end on the rim): slide along the rim.
+            let p = mesh.positions()[v as usize];
+            let rim = mesh
+                .neighbours(v)
+                .into_iter()
+                .find(|w| !on_path.contains(w));
+            if let Some(w) = rim.filter(|_| mesh.is_boundary_vertex(v)) {
+                let to = mesh.positions()[w as usize] - p;
+                let step = to.normalize_or_zero()
+                    * (0.45 * to.length()).min(settings.collision_distance / 2.0);
+                open_vertex(mesh, v, step, &start);
+            }
+        }
     }
     let mut touched = moved.clone();
     for &v in &moved {
@@ -334,41 +444,46 @@ fn open(mesh: &mut Mesh, copies: &[[u32; 2]], settings: &CutSettings) {
     }
 }
 
-/// Moves `v` up to `distance` along the surface, away from the cut, toward its neighbours
-/// off the cut; halves the move while a face around it would turn over.
-fn open_vertex(mesh: &mut Mesh, v: u32, on_cut: &std::collections::HashSet<u32>, distance: f32) {
-    let p = mesh.positions()[v as usize];
-    let normal = mesh.normals()[v as usize];
-    let inside: Vec<Vec3> = mesh
-        .neighbours(v)
-        .into_iter()
-        .filter(|w| !on_cut.contains(w))
-        .map(|w| mesh.positions()[w as usize])
-        .collect();
-    if inside.is_empty() {
-        return;
+/// The direction of the path at each of its vertices, smoothed over two edges either side
+/// (a path through split and original vertices zigzags about the stroke).
+fn path_directions(mesh: &Mesh, path: &[[u32; 2]]) -> HashMap<u32, Vec3> {
+    let mut order: Vec<u32> = Vec::with_capacity(path.len() + 1);
+    for &[a, b] in path {
+        if order.last() != Some(&a) {
+            order.push(a);
+        }
+        order.push(b);
     }
-    let centre = inside.iter().sum::<Vec3>() / inside.len() as f32;
-    let toward = centre - p;
-    let Some(direction) = (toward - normal * toward.dot(normal)).try_normalize() else {
-        return;
-    };
+    let p = |i: usize| mesh.positions()[order[i] as usize];
+    let last = order.len().saturating_sub(1);
+    let mut directions = HashMap::new();
+    for i in 0..order.len() {
+        let (from, to) = (i.saturating_sub(2), (i + 2).min(last));
+        if let Some(d) = (p(to) - p(from)).try_normalize() {
+            directions.entry(order[i]).or_insert(d);
+        }
+    }
+    directions
+}
+
+/// Moves `v` by `offset`; halves the move while a face around it would turn more than 60°
+/// from its normal at the `start` of the opening. Whether it moved at all.
+fn open_vertex(mesh: &mut Mesh, v: u32, offset: Vec3, start: &HashMap<u32, Vec3>) -> bool {
+    let p = mesh.positions()[v as usize];
     let faces: Vec<u32> = mesh.faces_around(v).collect();
-    let before: Vec<Vec3> = faces
-        .iter()
-        .map(|&f| mesh.face_normal(f as usize))
-        .collect();
-    let mut step = distance;
+    let before: Vec<Vec3> = faces.iter().map(|f| start[f]).collect();
+    let mut step = offset;
     for _ in 0..OPENING_TRIES {
-        mesh.positions_mut()[v as usize] = p + direction * step;
+        mesh.positions_mut()[v as usize] = p + step;
         let kept = faces
             .iter()
             .zip(&before)
             .all(|(&f, n)| mesh.face_normal(f as usize).dot(*n) > 0.5);
         if kept {
-            return;
+            return true;
         }
         step /= 2.0;
     }
     mesh.positions_mut()[v as usize] = p;
+    false
 }

@@ -7,8 +7,7 @@
 //! entries (undoable, bit for bit), `slayer layer` from the command line.
 //!
 //! Floors: `select` ← `obstacles` ← `shell` ← `duplicate` ← `patch`; `obstacles` ← `cut`;
-//! `delete` beside them. Nothing here
-//! imports the pipeline, the session or the GPU.
+//! `delete` beside them. Nothing here imports the pipeline, the session or the GPU.
 
 mod cut;
 mod delete;
@@ -78,6 +77,12 @@ pub enum ToolError {
     },
     #[error("{0}")]
     BadStroke(String),
+    #[error(
+        "the cut's two sides could not be opened apart ({pairs} pairs of faces would touch or \
+         fold); draw it across the piece, clear of the rim's corners, or where the surface is \
+         finer"
+    )]
+    CutNotOpened { pairs: usize },
     #[error("deleting {0} would leave no face; a mesh keeps at least one")]
     WouldEmpty(String),
 }

@@ -36,7 +36,14 @@ pub fn plan_patch(
     let bounds = Aabb::of_points(outline);
     let reach = (4.0 * edge).max(0.5 * (bounds.max - bounds.min).length());
     let surface = Obstacles::near(mesh, bounds.expanded(reach + edge), 1.5 * edge);
-    let on_layer = |p: Vec3| surface.nearest_face(p, reach, layer).map(|(_, q)| q);
+    // Most points lie near the surface: a short look first, the long one only where it fails.
+    let near = 4.0 * edge;
+    let nearest = |p: Vec3| {
+        surface
+            .nearest_face(p, near, layer)
+            .or_else(|| surface.nearest_face(p, reach, layer))
+    };
+    let on_layer = |p: Vec3| nearest(p).map(|(_, q)| q);
     let projected: Vec<Vec3> = outline
         .iter()
         .enumerate()
@@ -53,11 +60,7 @@ pub fn plan_patch(
         .iter()
         .map(|&p| on_layer(p).ok_or_else(|| bad("it encloses a hole in the layer")))
         .collect::<Result<Vec<Vec3>, _>>()?;
-    let facing = |p: Vec3| {
-        surface
-            .nearest_face(p, reach, layer)
-            .map_or(Vec3::ZERO, |(f, _)| mesh.face_normal(f as usize))
-    };
+    let facing = |p: Vec3| nearest(p).map_or(Vec3::ZERO, |(f, _)| mesh.face_normal(f as usize));
     let piece = triangulate(positions, &grid, settings, facing)?;
     lift_off(mesh, piece, layer, settings)
 }
