@@ -39,8 +39,8 @@ line() { # x0 y0 x1 y1 brush radius strength layers
 
 echo "{\"version\": 1, \"strokes\": [$(outline 0.3 0.3 0.14), $(outline 0.7 0.32 0.12), $(outline 0.48 0.7 0.16)]}" >patches.json
 echo "{\"version\": 1, \"strokes\": [$(line 0.2 0.3 0.4 0.3 draw 0.12 0.8 '["plane"]'), $(line 0.4 0.68 0.56 0.72 draw 0.14 0.8 '["plane"]')]}" >push.json
-echo "{\"version\": 1, \"strokes\": [$(line 0.12 0.22 0.48 0.38 draw 0.05 0.5 '[1]'), $(line 0.58 0.2 0.82 0.44 draw 0.05 0.5 '[2]'), $(line 0.3 0.78 0.66 0.62 draw 0.05 0.5 '[3]')]}" >cuts.json
-echo "{\"version\": 1, \"strokes\": [$(line 0.62 0.3 0.64 0.3 draw 0.08 1.0 '[2]'), $(line 0.5 0.78 0.52 0.78 draw 0.1 1.0 '[3]')]}" >lift.json
+echo "{\"version\": 1, \"strokes\": [$(line 0.12 0.22 0.48 0.38 draw 0.05 0.5 '[1]'), $(line 0.58 0.2 0.82 0.44 draw 0.05 0.5 '[2]'), $(line 0.34 0.56 0.62 0.84 draw 0.05 0.5 '[3]')]}" >cuts.json
+echo "{\"version\": 1, \"strokes\": [$(line 0.36 0.74 0.40 0.8 draw 0.09 1.0 '[3]'), $(line 0.30 0.22 0.36 0.18 draw 0.07 1.0 '[1]')]}" >lift.json
 
 echo "1. a plain surface"
 "$slayer" scene plane --triangles "$triangles" -o 1-plain.slayer
@@ -54,9 +54,9 @@ render 3-pushed
 echo "4. the patches cut"
 "$slayer" layer cut 3-pushed.slayer -o 4-cut.slayer --strokes cuts.json --layers 1,2,3
 render 4-cut
-echo "5. pieces lifted, the two smallest deleted"
+echo "5. pieces lifted, the smallest deleted"
 "$slayer" sculpt --input 4-cut.slayer --strokes lift.json --output 5a-lifted.slayer --backend cpu
-"$slayer" layer delete 5a-lifted.slayer -o 5-deleted.slayer --smallest 2
+"$slayer" layer delete 5a-lifted.slayer -o 5-deleted.slayer --smallest 1
 render 5-deleted
 "$slayer" check 5-deleted.slayer | tail -4
 "$slayer" history 5-deleted.slayer

@@ -54,13 +54,29 @@ impl IntersectionReport {
 /// Finds every pair of live faces that intersect (closed triangles, so touching counts); pairs
 /// that share a vertex count only where they overlap beyond it.
 pub fn find_intersections(mesh: &Mesh) -> IntersectionReport {
-    let (usable, boxes) = face_boxes(mesh);
+    find_intersections_within(mesh, None)
+}
+
+/// [`find_intersections`] among the faces whose boxes meet `region`: every intersecting pair
+/// with a face inside `region` (a pair's boxes overlap, so the other face meets it too). What
+/// an edit checks after changing the faces in `region` only.
+pub fn find_intersections_in(mesh: &Mesh, region: &Aabb) -> IntersectionReport {
+    find_intersections_within(mesh, Some(region))
+}
+
+fn find_intersections_within(mesh: &Mesh, region: Option<&Aabb>) -> IntersectionReport {
+    let (mut usable, boxes) = face_boxes(mesh);
     let skipped_faces = mesh
         .faces()
         .iter()
         .zip(&usable)
         .filter(|(t, ok)| t[0] != INVALID && !**ok)
         .count();
+    if let Some(region) = region {
+        for (ok, b) in usable.iter_mut().zip(&boxes) {
+            *ok &= b.overlaps(region);
+        }
+    }
     let cells = Cells {
         size: broad_phase_cell_size(&boxes, &usable),
     };

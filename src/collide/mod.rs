@@ -21,7 +21,9 @@ mod state;
 
 pub use backstop::Backstop;
 pub use gap::smallest_layer_gap;
-pub use intersections::{IntersectingPair, IntersectionReport, find_intersections};
+pub use intersections::{
+    IntersectingPair, IntersectionReport, find_intersections, find_intersections_in,
+};
 pub use local_grid::LocalFaceGrid;
 pub use region::{Region, Scratch, StepMoves};
 pub use response::{

@@ -102,7 +102,9 @@ pub fn cut(
             "the stroke crosses no edge of the layers it was to cut (is it on them?)".into(),
         ));
     }
-    let crossings = crate::collide::find_intersections(&work).total();
+    // Everything the cut changed lies near the stroke: only faces there need the exact test.
+    let crossings =
+        crate::collide::find_intersections_in(&work, &near_stroke(&points, settings)).total();
     if crossings > 0 {
         return Err(ToolError::CutNotOpened { pairs: crossings });
     }
@@ -208,7 +210,12 @@ fn cut_layer(
     report.path_edges += edges.len();
     let copies = mesh.split_along(&edges);
     report.duplicated += copies.len();
-    open(mesh, &edges, &copies, settings);
+    open(
+        mesh,
+        (&edges, &copies),
+        &near_stroke(points, settings),
+        settings,
+    );
 }
 
 /// Splits, under each projected point farther than `SNAP_SHARE · L` from its face's vertices,
@@ -375,7 +382,12 @@ fn distance_to_polyline(p: Vec3, line: &[Vec3]) -> f32 {
 /// the path's smoothed direction toward its own side (less where a face would turn over),
 /// then remeshes the band. Across the smoothed direction, not toward each wedge: a path that
 /// zigzags between edges moves each side as one, so the two never cross.
-fn open(mesh: &mut Mesh, path: &[[u32; 2]], copies: &[[u32; 2]], settings: &CutSettings) {
+fn open(
+    mesh: &mut Mesh,
+    (path, copies): (&[[u32; 2]], &[[u32; 2]]),
+    region: &Aabb,
+    settings: &CutSettings,
+) {
     if copies.is_empty() {
         return;
     }
@@ -439,9 +451,24 @@ fn open(mesh: &mut Mesh, path: &[[u32; 2]], copies: &[[u32; 2]], settings: &CutS
     mesh.recompute_normals_at(&touched);
     let mut remesh = RemeshSettings::new(settings.edge);
     remesh.collision_distance = settings.collision_distance;
-    if let Ok(mut grid) = SpatialHash::build(mesh, settings.edge) {
+    // The remesher reads the grid only around the band: a grid of what is near the stroke
+    // serves it as the whole mesh's would, without an O(mesh) build.
+    if let Ok(mut grid) = SpatialHash::new(settings.edge, mesh.vertex_count()) {
+        for v in 0..mesh.vertex_count() as u32 {
+            let p = mesh.positions()[v as usize];
+            if mesh.is_vertex_live(v) && region.distance_squared_to(p) == 0.0 {
+                grid.insert(v, p);
+            }
+        }
         remesh_region(mesh, &mut grid, &touched, &remesh);
     }
+}
+
+/// A box holding everything a cut along `points` can change, and what the remesher and the
+/// exact test look at around it: the reach of the projection, the band the remesher works on
+/// and its queries' reach.
+fn near_stroke(points: &[Vec3], settings: &CutSettings) -> Aabb {
+    Aabb::of_points(points).expanded(settings.reach + 8.0 * settings.edge)
 }
 
 /// The direction of the path at each of its vertices, smoothed over two edges either side

@@ -221,7 +221,10 @@ fn coons_grid(ring: &[Vec3], corners: &[usize; 4], edge: f32) -> Grid {
     let length = |s: &[Vec3]| s.windows(2).map(|w| w[0].distance(w[1])).sum::<f32>();
     let sides: Vec<Vec<Vec3>> = (0..4).map(side).collect();
     let columns = ((length(&sides[0]).max(length(&sides[2])) / edge).round() as usize).max(1);
-    let rows = ((length(&sides[1]).max(length(&sides[3])) / edge).round() as usize).max(1);
+    // Rows √3/2·L apart: each quad's diagonal is then about 1.32·L, inside the remesher's
+    // band (4/3·L), and its triangles near equilateral, so remeshing has little left to do.
+    let row = 0.5 * 3f32.sqrt() * edge;
+    let rows = ((length(&sides[1]).max(length(&sides[3])) / row).round() as usize).max(1);
     let bottom = resample(&sides[0], columns);
     let right = resample(&sides[1], rows);
     let mut top = resample(&sides[2], columns);
@@ -270,8 +273,10 @@ fn triangulate(
             }
         }
     }
+    // Which way the surface faces, from a few dozen faces.
     let facing: f32 = faces
         .iter()
+        .step_by((faces.len() / 64).max(1))
         .map(|&[a, b, c]| {
             let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
             let under = surface_normal(pa);
