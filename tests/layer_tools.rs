@@ -241,6 +241,28 @@ fn a_copy_that_cannot_be_placed_is_refused_and_changes_nothing() {
 }
 
 #[test]
+fn each_material_loses_its_smallest_pieces_and_top_layer_and_gets_them_back() {
+    for kind in [SceneKind::Plaster, SceneKind::Bark, SceneKind::Metal] {
+        let mut session = Session::new(scene(kind, 20_000));
+        let (start, layers) = (session.mesh().digest(), session.mesh().layer_count());
+        let components = session.mesh().components().count();
+        session.delete(DeleteTarget::Smallest(2)).unwrap();
+        session
+            .delete(DeleteTarget::Layer(layers as LayerId - 1))
+            .unwrap();
+        let mesh = session.mesh();
+        mesh.validate().unwrap();
+        assert_eq!(find_intersections(mesh).total(), 0);
+        assert_eq!(mesh.layer_count(), layers - 1, "{kind:?}");
+        assert!(mesh.components().count() < components - 1, "{kind:?}");
+        assert!(mesh.brdfs().iter().all(|b| b.is_finite()));
+        session.undo().unwrap();
+        session.undo().unwrap();
+        assert_eq!(session.mesh().digest(), start, "{kind:?}");
+    }
+}
+
+#[test]
 fn deleting_components_and_layers_compacts_and_undoes() {
     let mut session = Session::new(scene(SceneKind::Plaster, 20_000));
     let mesh = session.mesh();

@@ -484,10 +484,10 @@ fn path_directions(mesh: &Mesh, path: &[[u32; 2]]) -> HashMap<u32, Vec3> {
     let p = |i: usize| mesh.positions()[order[i] as usize];
     let last = order.len().saturating_sub(1);
     let mut directions = HashMap::new();
-    for i in 0..order.len() {
+    for (i, &v) in order.iter().enumerate() {
         let (from, to) = (i.saturating_sub(2), (i + 2).min(last));
         if let Some(d) = (p(to) - p(from)).try_normalize() {
-            directions.entry(order[i]).or_insert(d);
+            directions.entry(v).or_insert(d);
         }
     }
     directions
