@@ -12,12 +12,13 @@ use crate::tools::{
 };
 
 /// What a delete removed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Deleted {
     pub components: usize,
     pub faces: usize,
     /// The layer removed, for [`DeleteTarget::Layer`].
     pub layer: Option<LayerId>,
+    pub millis: f64,
 }
 
 impl Session {
@@ -87,6 +88,7 @@ impl Session {
     /// Deletes `target` and compacts the mesh, as one history entry; on an error (a target
     /// that does not exist, or one that would leave no face) nothing changes.
     pub fn delete(&mut self, target: DeleteTarget) -> Result<(Deleted, Recorded), ToolError> {
+        let started = Instant::now();
         let (doomed, components) = plan_delete(&self.mesh, target)?;
         let faces = doomed.iter().filter(|&&d| d).count();
         let label = match target {
@@ -111,6 +113,7 @@ impl Session {
             components,
             faces,
             layer,
+            millis: started.elapsed().as_secs_f64() * 1e3,
         };
         Ok((deleted, recorded))
     }

@@ -220,13 +220,14 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             let (deleted, _) = session.delete(target)?;
             save(&session, &files)?;
             println!(
-                "deleted {} components ({} faces){} -> {}",
+                "deleted {} components ({} faces){}, {:.0} ms -> {}",
                 deleted.components,
                 deleted.faces,
                 deleted
                     .layer
                     .map(|l| format!(", layer {l}"))
                     .unwrap_or_default(),
+                deleted.millis,
                 files.output.display()
             );
             Ok(ExitCode::SUCCESS)
