@@ -38,19 +38,10 @@ pub enum LayerCommand {
         /// A stroke file applied first (mask strokes, typically), to mask what --masked copies.
         #[arg(long, value_name = "FILE", requires = "masked")]
         mask_strokes: Option<PathBuf>,
-        /// How far the copy is lifted, in mean edge lengths (the collision distance is 1).
-        #[arg(long, default_value_t = 2.0)]
-        offset: f32,
-        /// Make a closed shell this thick (in mean edge lengths) instead of a sheet.
-        #[arg(long)]
-        thickness: Option<f32>,
-        /// The new layer's name (default: the source's, with " copy").
-        #[arg(long)]
-        name: Option<String>,
-        /// The new layer's material: a preset name (plaster, paint, rust, ...); default: the
-        /// source layer's.
-        #[arg(long)]
-        material: Option<String>,
+        /// The new layer (its name defaults to the source's with " copy", its material to
+        /// the source layer's).
+        #[command(flatten)]
+        lift: Lift,
     },
     /// Make a new layer of the Coons patch that fills each closed stroke of a stroke file
     /// (its samples the outline, drawn on --layer), lifted off the surface like a duplicate.
@@ -63,18 +54,9 @@ pub enum LayerCommand {
         /// The layer the outlines are drawn on (name or number).
         #[arg(long)]
         layer: String,
-        /// How far the patch is lifted, in mean edge lengths (the collision distance is 1).
-        #[arg(long, default_value_t = 2.0)]
-        offset: f32,
-        /// Make a closed shell this thick (in mean edge lengths) instead of a sheet.
-        #[arg(long)]
-        thickness: Option<f32>,
-        /// The new layer's name.
-        #[arg(long, default_value = "patch")]
-        name: String,
-        /// The new layer's material: a preset name (plaster, paint, rust, ...).
-        #[arg(long, default_value = "paint")]
-        material: String,
+        /// The new layer (named `patch`, in `paint` unless told).
+        #[command(flatten)]
+        lift: Lift,
     },
     /// Cut layers open along the strokes of a stroke file (each stroke one cut, its samples
     /// the path): snapped to the edges, opened by the collision distance. A closed or
@@ -108,6 +90,47 @@ pub enum LayerCommand {
     },
 }
 
+/// The new layer a duplicate or a patch makes.
+#[derive(Args)]
+pub struct Lift {
+    /// How far it is lifted off the surface, in mean edge lengths (the collision distance is 1).
+    #[arg(long, default_value_t = 2.0)]
+    offset: f32,
+    /// Make a closed shell this thick (in mean edge lengths) instead of a sheet.
+    #[arg(long)]
+    thickness: Option<f32>,
+    /// The new layer's name.
+    #[arg(long)]
+    name: Option<String>,
+    /// The new layer's material: a preset name (plaster, paint, rust, ...).
+    #[arg(long)]
+    material: Option<String>,
+}
+
+impl Lift {
+    /// The tool's settings in world units, from edge lengths and names; `defaults` are the
+    /// name and material where none was given.
+    fn settings(
+        &self,
+        mesh: &slayer::mesh::Mesh,
+        (name, material): (String, slayer::mesh::Brdf),
+    ) -> anyhow::Result<DuplicateSettings> {
+        let material = match &self.material {
+            Some(preset) => {
+                slayer::material::preset(preset)
+                    .with_context(|| format!("--material: no preset `{preset}`"))?
+                    .brdf
+            }
+            None => material,
+        };
+        let name = self.name.clone().unwrap_or(name);
+        let mut settings = DuplicateSettings::for_mesh(mesh, &name, material);
+        settings.offset = self.offset * settings.edge;
+        settings.thickness = self.thickness.map(|t| t * settings.edge);
+        Ok(settings)
+    }
+}
+
 /// The input and output of a tool.
 #[derive(Args)]
 pub struct Files {
@@ -130,10 +153,7 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             component,
             masked,
             mask_strokes,
-            offset,
-            thickness,
-            name,
-            material,
+            lift,
         } => {
             let mut session = open(&files, strict)?;
             let selection = match (layer, component) {
@@ -151,8 +171,12 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             if let Some(strokes) = &mask_strokes {
                 apply_strokes(&mut session, strokes)?;
             }
-            let settings =
-                duplicate_settings(&session, selection, (offset, thickness), (name, material))?;
+            let source = source_layer(session.mesh(), selection)?;
+            let defaults = (
+                format!("{} copy", session.mesh().layer_names()[source as usize]),
+                session.layers()[source as usize].material,
+            );
+            let settings = lift.settings(session.mesh(), defaults)?;
             let (report, _) = session.duplicate(selection, &settings)?;
             save(&session, &files)?;
             println!(
@@ -176,26 +200,24 @@ pub fn run(command: LayerCommand, strict: bool) -> anyhow::Result<ExitCode> {
             files,
             strokes,
             layer,
-            offset,
-            thickness,
-            name,
-            material,
+            lift,
         } => {
             let mut session = open(&files, strict)?;
             let layer = one_layer(session.mesh(), &layer)?;
-            let material = slayer::material::preset(&material)
-                .with_context(|| format!("--material: no preset `{material}`"))?
-                .brdf;
-            let mut settings = DuplicateSettings::for_mesh(session.mesh(), &name, material);
-            settings.offset = offset * settings.edge;
-            settings.thickness = thickness.map(|t| t * settings.edge);
+            let defaults = ("patch".to_string(), slayer::material::PAINT.brdf);
+            let settings = lift.settings(session.mesh(), defaults)?;
             for (i, outline) in stroke_paths(&session, &strokes)?.iter().enumerate() {
                 let (report, _) = session
                     .patch(outline, layer, &settings)
                     .with_context(|| format!("{}: strokes[{i}]", strokes.display()))?;
                 println!(
-                    "patch {i}: new layer {} `{name}`, {} faces, lifted {:.3} ({} vertices stopped short), {:.0} ms",
-                    report.layer, report.faces, report.smallest_lift, report.clamped, report.millis
+                    "patch {i}: new layer {} `{}`, {} faces, lifted {:.3} ({} vertices stopped short), {:.0} ms",
+                    report.layer,
+                    settings.name,
+                    report.faces,
+                    report.smallest_lift,
+                    report.clamped,
+                    report.millis
                 );
             }
             save(&session, &files)?;
@@ -350,27 +372,8 @@ fn apply_strokes(session: &mut Session, path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The tool's settings in world units, from the CLI's edge lengths and names.
-fn duplicate_settings(
-    session: &Session,
-    selection: Selection,
-    (offset, thickness): (f32, Option<f32>),
-    (name, material): (Option<String>, Option<String>),
-) -> anyhow::Result<DuplicateSettings> {
-    let mesh = session.mesh();
+/// The layer a selection lies on.
+fn source_layer(mesh: &slayer::mesh::Mesh, selection: Selection) -> anyhow::Result<LayerId> {
     let faces = slayer::tools::selected_faces(mesh, selection)?;
-    let source = mesh.face_layers()[faces[0] as usize];
-    let material = match material {
-        Some(name) => {
-            slayer::material::preset(&name)
-                .with_context(|| format!("--material: no preset `{name}`"))?
-                .brdf
-        }
-        None => session.layers()[source as usize].material,
-    };
-    let name = name.unwrap_or_else(|| format!("{} copy", mesh.layer_names()[source as usize]));
-    let mut settings = DuplicateSettings::for_mesh(mesh, &name, material);
-    settings.offset = offset * settings.edge;
-    settings.thickness = thickness.map(|t| t * settings.edge);
-    Ok(settings)
+    Ok(mesh.face_layers()[faces[0] as usize])
 }
