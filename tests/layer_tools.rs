@@ -300,6 +300,18 @@ fn deleting_components_and_layers_compacts_and_undoes() {
     );
     assert_eq!(session.layers().len(), layers);
 
+    // A pipeline prepared for the mesh before the tools sculpts the mesh they left.
+    let mut pipeline = slayer::pipeline::Pipeline::new(Default::default());
+    let script = slayer::bench::generate_script(session.mesh(), &Default::default());
+    let strokes = script.resolve(session.mesh(), "script").unwrap();
+    session.apply_stroke(&mut pipeline, &strokes[0]).unwrap();
+    session.delete(DeleteTarget::Layer(2)).unwrap();
+    let script = slayer::bench::generate_script(session.mesh(), &Default::default());
+    let strokes = script.resolve(session.mesh(), "script").unwrap();
+    session.apply_stroke(&mut pipeline, &strokes[1]).unwrap();
+    session.mesh().validate().unwrap();
+    assert_eq!(find_intersections(session.mesh()).total(), 0);
+
     let refused = session.delete(DeleteTarget::Component(999)).unwrap_err();
     assert!(matches!(refused, ToolError::NoSuchComponent { .. }));
     let mut sphere = Session::new(scene(SceneKind::Sphere, 2_000));
