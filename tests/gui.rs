@@ -75,6 +75,15 @@ fn centre(harness: &Harness<'_, SlayerApp>) -> Pos2 {
 /// Hovers at `from` until the pointer is over the mesh, then drags to `to` in steps, holding
 /// `modifiers`, and waits until the stroke is done.
 fn drag(harness: &mut Harness<'_, SlayerApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
+    let path: Vec<Pos2> = (0..=12)
+        .map(|k| from + (to - from) * (k as f32 / 12.0))
+        .collect();
+    drag_through(harness, &path, modifiers);
+}
+
+/// A drag along `path` with the primary button, waiting until it is recorded in the history.
+fn drag_through(harness: &mut Harness<'_, SlayerApp>, path: &[Pos2], modifiers: Modifiers) {
+    let (from, to) = (path[0], path[path.len() - 1]);
     let strokes_before = harness.state().status.history.len();
     harness.hover_at(from);
     settle(harness, "the pointer is over the mesh", |app| {
@@ -88,14 +97,16 @@ fn drag(harness: &mut Harness<'_, SlayerApp>, from: Pos2, to: Pos2, modifiers: M
     };
     harness.event(button(from, true));
     harness.step();
-    for k in 1..=12 {
-        harness.hover_at(from + (to - from) * (k as f32 / 12.0));
+    for &p in &path[1..] {
+        harness.hover_at(p);
         harness.step();
     }
     harness.event(button(to, false));
-    settle(harness, "the stroke is recorded", |app| {
-        app.idle() && app.status.history.len() > strokes_before
+    settle(harness, "the stroke is recorded or refused", |app| {
+        app.idle() && app.status.history.len() > strokes_before || app.messages().count() > 0
     });
+    let messages: Vec<&str> = harness.state().messages().collect();
+    assert!(messages.is_empty(), "{messages:?}");
 }
 
 /// A plain drag between two points given relative to the viewport's centre.
@@ -522,6 +533,62 @@ fn a_layer_is_duplicated_and_deleted_from_its_menu() {
     harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     settle(&mut harness, "the copy is undone", |app| {
         app.status.layers.len() == 3
+    });
+    assert_eq!(digest(&harness), start);
+}
+
+/// The cut and the patch traced with the pointer: a drag across the sphere cuts it, a closed
+/// drag makes a patch layer; each is one undo step.
+#[test]
+fn cut_and_patch_are_traced_on_the_surface() {
+    let sphere = generate(&SceneSpec {
+        triangles: 5_000,
+        ..SceneSpec::new(SceneKind::Sphere)
+    })
+    .unwrap();
+    let mut harness = app(Session::new(sphere));
+    let start = digest(&harness);
+    harness.get_by_label("cut").click();
+    harness.step();
+    assert_eq!(harness.state().tools.trace, Some(slayer::app::Trace::Cut));
+    drag_across(
+        &mut harness,
+        egui::vec2(-120.0, -10.0),
+        egui::vec2(120.0, 15.0),
+    );
+    let checked = |harness: &Harness<'_, SlayerApp>| {
+        harness
+            .state()
+            .query(|s| {
+                let mesh = s.mesh();
+                let label = s.history().entries().last().map(|e| e.label.clone());
+                let sound = mesh.validate().is_ok()
+                    && slayer::collide::find_intersections(mesh).total() == 0;
+                (label, sound, mesh.layer_count())
+            })
+            .unwrap()
+    };
+    assert_eq!(checked(&harness), (Some("cut".to_string()), true, 1));
+    harness.get_by_label("patch").click();
+    harness.step();
+    let c = centre(&harness);
+    let ring: Vec<Pos2> = (0..=24)
+        .map(|k| {
+            let a = k as f32 / 24.0 * std::f32::consts::TAU;
+            c + egui::vec2(55.0 * a.cos(), 55.0 * a.sin() + 90.0)
+        })
+        .collect();
+    drag_through(&mut harness, &ring, Modifiers::NONE);
+    assert_eq!(
+        checked(&harness),
+        (Some("patch layer".to_string()), true, 2)
+    );
+    for _ in 0..2 {
+        harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        harness.step();
+    }
+    settle(&mut harness, "both are undone", |app| {
+        app.status.layers.len() == 1 && app.idle()
     });
     assert_eq!(digest(&harness), start);
 }

@@ -8,8 +8,9 @@ use std::time::Instant;
 use eframe::egui::{self, Event, Key, Modifiers, PointerButton, Pos2, Rect};
 use glam::Vec2;
 
-use super::SlayerApp;
-use super::worker::{Command, StrokePoint};
+use super::pick::Ray;
+use super::worker::{Command, LayerTool, StrokePoint};
+use super::{SlayerApp, Trace};
 use crate::brush::BrushKind;
 
 /// What a drag is doing.
@@ -18,6 +19,8 @@ enum Gesture {
     #[default]
     None,
     Stroke,
+    /// A layer tool (cut, patch) traced on the surface: the rays gather in `PointerState`.
+    Trace,
     Orbit,
     Pan,
     /// F or Shift-F: the pointer's horizontal travel sets the value until a click or release.
@@ -46,6 +49,8 @@ pub struct PointerState {
     moved_camera: bool,
     /// The replay's orbit (counted as orbiting).
     pub orbiting_by_replay: bool,
+    /// The rays of a layer tool's trace so far.
+    trace: Vec<Ray>,
 }
 
 impl PointerState {
@@ -148,15 +153,20 @@ fn button_event(
     let inside = rect.contains(pos) && on_viewport;
     match (button, pressed, app.pointer.gesture) {
         (PointerButton::Primary, true, Gesture::None) if inside => {
-            app.pointer.gesture = if app.hover.is_some() {
-                begin_stroke(app, modifiers, rect, pos, points)
-            } else {
-                Gesture::Orbit
+            app.pointer.gesture = match (app.hover.is_some(), app.tools.trace) {
+                (true, Some(_)) => {
+                    app.pointer.trace = ray_at(app, rect, pos).into_iter().collect();
+                    Gesture::Trace
+                }
+                (true, None) => begin_stroke(app, modifiers, rect, pos, points),
+                (false, _) => Gesture::Orbit,
             };
         }
         (PointerButton::Primary, false, gesture) => {
-            if gesture == Gesture::Stroke {
-                end_stroke(app, points);
+            match gesture {
+                Gesture::Stroke => end_stroke(app, points),
+                Gesture::Trace => end_trace(app),
+                _ => {}
             }
             app.pointer.gesture = Gesture::None;
         }
@@ -199,6 +209,18 @@ fn end_stroke(app: &mut SlayerApp, points: &mut Vec<StrokePoint>) {
     app.hover = None;
 }
 
+/// Hands the traced rays to the engine for the chosen layer tool.
+fn end_trace(app: &mut SlayerApp) {
+    let rays = std::mem::take(&mut app.pointer.trace);
+    let tool = match app.tools.trace {
+        Some(Trace::Cut) => LayerTool::Cut,
+        Some(Trace::Patch) => LayerTool::Patch(app.tools.material),
+        None => return,
+    };
+    app.send(Command::Trace(tool, rays));
+    app.hover = None;
+}
+
 fn begin_stroke(
     app: &mut SlayerApp,
     modifiers: Modifiers,
@@ -228,6 +250,10 @@ fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoin
         .map_or(Vec2::ZERO, |last| Vec2::new(pos.x - last.x, pos.y - last.y));
     match app.pointer.gesture {
         Gesture::Stroke => points.extend(ray_point(app, rect, pos)),
+        Gesture::Trace => {
+            let ray = ray_at(app, rect, pos);
+            app.pointer.trace.extend(ray);
+        }
         Gesture::Orbit => {
             if let Some(camera) = &mut app.camera {
                 camera.orbit(delta);
@@ -283,12 +309,16 @@ fn local(rect: Rect, pos: Pos2) -> Vec2 {
 }
 
 fn ray_point(app: &SlayerApp, rect: Rect, pos: Pos2) -> Option<StrokePoint> {
-    let camera = app.camera.as_ref()?;
-    let ray = camera.ray(local(rect, pos), Vec2::new(rect.width(), rect.height()));
     Some(StrokePoint::Ray {
-        ray,
+        ray: ray_at(app, rect, pos)?,
         pressure: app.pointer.pressure.unwrap_or(1.0),
     })
+}
+
+/// The camera's ray through `pos`.
+fn ray_at(app: &SlayerApp, rect: Rect, pos: Pos2) -> Option<Ray> {
+    let camera = app.camera.as_ref()?;
+    Some(camera.ray(local(rect, pos), Vec2::new(rect.width(), rect.height())))
 }
 
 /// The key map (ignored while a text field has the keyboard).

@@ -93,10 +93,21 @@ pub struct Tools {
     /// Mirror strokes across the plane x = the scene's centre.
     pub symmetry_x: bool,
     pub remesh: bool,
+    /// A drag on the mesh traces this layer tool instead of stroking the brush.
+    pub trace: Option<Trace>,
     pub view: ViewOptions,
     /// The engine's phase times in the status bar (off for pictures that must not change
     /// from run to run).
     pub phase_times: bool,
+}
+
+/// The layer tools a drag traces (`docs/layers.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Trace {
+    /// Cut the active layers open along the drag.
+    Cut,
+    /// A new layer in the brush's material filling the closed drag.
+    Patch,
 }
 
 /// A generated stencil: `pattern` of the brush's material and `second`, repeating every
@@ -206,6 +217,7 @@ impl SlayerApp {
                 stencil: None,
                 symmetry_x: false,
                 remesh: true,
+                trace: None,
                 view: ViewOptions {
                     show_mask: true,
                     ..ViewOptions::default()
@@ -373,6 +385,11 @@ impl SlayerApp {
         let message = format!("the engine stopped ({why}); the last saved file is intact");
         self.notify(message.clone());
         self.engine_stopped = Some(message);
+    }
+
+    /// The errors and notices shown so far, oldest first.
+    pub fn messages(&self) -> impl Iterator<Item = &str> {
+        self.messages.iter().map(|(m, _)| m.as_str())
     }
 
     pub(crate) fn notify(&mut self, message: String) {

@@ -7,7 +7,7 @@ use eframe::egui::{self, Color32, Painter, Rect, RichText, Stroke as Line, Ui};
 use glam::Vec3;
 
 use super::worker::Command;
-use super::{SlayerApp, StencilChoice};
+use super::{SlayerApp, StencilChoice, Trace};
 use crate::brush::{BrushKind, Falloff, Pattern};
 use crate::material::{PRESETS, linear_to_srgb, srgb_to_linear};
 use crate::mesh::Brdf;
@@ -98,6 +98,8 @@ fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
                 ui.selectable_value(&mut brush.kind, kind, format!("{}{key}", kind.name()));
             }
         });
+    trace_choice(app, ui);
+    let brush = &mut app.tools.brush;
     let edge = app.status.edge_length.max(1e-6);
     let extent = app.status.extent.max(edge);
     // Not clamped: a radius typed in or set with F stays what the user chose.
@@ -313,6 +315,19 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
             .weak()
             .small(),
     );
+}
+
+/// What a drag on the mesh does: stroke the brush, or trace a layer tool.
+fn trace_choice(app: &mut SlayerApp, ui: &mut Ui) {
+    ui.horizontal(|ui| {
+        ui.label("drag:");
+        let trace = &mut app.tools.trace;
+        ui.selectable_value(trace, None, "brush");
+        ui.selectable_value(trace, Some(Trace::Cut), "cut")
+            .on_hover_text("cut the active layers open along the drag");
+        ui.selectable_value(trace, Some(Trace::Patch), "patch")
+            .on_hover_text("draw a closed outline: a new layer in the brush's material fills it");
+    });
 }
 
 /// The layer tools on a layer's name: duplicate (its masked part, or all of it) in the brush's

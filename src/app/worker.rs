@@ -19,7 +19,7 @@ use crate::brush::{BrushKind, Sample, StrokeSettings};
 use crate::mesh::{Brdf, LayerId, Mesh};
 use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress, StrokeReport};
 use crate::session::{LayerSettings, Session};
-use crate::tools::{DeleteTarget, DuplicateSettings, Selection, selected_faces};
+use crate::tools::{CutSettings, DeleteTarget, DuplicateSettings, Selection, selected_faces};
 
 /// While a batch of points runs, the UI hears what changed at least this often, so the
 /// picture follows the stroke even when the engine is behind the pointer.
@@ -52,6 +52,8 @@ pub enum Command {
     /// lifted off it, in this material.
     DuplicateLayer(LayerId, Brdf),
     DeleteLayer(LayerId),
+    /// A layer tool traced on the surface: the pointer's rays over one drag.
+    Trace(LayerTool, Vec<Ray>),
     ClearMask,
     InvertMask,
     Save(PathBuf),
@@ -62,6 +64,15 @@ pub enum Command {
     /// Runs once every earlier command is done, on the session as they left it (tests, the
     /// replay's end).
     Query(Box<dyn FnOnce(&Session) + Send>),
+}
+
+/// A layer tool a drag on the mesh traces instead of a stroke.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LayerTool {
+    /// Cut the active layers open along the trace.
+    Cut,
+    /// A new layer in this material, filling the closed trace.
+    Patch(Brdf),
 }
 
 /// The document as the panels show it.
@@ -183,6 +194,10 @@ impl Worker {
                 let result = self.duplicate(layer, material);
                 self.after_tool(result);
             }
+            Command::Trace(tool, rays) => {
+                let result = self.trace(tool, &rays);
+                self.after_tool(result);
+            }
             Command::DeleteLayer(layer) => {
                 let result = self.session.delete(DeleteTarget::Layer(layer));
                 self.after_tool(result.map(|_| ()).map_err(|e| e.to_string()));
@@ -262,6 +277,32 @@ impl Worker {
         let settings = DuplicateSettings::for_mesh(mesh, &format!("{name} copy"), material);
         let result = self.session.duplicate(selection, &settings);
         result.map(|_| ()).map_err(|e| e.to_string())
+    }
+
+    /// A cut of the active layers along the traced points, or a patch filling them on the
+    /// layer the trace began on.
+    fn trace(&mut self, tool: LayerTool, rays: &[Ray]) -> Result<(), String> {
+        let hits: Vec<Hit> = rays
+            .iter()
+            .filter_map(|ray| self.picker.pick(self.session.mesh(), ray))
+            .collect();
+        let Some(first) = hits.first() else {
+            return Err("the trace missed the mesh".to_string());
+        };
+        let mesh = self.session.mesh();
+        let layer = mesh.face_layers()[first.face as usize];
+        let points: Vec<Vec3> = hits.iter().map(|h| h.point).collect();
+        let result = match tool {
+            LayerTool::Cut => {
+                let settings = CutSettings::for_mesh(mesh, &self.session.active_layers());
+                self.session.cut(&points, &settings).map(|_| ())
+            }
+            LayerTool::Patch(material) => {
+                let settings = DuplicateSettings::for_mesh(mesh, "patch", material);
+                self.session.patch(&points, layer, &settings).map(|_| ())
+            }
+        };
+        result.map_err(|e| e.to_string())
     }
 
     /// After a layer tool: a refusal is said, a change shown (layers and topology both).
