@@ -500,16 +500,21 @@ fn closing_with_unsaved_changes_asks_and_save_and_quit_saves() {
     std::fs::remove_file(saved).ok();
 }
 
+/// Right-clicks the widget labelled `label` and lets its menu open.
+fn open_menu(harness: &mut Harness<'_, SlayerApp>, label: &str) {
+    harness.get_by_label(label).click_secondary();
+    for _ in 0..3 {
+        harness.step();
+    }
+}
+
 /// The layer tools from the layer's menu: right-click a name, duplicate, then delete the copy;
 /// undo takes both back, bit for bit.
 #[test]
 fn a_layer_is_duplicated_and_deleted_from_its_menu() {
     let mut harness = app(plaster());
     let start = digest(&harness);
-    harness.get_by_label("paint").click_secondary();
-    for _ in 0..3 {
-        harness.step();
-    }
+    open_menu(&mut harness, "paint");
     harness.get_by_label("duplicate, lifted off it").click();
     settle(&mut harness, "the copy is a layer", |app| {
         app.status.layers.len() == 4
@@ -517,10 +522,7 @@ fn a_layer_is_duplicated_and_deleted_from_its_menu() {
     assert_eq!(harness.state().status.layers[3].0, "paint copy");
     let with_copy = digest(&harness);
     assert_ne!(with_copy, start);
-    harness.get_by_label("paint copy").click_secondary();
-    for _ in 0..3 {
-        harness.step();
-    }
+    open_menu(&mut harness, "paint copy");
     harness.get_by_label("delete layer").click();
     settle(&mut harness, "the copy is gone", |app| {
         app.status.layers.len() == 3

@@ -79,7 +79,6 @@ fn duplicate_and_check(
     session: &mut Session,
     selection: Selection,
     settings: &DuplicateSettings,
-    source: LayerId,
 ) -> Vec<u32> {
     let before = session.mesh().digest();
     let layers_before = session.mesh().layer_count();
@@ -111,8 +110,14 @@ fn duplicate_and_check(
     assert_eq!(session.layers().len(), layers_before);
     session.redo().unwrap();
     assert_eq!(session.mesh().digest(), after, "redo makes it again");
-    let _ = source;
     new
+}
+
+/// The closed components of `layer`.
+fn closed_on(mesh: &Mesh, layer: LayerId) -> Vec<slayer::mesh::ClosedComponent> {
+    let mut closed = mesh.closed_components();
+    closed.retain(|c| c.layer == layer);
+    closed
 }
 
 /// Every vertex of the copy lies within [0.9, 1.1] × the offset of its source layer.
@@ -142,7 +147,7 @@ fn a_masked_part_of_each_material_is_copied_above_itself() {
         mask_disc(&mut session, layer, centre, radius);
         let material = slayer::material::RED_PAINT.brdf;
         let settings = DuplicateSettings::for_mesh(session.mesh(), "copy", material);
-        let new = duplicate_and_check(&mut session, Selection::Masked(layer), &settings, layer);
+        let new = duplicate_and_check(&mut session, Selection::Masked(layer), &settings);
         let mesh = session.mesh();
         let components = mesh.components();
         let new_layer = mesh.layer_count() as u32 - 1;
@@ -159,20 +164,15 @@ fn a_masked_part_of_each_material_is_copied_above_itself() {
 fn a_closed_sphere_is_copied_as_a_sheet_and_as_a_shell() {
     let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
     let settings = DuplicateSettings::for_mesh(session.mesh(), "skin", slayer::material::RUST.brdf);
-    let new = duplicate_and_check(&mut session, Selection::Layer(0), &settings, 0);
+    let new = duplicate_and_check(&mut session, Selection::Layer(0), &settings);
     assert_offset(session.mesh(), &new, 0, settings.offset);
 
     let mut session = Session::new(scene(SceneKind::Sphere, 5_000));
     let mut shell = settings.clone();
     shell.thickness = Some(1.5 * settings.edge);
     shell.name = "shell".into();
-    duplicate_and_check(&mut session, Selection::Component(0), &shell, 0);
-    let mesh = session.mesh();
-    let closed: Vec<_> = mesh
-        .closed_components()
-        .into_iter()
-        .filter(|c| c.layer == 1)
-        .collect();
+    duplicate_and_check(&mut session, Selection::Component(0), &shell);
+    let closed = closed_on(session.mesh(), 1);
     assert_eq!(
         closed.len(),
         2,
@@ -191,13 +191,8 @@ fn a_sheet_thickened_is_one_closed_shell() {
     let mut settings =
         DuplicateSettings::for_mesh(session.mesh(), "chip", slayer::material::PAINT.brdf);
     settings.thickness = Some(2.0 * edge);
-    duplicate_and_check(&mut session, Selection::Masked(1), &settings, 1);
-    let mesh = session.mesh();
-    let shells: Vec<_> = mesh
-        .closed_components()
-        .into_iter()
-        .filter(|c| c.layer == 3)
-        .collect();
+    duplicate_and_check(&mut session, Selection::Masked(1), &settings);
+    let shells = closed_on(session.mesh(), 3);
     assert_eq!(
         shells.len(),
         1,

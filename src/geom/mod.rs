@@ -16,6 +16,14 @@ pub use tri_tri::{neighbours_overlap, triangles_intersect};
 
 use glam::Vec3;
 
+/// The point of the segment `ab` closest to `p`, and its parameter from `a` (0) to `b` (1); `a`
+/// for a degenerate segment.
+pub fn closest_on_segment(p: Vec3, a: Vec3, b: Vec3) -> (f32, Vec3) {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (t, a + ab * t)
+}
+
 /// The farthest any point moves from `from[i]` to `to[i]` (0 for none): the drift and step
 /// bounds the broad phases grow their reach by.
 pub fn largest_move(from: &[Vec3], to: &[Vec3]) -> f32 {

@@ -109,20 +109,30 @@ pub struct ClosedComponent {
 }
 
 impl Mesh {
+    /// Per component of `components` (this mesh's): whether it has a boundary edge.
+    pub fn open_components(&self, components: &Components) -> Vec<bool> {
+        let mut open = vec![false; components.count()];
+        let opposite = &self.adjacency().opposite;
+        for (face, &label) in components.face_component.iter().enumerate() {
+            if label != INVALID && (0..3).any(|k| opposite[3 * face + k] == INVALID) {
+                open[label as usize] = true;
+            }
+        }
+        open
+    }
+
     /// Every closed component, in order of their first face.
     pub fn closed_components(&self) -> Vec<ClosedComponent> {
         let components = self.components();
         let count = components.count();
-        let mut open = vec![false; count];
+        let open = self.open_components(&components);
         let mut sums = vec![(glam::DVec3::ZERO, 0usize); count];
         for (face, tri) in self.faces().iter().enumerate() {
             let label = components.face_component[face];
             if label == INVALID {
                 continue;
             }
-            for (k, &v) in tri.iter().enumerate() {
-                let corner = 3 * face as u32 + k as u32;
-                open[label as usize] |= self.adjacency().opposite[corner as usize] == INVALID;
+            for &v in tri {
                 let s = &mut sums[label as usize];
                 s.0 += self.positions()[v as usize].as_dvec3();
                 s.1 += 1;

@@ -18,7 +18,7 @@ use glam::Vec3;
 use super::obstacles::Obstacles;
 use super::select::check_layer;
 use super::{ToolError, check_length};
-use crate::geom::Aabb;
+use crate::geom::{Aabb, closest_on_segment};
 use crate::grid::SpatialHash;
 use crate::mesh::{LayerId, Mesh};
 use crate::remesh::{RemeshSettings, remesh_region};
@@ -259,10 +259,8 @@ fn nearest_edge(mesh: &Mesh, tri: [u32; 3], q: Vec3) -> (u32, u32, f32) {
     (0..3)
         .map(|k| {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            let ab = p(b) - p(a);
-            let t =
-                ((q - p(a)).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-            (a, b, t, (p(a) + ab * t).distance_squared(q))
+            let (t, on) = closest_on_segment(q, p(a), p(b));
+            (a, b, t, on.distance_squared(q))
         })
         .min_by(|x, y| x.3.total_cmp(&y.3))
         .map(|(a, b, t, _)| (a, b, t))
@@ -312,10 +310,8 @@ fn rim_vertex(mesh: &mut Mesh, face: u32, q: Vec3, edge: f32) -> Option<u32> {
         .into_iter()
         .map(|corner| {
             let (a, b) = mesh.edge_vertices(corner);
-            let ab = p(mesh, b) - p(mesh, a);
-            let t = ((q - p(mesh, a)).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE))
-                .clamp(0.0, 1.0);
-            (corner, t, (p(mesh, a) + ab * t).distance_squared(q))
+            let (t, on) = closest_on_segment(q, p(mesh, a), p(mesh, b));
+            (corner, t, on.distance_squared(q))
         })
         .min_by(|x, y| x.2.total_cmp(&y.2).then(x.0.cmp(&y.0)))?;
     let (a, b) = mesh.edge_vertices(corner);
@@ -369,12 +365,7 @@ fn distance_to_polyline(p: Vec3, line: &[Vec3]) -> f32 {
         return p.distance(line[0]);
     }
     line.windows(2)
-        .map(|s| {
-            let ab = s[1] - s[0];
-            let t =
-                ((p - s[0]).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-            p.distance(s[0] + ab * t)
-        })
+        .map(|s| p.distance(closest_on_segment(p, s[0], s[1]).1))
         .fold(f32::INFINITY, f32::min)
 }
 

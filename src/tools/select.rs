@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::ToolError;
-use crate::mesh::{INVALID, LayerId, Mesh};
+use crate::mesh::{LayerId, Mesh};
 
 /// A mask weight at least this selects a vertex.
 const MASKED: f32 = 0.5;
@@ -99,13 +99,7 @@ pub struct ComponentSummary {
 /// Every layer with its components, in layer order.
 pub fn layer_summaries(mesh: &Mesh) -> Vec<LayerSummary> {
     let components = mesh.components();
-    let mut open = vec![false; components.count()];
-    let opposite = &mesh.adjacency().opposite;
-    for (f, &label) in components.face_component.iter().enumerate() {
-        if label != INVALID && (0..3).any(|k| opposite[3 * f + k] == INVALID) {
-            open[label as usize] = true;
-        }
-    }
+    let open = mesh.open_components(&components);
     let mut vertices = vec![0; mesh.layer_count()];
     for v in 0..mesh.vertex_count() as u32 {
         if mesh.is_vertex_live(v) {
