@@ -5,7 +5,7 @@ use serde::Serialize;
 use crate::collide::{find_intersections, smallest_layer_gap};
 use crate::grid::SpatialHash;
 use crate::io::ImportReport;
-use crate::mesh::{ClosedComponent, Mesh};
+use crate::mesh::{ClosedComponent, ComponentShape, Mesh};
 use crate::remesh::MIN_CLOSED_FACES;
 
 /// A closed component whose volume changed by more than this share from the `--against` file
@@ -27,6 +27,9 @@ pub struct CheckReport {
     pub faces_per_layer: Vec<usize>,
     pub components: usize,
     pub components_per_layer: Vec<usize>,
+    /// Each component's topology: layer, faces, boundary loops (0: closed), Euler
+    /// characteristic and genus.
+    pub component_shapes: Vec<crate::mesh::ComponentShape>,
     pub mean_edge_length: f64,
     pub edge_length_cv: f64,
     pub min_edge_length: f64,
@@ -220,6 +223,7 @@ pub fn check_mesh(
         faces_per_layer: mesh.faces_per_layer(),
         components: components.count(),
         components_per_layer: components.per_layer(mesh.layer_count()),
+        component_shapes: mesh.component_shapes(),
         mean_edge_length: stats.mean,
         edge_length_cv: stats.coefficient_of_variation(),
         min_edge_length: stats.min,
@@ -322,6 +326,35 @@ impl Found<'_> {
     }
 }
 
+impl CheckReport {
+    /// One line on a layer's components: how many are closed and their genera, how many are
+    /// open and their boundary loops.
+    fn layer_topology(&self, layer: u32) -> String {
+        let shapes: Vec<_> = (self.component_shapes.iter())
+            .filter(|s| s.layer == layer)
+            .collect();
+        let (closed, open): (Vec<&ComponentShape>, Vec<_>) =
+            shapes.iter().partition(|s| s.is_closed());
+        let genera = match closed.len() {
+            0 => String::new(),
+            1..=6 => {
+                let list: Vec<String> = closed.iter().map(|s| s.genus.to_string()).collect();
+                format!(" (genus {})", list.join(", "))
+            }
+            _ => format!(
+                " (genus {} in all)",
+                closed.iter().map(|s| s.genus).sum::<i64>()
+            ),
+        };
+        let loops: usize = open.iter().map(|s| s.boundary_loops).sum();
+        format!(
+            "       {} closed{genera}, {} open ({loops} boundary loops)",
+            closed.len(),
+            open.len()
+        )
+    }
+}
+
 impl std::fmt::Display for CheckReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(f, "{}", self.file)?;
@@ -346,6 +379,7 @@ impl std::fmt::Display for CheckReport {
                 self.faces_per_layer.get(i).copied().unwrap_or(0),
                 self.components_per_layer.get(i).copied().unwrap_or(0)
             )?;
+            writeln!(f, "{}", self.layer_topology(i as u32))?;
         }
         writeln!(f, "  components        {}", self.components)?;
         writeln!(

@@ -29,3 +29,4 @@ pub mod render;
 pub mod scene;
 pub mod session;
 pub mod tools;
+pub mod topology;

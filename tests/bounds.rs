@@ -41,6 +41,7 @@ fn settings(radius: f32) -> StrokeSettings {
         layers: vec![1],
         spacing: 0.25,
         symmetry: None,
+        fuse: Vec::new(),
     }
 }
 

@@ -594,3 +594,25 @@ fn cut_and_patch_are_traced_on_the_surface() {
     });
     assert_eq!(digest(&harness), start);
 }
+
+/// The Layers panel's policy switch: a click makes one layer fuse, as an undoable entry.
+#[test]
+fn a_layer_is_switched_to_fuse_and_back_from_the_layers_panel() {
+    use slayer::topology::ProximityPolicy;
+    let mut harness = app(plaster());
+    let policy =
+        |harness: &Harness<'_, SlayerApp>, l: usize| harness.state().status.layers[l].1.policy;
+    harness
+        .get_all_by_label("collide")
+        .next()
+        .expect("a collide switch")
+        .click();
+    settle(&mut harness, "the plaster fuses", |app| {
+        app.status.layers[0].1.policy == ProximityPolicy::Fuse
+    });
+    assert_eq!(policy(&harness, 1), ProximityPolicy::Collide);
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    settle(&mut harness, "the switch is undone", |app| {
+        app.status.layers[0].1.policy == ProximityPolicy::Collide
+    });
+}

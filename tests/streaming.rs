@@ -4,7 +4,7 @@
 //! skipped), where the samples of one call may run ahead in one submission.
 
 use proptest::prelude::*;
-use slayer::bench::{ScriptSpec, feed_stroke, generate_script};
+use slayer::bench::{Feed, ScriptSpec, feed_stroke, generate_script};
 use slayer::brush::{Resampler, Sample, Stroke, resample};
 use slayer::collide::find_intersections;
 use slayer::gpu::{GpuContext, GpuKernels, GpuOptions};
@@ -65,7 +65,16 @@ fn sculpt(
 ) -> Mesh {
     let mut mesh = start.clone();
     for stroke in strokes {
-        feed_stroke(pipeline, &mut mesh, stroke, samples_per_call).unwrap();
+        feed_stroke(
+            pipeline,
+            &mut mesh,
+            stroke,
+            Feed {
+                samples_per_call,
+                fuse: false,
+            },
+        )
+        .unwrap();
     }
     mesh
 }

@@ -39,6 +39,7 @@ use crate::brush::{BrushKind, Stroke};
 use crate::mesh::Brdf;
 use crate::pipeline::{PhaseTimes, Pipeline};
 use crate::session::{BrushSettings, LayerSettings, Session};
+use crate::topology::ProximityPolicy;
 use input::PointerState;
 use viewport::Viewport;
 
@@ -485,6 +486,11 @@ impl SlayerApp {
         if layers.is_empty() {
             return Err("no layer is active: tick one in the Layers panel".into());
         }
+        let fuse = layers
+            .iter()
+            .copied()
+            .filter(|&l| self.status.layers[l as usize].1.policy == ProximityPolicy::Fuse)
+            .collect();
         let settings = crate::brush::StrokeSettings {
             brush: crate::brush::Brush {
                 kind,
@@ -500,6 +506,7 @@ impl SlayerApp {
                 .symmetry_x
                 .then(|| crate::brush::Mirror::new(self.status.centre, glam::Vec3::X))
                 .flatten(),
+            fuse,
         };
         settings.check(self.status.extent.max(1e-6))?;
         Ok(settings)

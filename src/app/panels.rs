@@ -11,6 +11,7 @@ use super::{SlayerApp, StencilChoice, Trace};
 use crate::brush::{BrushKind, Falloff, Pattern};
 use crate::material::{PRESETS, linear_to_srgb, srgb_to_linear};
 use crate::mesh::Brdf;
+use crate::topology::ProximityPolicy;
 
 /// How long a message stays in the status bar.
 const MESSAGE_SECONDS: u64 = 8;
@@ -295,8 +296,7 @@ fn layers_section(app: &mut SlayerApp, ui: &mut Ui) {
                     layer_menu(app, &label, l);
                 }
             }
-            ui.label(RichText::new("collide").weak())
-                .on_hover_text("contact stops motion: this layer never crosses another");
+            policy_toggle(ui, &mut changed.policy);
             if changed != *settings {
                 app.send(Command::SetLayer(l, changed));
                 // Shown at once, and the next change builds on it (the engine's status
@@ -332,6 +332,31 @@ fn trace_choice(app: &mut SlayerApp, ui: &mut Ui) {
 
 /// The layer tools on a layer's name: duplicate (its masked part, or all of it) in the brush's
 /// material, delete.
+/// The layer's proximity policy, switched by a click.
+fn policy_toggle(ui: &mut Ui, policy: &mut ProximityPolicy) {
+    let fuse = *policy == ProximityPolicy::Fuse;
+    let (text, hint) = match fuse {
+        false => (
+            "collide",
+            "collide: contact stops motion, this layer never crosses anything (click: fuse)",
+        ),
+        true => (
+            "fuse",
+            "fuse: where this layer touches itself it joins, and necks thinner than the join distance split; other layers still collide (click: collide)",
+        ),
+    };
+    if ui
+        .selectable_label(fuse, text)
+        .on_hover_text(hint)
+        .clicked()
+    {
+        *policy = match fuse {
+            false => ProximityPolicy::Fuse,
+            true => ProximityPolicy::Collide,
+        };
+    }
+}
+
 fn layer_menu(app: &mut SlayerApp, label: &egui::Response, layer: u32) {
     label.context_menu(|ui| {
         if ui

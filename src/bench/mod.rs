@@ -4,18 +4,19 @@
 mod report;
 mod script;
 
-pub use report::{gpu_memory_lines, paper_table, scaling_svg, scaling_table};
+pub use report::{gpu_memory_lines, paper_table, scaling_svg, scaling_table, topology_lines};
 pub use script::{BrushMix, ScriptSpec, generate_script};
 
 use serde::Serialize;
 
-use crate::brush::Stroke;
+use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
 use crate::pipeline::{
     BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, StrokeReport, Uploads,
 };
 use crate::remesh::RemeshReport;
+use crate::topology::TopologyReport;
 
 /// The distribution of the smallest angle of a set of faces, in degrees.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -82,6 +83,8 @@ pub struct SceneResult {
     pub ms_per_sample: f64,
     pub ms_per_stroke: f64,
     pub ms_per_remesh: f64,
+    /// With `--policy fuse`: the joins and splits the strokes made, and their cost.
+    pub topology: Option<TopologyFigures>,
     /// The most heap bytes live at once from the set-up to the last stroke: the mesh, the
     /// grid, the scratch and the strokes' own (`None` where the program does not count).
     pub peak_heap_bytes: Option<usize>,
@@ -116,6 +119,45 @@ pub struct SceneResult {
     /// stroke and per `add_samples` call: what a stroke costs in round trips, whatever the
     /// adapter's speed.
     pub gpu_calls: Option<GpuCalls>,
+}
+
+/// What the topology changes of a fuse run did and cost.
+#[derive(Debug, Clone, Serialize)]
+pub struct TopologyFigures {
+    pub joins: usize,
+    pub splits: usize,
+    pub refused: usize,
+    /// The refusals by reason (`topology::Refusal`, snake case).
+    pub refused_by_reason: std::collections::BTreeMap<String, usize>,
+    pub joins_per_stroke: f64,
+    pub splits_per_stroke: f64,
+    pub ms: f64,
+    pub ms_per_stroke: f64,
+    /// The topology pass's time over the strokes' whole time (the phases and it).
+    pub share: f64,
+}
+
+impl TopologyFigures {
+    fn of(report: &TopologyReport, phases: &PhaseTimes, strokes: usize) -> TopologyFigures {
+        let per_stroke = |n: f64| n / strokes.max(1) as f64;
+        TopologyFigures {
+            joins: report.joins,
+            splits: report.splits,
+            refused: report.refused.len(),
+            refused_by_reason: report
+                .refused
+                .iter()
+                .fold(Default::default(), |mut m, why| {
+                    *m.entry(why.name().to_string()).or_default() += 1;
+                    m
+                }),
+            joins_per_stroke: per_stroke(report.joins as f64),
+            splits_per_stroke: per_stroke(report.splits as f64),
+            ms: report.millis,
+            ms_per_stroke: per_stroke(report.millis),
+            share: report.millis / (phases.total() + report.millis).max(f64::MIN_POSITIVE),
+        }
+    }
 }
 
 /// Round trips to the GPU over a run of strokes (set-up before the first excluded).
@@ -168,19 +210,37 @@ impl GpuCalls {
     }
 }
 
-/// Runs `stroke` on `mesh` as an app would feed it: `samples_per_call` samples per
-/// `add_samples` call, then `finish` (`None`: all of them and the end in one call,
+/// How the bench hands strokes to the engine.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Feed {
+    /// Samples per `add_samples` call (`None`: a stroke's samples and its end in one call,
+    /// the batch).
+    pub samples_per_call: Option<usize>,
+    /// Every layer a stroke brushes fuses (`--policy fuse`, `crate::topology`).
+    pub fuse: bool,
+}
+
+/// Runs `stroke` on `mesh` as an app would feed it: `feed.samples_per_call` samples per
+/// `add_samples` call, then `finish` (`None`: all of them and the end in one call, as
 /// [`Pipeline::apply_stroke`]). Returns the stroke's report and the calls it took.
 pub fn feed_stroke(
     pipeline: &mut Pipeline,
     mesh: &mut Mesh,
     stroke: &Stroke,
-    samples_per_call: Option<usize>,
+    feed: Feed,
 ) -> Result<(StrokeReport, usize), PipelineError> {
-    let Some(chunk) = samples_per_call else {
-        return Ok((pipeline.apply_stroke(mesh, stroke)?, 1));
+    let settings = StrokeSettings {
+        fuse: if feed.fuse {
+            stroke.layers.clone()
+        } else {
+            Vec::new()
+        },
+        ..stroke.settings()
     };
-    let mut in_progress = pipeline.begin_stroke(mesh, stroke.settings())?;
+    let mut in_progress = pipeline.begin_stroke(mesh, settings)?;
+    let Some(chunk) = feed.samples_per_call else {
+        return Ok((in_progress.finish_with(&stroke.samples)?, 1));
+    };
     for samples in stroke.samples.chunks(chunk.max(1)) {
         in_progress.add_samples(samples)?;
     }
@@ -212,8 +272,9 @@ pub fn run_strokes(
     strokes: &[Stroke],
     pipeline: &mut Pipeline,
     mut progress: impl FnMut(usize),
-    (check_intersections, samples_per_call): (bool, Option<usize>),
+    (check_intersections, feed): (bool, Feed),
 ) -> Result<SceneResult, PipelineError> {
+    let samples_per_call = feed.samples_per_call;
     let (vertices, faces) = (mesh.live_vertex_count(), mesh.live_face_count());
     crate::memory::reset_peak();
     // Where the strokes went: vertices that moved or were made; the edge band is measured there.
@@ -228,12 +289,14 @@ pub fn run_strokes(
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
     let mut phases = PhaseTimes::default();
     let mut remesh = RemeshReport::default();
+    let mut topology = TopologyReport::default();
     let (mut samples, mut steps, mut collisions, mut reverted, mut moves) = (0, 0, 0, 0, 0);
     let mut gpu_memory = pipeline.gpu_memory(mesh);
     let uploads_before = pipeline.uploads();
     let mut calls = 0;
     for (i, stroke) in strokes.iter().enumerate() {
-        let (report, stroke_calls) = feed_stroke(pipeline, mesh, stroke, samples_per_call)?;
+        let (report, stroke_calls) = feed_stroke(pipeline, mesh, stroke, feed)?;
+        topology.add(&report.topology);
         calls += stroke_calls;
         gpu_memory = gpu_memory
             .into_iter()
@@ -294,6 +357,9 @@ pub fn run_strokes(
         ms_per_sample: sampling_ms / samples.max(1) as f64,
         ms_per_stroke: phases.total() / strokes.len().max(1) as f64,
         ms_per_remesh: phases.remesh / strokes.len().max(1) as f64,
+        topology: feed
+            .fuse
+            .then(|| TopologyFigures::of(&topology, &phases, strokes.len())),
         intersections,
         edge_band_fraction: band,
         valid: validation.is_ok(),

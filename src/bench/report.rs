@@ -7,6 +7,27 @@ use super::{ScalingRow, SceneResult};
 /// Lines per scene run on the GPU: the most GPU memory it held after any stroke, as the
 /// allocator reports it and as the budget counts the mesh's copy; its submissions and
 /// blocking read-backs.
+/// One line per scene run with `--policy fuse`: what its topology changes did and cost.
+pub fn topology_lines(results: &[SceneResult]) -> String {
+    let mut out = String::new();
+    for r in results {
+        let Some(t) = &r.topology else { continue };
+        let _ = writeln!(
+            out,
+            "topology {}: {} joins, {} splits, {} refused ({:.2} joins and {:.2} splits a stroke); {:.1} ms a stroke, {:.1} % of the strokes' time",
+            r.name,
+            t.joins,
+            t.splits,
+            t.refused,
+            t.joins_per_stroke,
+            t.splits_per_stroke,
+            t.ms_per_stroke,
+            100.0 * t.share
+        );
+    }
+    out
+}
+
 pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
     let mut out = String::new();

@@ -221,6 +221,9 @@ pub struct StrokeSettings {
     pub spacing: f32,
     /// Every sample brushed with its image across this plane, in the same steps.
     pub symmetry: Option<Mirror>,
+    /// Layers among `layers` whose policy is fuse (`topology::ProximityPolicy`): where the
+    /// stroke leaves one touching itself, it joins or splits after the stroke. Sorted.
+    pub fuse: Vec<LayerId>,
 }
 
 impl StrokeSettings {
@@ -252,6 +255,7 @@ impl Stroke {
             layers: self.layers.clone(),
             spacing: self.spacing,
             symmetry: self.symmetry,
+            fuse: Vec::new(),
         }
     }
 }

@@ -54,7 +54,7 @@ impl Mesh {
 
     /// Re-points `vertex` at a corner of its fan that starts at a boundary, if it has one,
     /// beginning from `known`, a live corner of the vertex.
-    fn repair_vertex_corner(&mut self, vertex: u32, known: u32) {
+    pub(super) fn repair_vertex_corner(&mut self, vertex: u32, known: u32) {
         let mut c = known;
         for _ in 0..super::corner_table::MAX_FAN {
             let left = self.adjacency.swing_left(c);
@@ -83,7 +83,7 @@ impl Mesh {
         room(&mut self.adjacency.opposite, 6);
     }
 
-    fn push_face(&mut self, vertices: [u32; 3], layer: u32) -> u32 {
+    pub(super) fn push_face(&mut self, vertices: [u32; 3], layer: u32) -> u32 {
         let f = self.faces.len() as u32;
         self.faces.push(vertices);
         self.face_layers.push(layer);

@@ -18,6 +18,7 @@ use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, MeshVersion, next, prev};
 use crate::remesh::{RemeshReport, RemeshSets, RemeshSettings, remesh_region_with};
+use crate::topology::{FuseSettings, TopologyReport, adapt};
 
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
 /// remeshing run here on the CPU; selection, deformation and (on a GPU) the proximity passes
@@ -145,6 +146,11 @@ impl Pipeline {
                 layer,
                 layer_count: mesh.layer_count(),
             });
+        }
+        if let Some(&layer) = stroke.fuse.iter().find(|l| !stroke.layers.contains(l)) {
+            return Err(PipelineError::InvalidBrush(format!(
+                "fuse names layer {layer}, which the stroke does not brush"
+            )));
         }
         // A mesh with no vertices has no size to measure the brush by; it has no edges either,
         // which `begin_stroke` reports.
@@ -323,6 +329,27 @@ pub(super) fn remesh_touched(
     let (report, changed) = remesh_region_with(mesh, grid, seeds, &settings, sets);
     kernels.remeshed(mesh, since, &changed);
     (report, changed)
+}
+
+/// After a stroke with fuse layers: joins and splits them where they touch themselves near
+/// `seeds` (`crate::topology`), keeping `grid` exact and telling `kernels` what changed.
+pub(super) fn fuse_touched(
+    mesh: &mut Mesh,
+    (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
+    (fuse_layers, seeds): (&[u32], &[u32]),
+    (edge, distance): (f32, f32),
+) -> TopologyReport {
+    let mut fuse = vec![false; mesh.layer_count()];
+    for &l in fuse_layers {
+        fuse[l as usize] = true;
+    }
+    let settings = FuseSettings::new(mesh, edge, distance);
+    let since = mesh.version();
+    let report = adapt(mesh, grid, &fuse, seeds, &settings);
+    if !report.changed.is_empty() {
+        kernels.remeshed(mesh, since, &report.changed);
+    }
+    report
 }
 
 /// Longest edge of the given faces (all live faces when `faces` is `None`).

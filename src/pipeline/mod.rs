@@ -24,7 +24,7 @@
 //! let brush = Brush { kind: BrushKind::Draw, radius: 0.1, strength: 0.5,
 //!                     falloff: Falloff::default(), invert: true };
 //! let mut stroke = pipeline.begin_stroke(&mut mesh, StrokeSettings {
-//!     brush, paint: None, layers: vec![1], spacing: 0.25, symmetry: None,
+//!     brush, paint: None, layers: vec![1], spacing: 0.25, symmetry: None, fuse: vec![],
 //! })?;
 //! for x in [0.3f32, 0.35, 0.4, 0.45, 0.5] {
 //!     // One pointer event: the samples it completes run now.
@@ -58,6 +58,7 @@ use thiserror::Error;
 
 use crate::grid::GridError;
 use crate::remesh::RemeshReport;
+use crate::topology::TopologyReport;
 
 /// Tunables, in units of the mesh's edge length `L` where they are lengths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -182,6 +183,8 @@ pub struct StrokeReport {
     pub touched: usize,
     /// What remeshing did, summed over the stroke's remeshing passes.
     pub remesh: RemeshReport,
+    /// Joins and splits of fuse layers after the stroke (`crate::topology`).
+    pub topology: TopologyReport,
     pub phases: PhaseTimes,
     /// Vertices the last call (`finish`: its last samples and the remeshing after the stroke)
     /// changed, ascending, vertices remeshing added or removed among them: what a viewer

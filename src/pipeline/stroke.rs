@@ -12,7 +12,8 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::engine::{
-    Pipeline, Prepared, Scratch, longest_edge, longest_edge_at, millis, remesh_touched,
+    Pipeline, Prepared, Scratch, fuse_touched, longest_edge, longest_edge_at, millis,
+    remesh_touched,
 };
 use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
 use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
@@ -191,8 +192,9 @@ impl<'a> StrokeInProgress<'a> {
         let mut active = self.active.take().ok_or(PipelineError::StrokeEnded)?;
         let kernels = self.pipeline.kernels.as_mut();
         kernels.given(self.mesh, active.samples_run, &[]);
-        let remeshed =
+        let mut remeshed =
             active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
+        remeshed.extend(active.fuse_after_stroke(kernels, self.mesh, &remeshed));
         active.tighten_edge_bound(self.mesh, &remeshed);
         let mut report = std::mem::take(&mut active.report);
         report.changed = last_call.changed;
@@ -704,6 +706,35 @@ impl Active {
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.report.remesh.add(&pass);
         self.report.phases.remesh += millis(started);
+        changed
+    }
+}
+
+impl Active {
+    /// Joins and splits the stroke's fuse layers where it left them touching themselves;
+    /// returns the vertices that changed.
+    fn fuse_after_stroke(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        remeshed_at_end: &[u32],
+    ) -> Vec<u32> {
+        if self.stroke.fuse.is_empty() {
+            return Vec::new();
+        }
+        let seeds: Vec<u32> = (self.touched_list.iter())
+            .chain(&self.remeshed)
+            .chain(remeshed_at_end)
+            .copied()
+            .collect();
+        let report = fuse_touched(
+            mesh,
+            (&mut self.prepared.grid, kernels),
+            (&self.stroke.fuse, &seeds),
+            (self.lengths.edge, self.lengths.collision_distance),
+        );
+        let changed = report.changed.clone();
+        self.report.topology.add(&report);
         changed
     }
 }

@@ -172,6 +172,7 @@ fn write_layers(out: &mut Writer, layers: &[LayerSettings]) {
         out.u32(layer.active as u32);
         out.u32(match layer.policy {
             ProximityPolicy::Collide => 0,
+            ProximityPolicy::Fuse => 1,
         });
         out.array(&layer.material.as_array());
     }
@@ -197,6 +198,7 @@ fn read_layers(input: &mut Reader) -> Result<Vec<LayerSettings>, DecodeError> {
             let active = flag(input, "layer active")?;
             let policy = match input.u32("layer policy")? {
                 0 => ProximityPolicy::Collide,
+                1 => ProximityPolicy::Fuse,
                 other => {
                     return Err(DecodeError::new("layer policy", format!("unknown {other}")));
                 }

@@ -43,15 +43,7 @@ use serde::{Deserialize, Serialize};
 use crate::brush::{BrushKind, Falloff, Stroke, StrokeSettings};
 use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta};
 use crate::pipeline::{Pipeline, PipelineError, StrokeReport};
-
-/// How a layer meets what comes within the collision distance of it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ProximityPolicy {
-    /// Contact stops motion (sLayer): the layer never crosses anything.
-    #[default]
-    Collide,
-}
+pub use crate::topology::ProximityPolicy;
 
 /// A layer's settings; its name lives in the mesh (files keep it there).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -235,14 +227,32 @@ impl Session {
         }
     }
 
+    /// Those of `layers` whose policy is fuse: what a stroke brushing them gives as
+    /// [`StrokeSettings::fuse`].
+    pub fn fuse_layers(&self, layers: &[LayerId]) -> Vec<LayerId> {
+        (layers.iter().copied())
+            .filter(|&l| {
+                self.layers
+                    .get(l as usize)
+                    .is_some_and(|s| s.policy == ProximityPolicy::Fuse)
+            })
+            .collect()
+    }
+
     /// A whole stroke through `pipeline`, as one history entry named after its brush.
     pub fn apply_stroke(
         &mut self,
         pipeline: &mut Pipeline,
         stroke: &Stroke,
     ) -> Result<(StrokeReport, Recorded), PipelineError> {
-        let mut edit = self.edit(&stroke_label(&stroke.settings()));
-        let report = pipeline.apply_stroke(edit.mesh(), stroke);
+        let settings = StrokeSettings {
+            fuse: self.fuse_layers(&stroke.layers),
+            ..stroke.settings()
+        };
+        let mut edit = self.edit(&stroke_label(&settings));
+        let report = pipeline
+            .begin_stroke(edit.mesh(), settings)
+            .and_then(|s| s.finish_with(&stroke.samples));
         // A failed stroke leaves the mesh intact but may have moved some of it: recorded too.
         let recorded = edit.commit();
         Ok((report?, recorded))

@@ -3,12 +3,13 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use slayer::bench::{
-    ScalingRow, SceneResult, ScriptSpec, generate_script, gpu_memory_lines, paper_table,
-    run_strokes, scaling_svg, scaling_table,
+    Feed, ScalingRow, SceneResult, ScriptSpec, generate_script, gpu_memory_lines, paper_table,
+    run_strokes, scaling_svg, scaling_table, topology_lines,
 };
 use slayer::mesh::Mesh;
 use slayer::pipeline::{PipelineSettings, Remeshing};
 use slayer::scene::{SceneKind, SceneSpec, generate};
+use slayer::topology::ProximityPolicy;
 
 use crate::backend::{self, Backend};
 use crate::progress::{Bar, Steps};
@@ -28,6 +29,17 @@ pub struct Options {
     pub samples_per_call: Option<usize>,
     /// Skip the collision searches that cannot find anything (`--no-cull` turns it off).
     pub cull: bool,
+    /// Every brushed layer collides (the default) or fuses (`--policy fuse`).
+    pub policy: ProximityPolicy,
+}
+
+impl Options {
+    fn feed(&self) -> Feed {
+        Feed {
+            samples_per_call: self.samples_per_call,
+            fuse: self.policy == ProximityPolicy::Fuse,
+        }
+    }
 }
 
 /// `--scene`: one scene name, `all` (the paper's three materials) or `none` (scaling only).
@@ -89,7 +101,7 @@ fn bench_scene(
     triangles: usize,
     strokes: usize,
     seed: u64,
-    (remeshing, chosen, feed, cull): (Remeshing, Backend, Option<usize>, bool),
+    (remeshing, chosen, feed, cull): (Remeshing, Backend, Feed, bool),
 ) -> anyhow::Result<SceneRun> {
     let steps = Steps::new(kind.name());
     steps.step(&format!("generating {triangles} triangles"));
@@ -144,14 +156,14 @@ fn report_fallback(pipeline: &slayer::pipeline::Pipeline) {
     }
 }
 
-/// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does, `feed`
-/// samples per `add_samples` call (`None`: each stroke's samples in one call).
+/// Runs `strokes` through `pipeline` with a progress bar, measuring as the bench does, fed as
+/// `feed` says.
 pub fn sculpt_with_progress(
     name: &str,
     mesh: &mut slayer::mesh::Mesh,
     strokes: &[slayer::brush::Stroke],
     pipeline: &mut slayer::pipeline::Pipeline,
-    feed: Option<usize>,
+    feed: Feed,
 ) -> anyhow::Result<SceneResult> {
     let bar = Bar::new(name, strokes.len() as u64);
     let result = run_strokes(name, mesh, strokes, pipeline, |_| bar.inc(), (true, feed))?;
@@ -181,12 +193,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
             triangles,
             options.strokes,
             options.seed,
-            (
-                options.remeshing,
-                resolved,
-                options.samples_per_call,
-                options.cull,
-            ),
+            (options.remeshing, resolved, options.feed(), options.cull),
         )?);
     }
     let scenes: Vec<SceneResult> = runs.iter().map(|r| r.result.clone()).collect();
@@ -204,6 +211,7 @@ pub fn run(options: &Options) -> anyhow::Result<ExitCode> {
         .collect();
     if !scenes.is_empty() {
         println!("{}", paper_table(&scenes));
+        print!("{}", topology_lines(&scenes));
         print!("{}", gpu_memory_lines(&scenes));
     }
     if !gpu_scenes.is_empty() {
@@ -285,12 +293,7 @@ fn scaling_rows(options: &Options, backend: Backend) -> anyhow::Result<Vec<Scali
             faces,
             options.strokes.min(8),
             options.seed,
-            (
-                options.remeshing,
-                backend,
-                options.samples_per_call,
-                options.cull,
-            ),
+            (options.remeshing, backend, options.feed(), options.cull),
         )?
         .result;
         scaling.push(ScalingRow {

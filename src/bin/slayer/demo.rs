@@ -100,8 +100,13 @@ pub fn run(
         pipeline.name(),
         strokes_path.display()
     );
-    let result =
-        crate::bench::sculpt_with_progress("plaster", &mut mesh, &strokes, &mut pipeline, None)?;
+    let result = crate::bench::sculpt_with_progress(
+        "plaster",
+        &mut mesh,
+        &strokes,
+        &mut pipeline,
+        Default::default(),
+    )?;
     if let Some(why) = pipeline.kernel_failure() {
         eprintln!("warning: the GPU failed ({why}); the strokes finished on the CPU");
     }

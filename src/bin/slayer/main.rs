@@ -133,6 +133,11 @@ enum Command {
         /// cannot touch itself or no other layer is near: the same result, slower; to compare.
         #[arg(long)]
         no_cull: bool,
+        /// How a layer meets itself: `collide` (contact stops motion) or `fuse` (parts that
+        /// touch join, necks thinner than the join distance split). `fuse` alone sets every
+        /// layer; `LAYER=fuse` one layer, by index or name. Repeat for several.
+        #[arg(long, value_name = "[LAYER=]collide|fuse")]
+        policy: Vec<String>,
     },
     /// Undo the last entries of a session file's history and write the result.
     Undo {
@@ -229,6 +234,10 @@ enum Command {
         /// cannot touch itself or no other layer is near: the same result, slower; to compare.
         #[arg(long)]
         no_cull: bool,
+        /// How each brushed layer meets itself: `collide` or `fuse` (parts that touch join;
+        /// the report adds the joins, splits and their share of the time).
+        #[arg(long, default_value = "collide", value_name = "collide|fuse")]
+        policy: slayer::topology::ProximityPolicy,
     },
     /// Render a mesh file to a PNG with the preview renderer (headless; lavapipe without a GPU).
     ///
@@ -387,6 +396,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             remesh,
             backend,
             no_cull,
+            policy,
         } => sculpt::run(&sculpt::Args {
             input: &input,
             strokes: &strokes,
@@ -399,6 +409,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             backend,
             strict,
             cull: !no_cull,
+            policies: &policy,
         }),
         Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output, strict),
         Command::Undo {
@@ -484,6 +495,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             remesh,
             samples_per_call,
             no_cull,
+            policy,
         } => {
             let scenes = match bench::parse_scenes(&scene) {
                 Ok(scenes) => scenes,
@@ -504,6 +516,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
                 remeshing: remesh,
                 samples_per_call: samples_per_call.map(|n| n as usize),
                 cull: !no_cull,
+                policy,
             })
         }
     }

@@ -6,6 +6,7 @@ use slayer::brush::{Stroke, StrokeFile, SymmetrySpec, dabs_for};
 use slayer::io::AtomicBatch;
 use slayer::pipeline::step::MAX_STEPS_PER_SAMPLE;
 use slayer::pipeline::{PipelineSettings, Remeshing, StrokeReport};
+use slayer::session::{LayerSettings, ProximityPolicy, Session};
 
 use crate::progress::Bar;
 
@@ -27,6 +28,51 @@ pub struct Args<'a> {
     pub strict: bool,
     /// Skip the collision searches that cannot find anything (`--no-cull`: off).
     pub cull: bool,
+    /// `--policy` values: `collide|fuse` for every layer, `LAYER=collide|fuse` for one.
+    pub policies: &'a [String],
+}
+
+/// Sets the layers' proximity policies as `--policy` says (each is a history entry).
+pub fn set_policies(session: &mut Session, specs: &[String]) -> anyhow::Result<()> {
+    for spec in specs {
+        let (layer, policy) = match spec.split_once('=') {
+            Some((layer, policy)) => (Some(layer), policy),
+            None => (None, spec.as_str()),
+        };
+        let policy: ProximityPolicy = policy
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--policy {spec}: {e}"))?;
+        let layers: Vec<u32> = match layer {
+            None => (0..session.mesh().layer_count() as u32).collect(),
+            Some(name) => {
+                vec![find_layer(session.mesh(), name).with_context(|| format!("--policy {spec}"))?]
+            }
+        };
+        for l in layers {
+            let settings = LayerSettings {
+                policy,
+                ..session.layers()[l as usize]
+            };
+            session.set_layer(l, settings)?;
+        }
+    }
+    Ok(())
+}
+
+/// A layer by index or name.
+fn find_layer(mesh: &slayer::mesh::Mesh, name: &str) -> anyhow::Result<u32> {
+    let names = mesh.layer_names();
+    if let Some(l) = names.iter().position(|n| n == name) {
+        return Ok(l as u32);
+    }
+    match name.parse::<u32>() {
+        Ok(l) if (l as usize) < names.len() => Ok(l),
+        _ => bail!(
+            "no layer `{}` (the mesh has {})",
+            slayer::files::escape(name),
+            names.join(", ")
+        ),
+    }
 }
 
 /// Applies a stroke file to a mesh or session and writes the result (and the stats) as one
@@ -50,6 +96,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
             stroke.symmetry = Some(SymmetrySpec::Axis(axis.to_string()));
         }
     }
+    set_policies(&mut session, args.policies)?;
     let strokes = file.resolve(session.mesh(), &name)?;
     let load_peak = slayer::memory::peak_bytes();
     slayer::memory::reset_peak();

@@ -1,0 +1,283 @@
+//! Self-adaptive topology (the fuse policy): parts of one layer that touch join, necks split,
+//! and the surface stays closed, manifold and free of intersections; collide layers never
+//! change genus.
+
+use glam::Vec3;
+use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
+use slayer::collide::find_intersections;
+use slayer::grid::SpatialHash;
+use slayer::mesh::{ComponentShape, Mesh};
+use slayer::pipeline::{Pipeline, PipelineSettings, StrokeReport};
+use slayer::scene::geodesic_sphere;
+use slayer::topology::{FuseSettings, TopologyReport, adapt};
+
+/// Spheres of `radius` at `centres`, all on one layer named "blob".
+fn spheres(frequency: u32, radius: f32, centres: &[Vec3]) -> Mesh {
+    let one = geodesic_sphere(frequency, radius).expect("sphere");
+    let (mut positions, mut faces) = (Vec::new(), Vec::new());
+    for &c in centres {
+        let base = positions.len() as u32;
+        positions.extend(one.positions().iter().map(|&p| p + c));
+        faces.extend(one.faces().iter().map(|t| t.map(|v| v + base)));
+    }
+    let layers = vec![0; faces.len()];
+    Mesh::new(positions, faces, layers, vec!["blob".into()]).expect("spheres")
+}
+
+/// Runs the fuse pass over every vertex of a one-layer mesh.
+fn fuse_everywhere(mesh: &mut Mesh) -> TopologyReport {
+    let edge = mesh.mean_edge_length();
+    let settings = FuseSettings::new(mesh, edge, edge);
+    let mut grid = SpatialHash::build(mesh, edge).expect("grid");
+    let all: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+    adapt(mesh, &mut grid, &[true], &all, &settings)
+}
+
+/// Validates the mesh and returns its components' shapes, asserting they are closed and that
+/// nothing crosses anything.
+fn closed_and_clean(mesh: &Mesh) -> Vec<ComponentShape> {
+    mesh.validate().expect("valid mesh");
+    let crossings = find_intersections(mesh);
+    assert_eq!(crossings.total(), 0, "{crossings:?}");
+    let shapes = mesh.component_shapes();
+    assert!(shapes.iter().all(|s| s.is_closed()), "{shapes:?}");
+    shapes
+}
+
+#[test]
+fn two_spheres_within_the_join_distance_become_one() {
+    let probe = spheres(8, 0.5, &[Vec3::ZERO]);
+    let edge = probe.mean_edge_length();
+    let gap = 1.05 * edge;
+    let mut mesh = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.0 + gap, 0.0, 0.0)]);
+    assert_eq!(closed_and_clean(&mesh).len(), 2);
+
+    let report = fuse_everywhere(&mut mesh);
+    assert_eq!((report.joins, report.splits), (1, 0), "{report:?}");
+    let shapes = closed_and_clean(&mesh);
+    assert_eq!(shapes.len(), 1, "{shapes:?}");
+    assert_eq!(shapes[0].genus, 0);
+}
+
+#[test]
+fn spheres_farther_than_the_join_distance_stay_apart() {
+    let probe = spheres(8, 0.5, &[Vec3::ZERO]);
+    let gap = 1.5 * probe.mean_edge_length();
+    let mut mesh = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.0 + gap, 0.0, 0.0)]);
+    let before = mesh.clone();
+    let report = fuse_everywhere(&mut mesh);
+    assert_eq!((report.contacts, report.joins), (0, 0));
+    assert_eq!(mesh.positions(), before.positions());
+    assert_eq!(mesh.faces(), before.faces());
+}
+
+/// One stroke of `kind` through `points` on layer 0 of `mesh`, fuse when `fuse` holds.
+fn stroke(
+    pipeline: &mut Pipeline,
+    mesh: &mut Mesh,
+    (kind, radius, strength): (BrushKind, f32, f32),
+    points: &[Vec3],
+    fuse: bool,
+) -> StrokeReport {
+    let brush = Brush {
+        kind,
+        radius,
+        strength,
+        falloff: Falloff::default(),
+        invert: false,
+    };
+    let settings = StrokeSettings {
+        brush,
+        paint: None,
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        fuse: if fuse { vec![0] } else { Vec::new() },
+    };
+    let samples: Vec<Sample> = points
+        .iter()
+        .map(|&position| Sample {
+            position,
+            pressure: 1.0,
+            normal: None,
+        })
+        .collect();
+    pipeline
+        .begin_stroke(mesh, settings)
+        .expect("stroke begins")
+        .finish_with(&samples)
+        .expect("stroke runs")
+}
+
+/// Points from `from` to `to`, `count` of them, ends included.
+fn line(from: Vec3, to: Vec3, count: usize) -> Vec<Vec3> {
+    (0..count)
+        .map(|i| from.lerp(to, i as f32 / (count - 1) as f32))
+        .collect()
+}
+
+#[test]
+fn a_grab_pushing_the_north_pole_through_the_south_pole_makes_a_torus() {
+    let mut mesh = spheres(16, 1.0, &[Vec3::ZERO]);
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let push = line(Vec3::Y, Vec3::new(0.0, -1.3, 0.0), 24);
+    let report = stroke(
+        &mut pipeline,
+        &mut mesh,
+        (BrushKind::Grab, 0.4, 1.0),
+        &push,
+        true,
+    );
+    assert!(
+        report.clamped > 0,
+        "the pole must have reached the far side: {report:?}"
+    );
+    assert_eq!(report.topology.joins, 1, "{:?}", report.topology);
+    let shapes = closed_and_clean(&mesh);
+    assert_eq!(shapes.len(), 1, "{shapes:?}");
+    assert_eq!(shapes[0].genus, 1, "{shapes:?}");
+
+    // The same stroke on a collide layer: the pole stops at the far side, no genus changes.
+    let mut kept = spheres(16, 1.0, &[Vec3::ZERO]);
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let report = stroke(
+        &mut pipeline,
+        &mut kept,
+        (BrushKind::Grab, 0.4, 1.0),
+        &push,
+        false,
+    );
+    assert_eq!(report.topology, TopologyReport::default());
+    let shapes = closed_and_clean(&kept);
+    assert_eq!((shapes.len(), shapes[0].genus), (1, 0), "{shapes:?}");
+}
+
+/// A closed capsule along z: `around` vertices a ring, rings one edge apart, a fan at each end.
+/// Its radius follows `radius(z)`; the ring spacing is the circumference over `around` at the
+/// ends, so the mesh is near uniform there and the pinched rings are crowded.
+fn capsule(around: u32, rings: u32, radius: impl Fn(f32) -> f32) -> Mesh {
+    let end_radius = radius(0.0);
+    let spacing = std::f32::consts::TAU * end_radius / around as f32;
+    let length = spacing * (rings - 1) as f32;
+    let mut positions = Vec::new();
+    for k in 0..rings {
+        let z = k as f32 * spacing;
+        let r = radius(z / length);
+        for i in 0..around {
+            let t = std::f32::consts::TAU * i as f32 / around as f32;
+            positions.push(Vec3::new(r * t.cos(), r * t.sin(), z));
+        }
+    }
+    let (bottom, top) = (positions.len() as u32, positions.len() as u32 + 1);
+    positions.push(Vec3::new(0.0, 0.0, -0.8 * spacing));
+    positions.push(Vec3::new(0.0, 0.0, length + 0.8 * spacing));
+    let at = |k: u32, i: u32| k * around + i % around;
+    let mut faces = Vec::new();
+    for k in 0..rings - 1 {
+        for i in 0..around {
+            faces.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
+            faces.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
+        }
+    }
+    for i in 0..around {
+        faces.push([at(0, i + 1), at(0, i), bottom]);
+        faces.push([at(rings - 1, i), at(rings - 1, i + 1), top]);
+    }
+    let layers = vec![0; faces.len()];
+    Mesh::new(positions, faces, layers, vec!["blob".into()]).expect("capsule")
+}
+
+#[test]
+fn a_neck_pinched_below_the_join_distance_splits_into_two_closed_components() {
+    // 16 around a ring of radius 1: edges of 0.39. The waist is 0.2 across, under the join
+    // distance (1.18 edges = 0.46) and over the collision distance's reach of its own ring.
+    let waist = |t: f32| 1.0 - 0.9 * (-((t - 0.5) / 0.08).powi(2)).exp();
+    let mut mesh = capsule(16, 24, waist);
+    assert_eq!(closed_and_clean(&mesh).len(), 1);
+
+    let report = fuse_everywhere(&mut mesh);
+    assert_eq!((report.splits, report.joins), (1, 0), "{report:?}");
+    let shapes = closed_and_clean(&mesh);
+    assert_eq!(shapes.len(), 2, "{shapes:?}");
+    assert!(shapes.iter().all(|s| s.genus == 0), "{shapes:?}");
+}
+
+#[test]
+fn two_fuse_layers_touching_never_weld() {
+    let probe = spheres(8, 0.5, &[Vec3::ZERO]);
+    let gap = 1.05 * probe.mean_edge_length();
+    let one = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.0 + gap, 0.0, 0.0)]);
+    // The same two spheres, the second on a layer of its own.
+    let half = one.faces().len() / 2;
+    let layers: Vec<u32> = (0..one.faces().len()).map(|f| (f >= half) as u32).collect();
+    let mut mesh = Mesh::new(
+        one.positions().to_vec(),
+        one.faces().to_vec(),
+        layers,
+        vec!["flake".into(), "plaster".into()],
+    )
+    .expect("two layers");
+    let edge = mesh.mean_edge_length();
+    let settings = FuseSettings::new(&mesh, edge, edge);
+    let mut grid = SpatialHash::build(&mesh, edge).expect("grid");
+    let all: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+    let report = adapt(&mut mesh, &mut grid, &[true, true], &all, &settings);
+    assert_eq!((report.contacts, report.joins, report.splits), (0, 0, 0));
+    assert_eq!(closed_and_clean(&mesh).len(), 2);
+}
+
+/// Seeded strokes of every deforming brush over a sphere, the same on a fuse and on a collide
+/// copy: after each, both are closed, valid and free of intersections; the collide copy keeps
+/// its genus.
+#[test]
+fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(27);
+    let kinds = [
+        BrushKind::Grab,
+        BrushKind::Draw,
+        BrushKind::Inflate,
+        BrushKind::Deflate,
+        BrushKind::Smooth,
+        BrushKind::Pinch,
+    ];
+    let mut fused = spheres(6, 0.5, &[Vec3::ZERO]);
+    let mut kept = fused.clone();
+    let (mut fuse_pipeline, mut keep_pipeline) = (
+        Pipeline::new(PipelineSettings::default()),
+        Pipeline::new(PipelineSettings::default()),
+    );
+    let mut changes = 0;
+    let random_vec = |rng: &mut rand_chacha::ChaCha8Rng, r: f32| {
+        Vec3::new(
+            rng.random_range(-r..r),
+            rng.random_range(-r..r),
+            rng.random_range(-r..r),
+        )
+    };
+    for i in 0..300 {
+        let kind = kinds[rng.random_range(0..kinds.len())];
+        let brush = (
+            kind,
+            rng.random_range(0.08..0.3),
+            rng.random_range(0.3..1.0),
+        );
+        let start = random_vec(&mut rng, 1.0).normalize_or(Vec3::X) * 0.5;
+        let end = start + random_vec(&mut rng, 0.4);
+        let points = line(start, end, 6);
+        let report = stroke(&mut fuse_pipeline, &mut fused, brush, &points, true);
+        changes += report.topology.joins + report.topology.splits;
+        closed_and_clean(&fused);
+        stroke(&mut keep_pipeline, &mut kept, brush, &points, false);
+        let shapes = closed_and_clean(&kept);
+        assert_eq!(
+            (shapes.len(), shapes[0].genus),
+            (1, 0),
+            "stroke {i}: {shapes:?}"
+        );
+    }
+    eprintln!(
+        "{changes} joins and splits over 300 strokes: {:?}",
+        fused.component_shapes()
+    );
+}
