@@ -608,3 +608,69 @@ fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
         assert_eq!(read_backs, expected, "{label}: read-backs");
     }
 }
+
+/// A fuse layer joined after a stroke on the GPU backend: the GPU's copy of the mesh follows
+/// the topology change (faces cut out, a tube sewn in, remeshed), the next stroke runs on it,
+/// and both end as on the CPU pipeline.
+#[test]
+fn a_topology_change_after_a_stroke_patches_the_gpu_copy() {
+    use glam::Vec3;
+    use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
+    let sphere = slayer::scene::geodesic_sphere(8, 1.0).unwrap();
+    let settings = |kind: BrushKind, radius: f32| StrokeSettings {
+        brush: Brush {
+            kind,
+            radius,
+            strength: 1.0,
+            falloff: Falloff::default(),
+            invert: false,
+        },
+        paint: None,
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        fuse: vec![0],
+    };
+    let at = |points: &[[f32; 3]]| -> Vec<Sample> {
+        points
+            .iter()
+            .map(|&p| Sample {
+                position: Vec3::from(p),
+                pressure: 1.0,
+                normal: None,
+            })
+            .collect()
+    };
+    let push = at(&[[0.0, 1.0, 0.0], [0.0, -1.3, 0.0]]);
+    let draw = at(&[[1.0, 0.0, 0.0], [0.9, 0.3, 0.0]]);
+    let sculpt = |pipeline: &mut Pipeline, mesh: &mut Mesh| {
+        let first = pipeline
+            .begin_stroke(mesh, settings(BrushKind::Grab, 0.5))
+            .unwrap()
+            .finish_with(&push)
+            .unwrap();
+        assert_eq!(first.topology.joins, 1, "{:?}", first.topology);
+        pipeline.check_kernel_copy(mesh).unwrap();
+        pipeline
+            .begin_stroke(mesh, settings(BrushKind::Draw, 0.3))
+            .unwrap()
+            .finish_with(&draw)
+            .unwrap();
+        pipeline.check_kernel_copy(mesh).unwrap();
+    };
+    let mut on_cpu = sphere.clone();
+    sculpt(&mut Pipeline::new(PipelineSettings::default()), &mut on_cpu);
+    let mut on_gpu = sphere;
+    let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), Box::new(all_on_gpu()));
+    sculpt(&mut pipeline, &mut on_gpu);
+    assert_eq!(pipeline.kernel_failure(), None);
+    let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
+    assert_eq!(uploads.whole, 1, "patched, not sent again: {uploads:?}");
+    on_gpu.validate().unwrap();
+    assert_eq!(find_intersections(&on_gpu).total(), 0);
+    let shapes = on_gpu.component_shapes();
+    assert_eq!((shapes.len(), shapes[0].genus), (1, 1), "{shapes:?}");
+    assert_eq!(on_gpu.vertex_count(), on_cpu.vertex_count());
+    let deviation = largest_deviation(&on_cpu, &on_gpu);
+    assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
+}

@@ -226,13 +226,36 @@ fn two_fuse_layers_touching_never_weld() {
     assert_eq!(closed_and_clean(&mesh).len(), 2);
 }
 
-/// Seeded strokes of every deforming brush over a sphere, the same on a fuse and on a collide
-/// copy: after each, both are closed, valid and free of intersections; the collide copy keeps
-/// its genus.
-#[test]
-fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
+/// A torus about z: `around` quads the long way, `across` the short way, each split in two.
+fn torus(around: u32, across: u32, (major, minor): (f32, f32)) -> Mesh {
+    use std::f32::consts::TAU;
+    let mut positions = Vec::new();
+    for i in 0..around {
+        let u = TAU * i as f32 / around as f32;
+        for j in 0..across {
+            let v = TAU * j as f32 / across as f32;
+            let ring = major + minor * v.cos();
+            positions.push(Vec3::new(ring * u.cos(), ring * u.sin(), minor * v.sin()));
+        }
+    }
+    let at = |i: u32, j: u32| (i % around) * across + j % across;
+    let mut faces = Vec::new();
+    for i in 0..around {
+        for j in 0..across {
+            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let layers = vec![0; faces.len()];
+    Mesh::new(positions, faces, layers, vec!["ring".into()]).expect("torus")
+}
+
+/// 300 seeded strokes of every deforming brush over `start` (each from a vertex of the fuse
+/// copy, brush radii and reach scaled by `size`), the same on a fuse and on a collide copy: after each, both are closed, valid and free of intersections; the collide copy keeps
+/// its genus. Returns the joins and splits made.
+fn random_strokes(start: &Mesh, size: f32, seed: u64) -> usize {
     use rand::{Rng, SeedableRng};
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(27);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let kinds = [
         BrushKind::Grab,
         BrushKind::Draw,
@@ -241,8 +264,8 @@ fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
         BrushKind::Smooth,
         BrushKind::Pinch,
     ];
-    let mut fused = spheres(6, 0.5, &[Vec3::ZERO]);
-    let mut kept = fused.clone();
+    let genus = start.component_shapes()[0].genus;
+    let (mut fused, mut kept) = (start.clone(), start.clone());
     let (mut fuse_pipeline, mut keep_pipeline) = (
         Pipeline::new(PipelineSettings::default()),
         Pipeline::new(PipelineSettings::default()),
@@ -259,11 +282,14 @@ fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
         let kind = kinds[rng.random_range(0..kinds.len())];
         let brush = (
             kind,
-            rng.random_range(0.08..0.3),
+            rng.random_range(0.16..0.6) * size,
             rng.random_range(0.3..1.0),
         );
-        let start = random_vec(&mut rng, 1.0).normalize_or(Vec3::X) * 0.5;
-        let end = start + random_vec(&mut rng, 0.4);
+        let live: Vec<u32> = (0..fused.vertex_count() as u32)
+            .filter(|&v| fused.is_vertex_live(v))
+            .collect();
+        let start = fused.positions()[live[rng.random_range(0..live.len())] as usize];
+        let end = start + random_vec(&mut rng, 0.8 * size);
         let points = line(start, end, 6);
         let report = stroke(&mut fuse_pipeline, &mut fused, brush, &points, true);
         changes += report.topology.joins + report.topology.splits;
@@ -272,7 +298,7 @@ fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
         let shapes = closed_and_clean(&kept);
         assert_eq!(
             (shapes.len(), shapes[0].genus),
-            (1, 0),
+            (1, genus),
             "stroke {i}: {shapes:?}"
         );
     }
@@ -280,4 +306,19 @@ fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
         "{changes} joins and splits over 300 strokes: {:?}",
         fused.component_shapes()
     );
+    changes
+}
+
+#[test]
+fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
+    let changes = random_strokes(&spheres(6, 0.5, &[Vec3::ZERO]), 0.5, 27);
+    assert!(changes > 0, "the strokes must have made the surface touch itself");
+}
+
+#[test]
+fn random_strokes_keep_a_fuse_torus_closed_manifold_and_intersection_free() {
+    let ring = torus(40, 14, (0.5, 0.2));
+    assert_eq!(closed_and_clean(&ring)[0].genus, 1);
+    let changes = random_strokes(&ring, 0.6, 28);
+    assert!(changes > 0, "the strokes must have made the surface touch itself");
 }
