@@ -312,7 +312,10 @@ fn random_strokes(start: &Mesh, size: f32, seed: u64) -> usize {
 #[test]
 fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
     let changes = random_strokes(&spheres(6, 0.5, &[Vec3::ZERO]), 0.5, 27);
-    assert!(changes > 0, "the strokes must have made the surface touch itself");
+    assert!(
+        changes > 0,
+        "the strokes must have made the surface touch itself"
+    );
 }
 
 #[test]
@@ -320,5 +323,39 @@ fn random_strokes_keep_a_fuse_torus_closed_manifold_and_intersection_free() {
     let ring = torus(40, 14, (0.5, 0.2));
     assert_eq!(closed_and_clean(&ring)[0].genus, 1);
     let changes = random_strokes(&ring, 0.6, 28);
-    assert!(changes > 0, "the strokes must have made the surface touch itself");
+    assert!(
+        changes > 0,
+        "the strokes must have made the surface touch itself"
+    );
+}
+
+/// Two spheres joined into a dumbbell, its neck deflated stroke after stroke: the collision
+/// distance holds the two sides of the neck apart until they are within the join distance
+/// all the way round, and then the neck splits into two closed components.
+#[test]
+fn a_dumbbell_whose_neck_is_deflated_splits_into_two_closed_components() {
+    let probe = spheres(12, 0.5, &[Vec3::ZERO]);
+    let gap = 1.05 * probe.mean_edge_length();
+    let mut mesh = spheres(12, 0.5, &[Vec3::ZERO, Vec3::new(1.0 + gap, 0.0, 0.0)]);
+    assert_eq!(fuse_everywhere(&mut mesh).joins, 1);
+    assert_eq!(closed_and_clean(&mesh).len(), 1);
+
+    let neck = Vec3::new(0.5 + gap / 2.0, 0.0, 0.0);
+    let across = line(neck - 0.02 * Vec3::X, neck + 0.02 * Vec3::X, 5);
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let mut strokes = 0;
+    while strokes < 16 {
+        strokes += 1;
+        let deflate = (BrushKind::Deflate, 0.2, 1.0);
+        let report = stroke(&mut pipeline, &mut mesh, deflate, &across, true);
+        assert_eq!(report.topology.joins, 0, "{:?}", report.topology);
+        closed_and_clean(&mesh);
+        if report.topology.splits > 0 {
+            break;
+        }
+    }
+    let shapes = closed_and_clean(&mesh);
+    assert_eq!(shapes.len(), 2, "after {strokes} strokes: {shapes:?}");
+    assert!(shapes.iter().all(|s| s.genus == 0), "{shapes:?}");
+    eprintln!("the neck split after {strokes} strokes: {shapes:?}");
 }

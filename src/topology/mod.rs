@@ -76,6 +76,15 @@ pub const JOIN_OVER_EDGE: f32 = 1.18;
 pub const JOIN_OVER_COLLISION: f32 = 1.1;
 /// Topology changes made after one stroke at most.
 pub const MAX_CHANGES_PER_PASS: usize = 16;
+/// The neighbourhood a vertex skips when looking for contacts: its own faces and those touching
+/// its neighbours. Collision sizes its ring from the thinnest faces (`collide::neighbourhood`),
+/// which a pinched neck makes thin: a ring sized so would hide the neck's far side. A face
+/// beyond one ring of a well-shaped sheet is farther than the join distance anyway, and a
+/// contact between near neighbours (on slivers) is refused as overlapping or not simple.
+const CONTACT_RING: u32 = 1;
+/// A split leaves each side at least this many faces (before capping): a smaller part is a
+/// crumb the contact clusters happened to ring, not a body pinched off.
+pub const MIN_SPLIT_FACES: usize = 4 * crate::remesh::MIN_CLOSED_FACES;
 /// Rounds of contact reading after one stroke at most (each after the changes of the last).
 const MAX_ROUNDS: usize = 4;
 
@@ -103,7 +112,7 @@ impl FuseSettings {
             edge,
             collision_distance,
             join_distance,
-            exclusion_ring: exclusion_ring(mesh, join_distance),
+            exclusion_ring: CONTACT_RING,
             collision_ring: exclusion_ring(mesh, collision_distance),
         }
     }
@@ -149,6 +158,8 @@ pub enum Refusal {
     NotManifold,
     /// The new faces would cross something.
     WouldIntersect,
+    /// A split would cut off a part of fewer than [`MIN_SPLIT_FACES`] faces.
+    TinyPart,
 }
 
 impl Refusal {
@@ -159,6 +170,7 @@ impl Refusal {
             Refusal::NotSimple => "not_simple",
             Refusal::NotManifold => "not_manifold",
             Refusal::WouldIntersect => "would_intersect",
+            Refusal::TinyPart => "tiny_part",
         }
     }
 }
@@ -347,6 +359,13 @@ fn split(
         Some(loops) if loops.len() == 2 && regions::euler_characteristic(mesh, &band) == 0 => loops,
         _ => return Err(Refusal::NotSimple),
     };
+    // A neck between a body and a crumb is no neck: both sides must be a body of their own.
+    if holes
+        .iter()
+        .any(|hole| regions::faces_beyond(mesh, &band, hole, MIN_SPLIT_FACES) < MIN_SPLIT_FACES)
+    {
+        return Err(Refusal::TinyPart);
+    }
     let layer = mesh.face_layers()[band[0] as usize];
     replace(mesh, grid, &band, settings, |mesh| {
         let mut faces = sew::cap(mesh, &holes[0], layer);

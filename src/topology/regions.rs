@@ -117,3 +117,38 @@ pub fn hole_loops(mesh: &Mesh, faces: &[u32]) -> Option<Vec<Vec<u32>>> {
     }
     Some(loops)
 }
+
+/// Faces reached from the rim of `hole` (a loop of [`hole_loops`] of `removed`) without
+/// crossing `removed`, counted up to `limit`.
+pub fn faces_beyond(mesh: &Mesh, removed: &[u32], hole: &[u32], limit: usize) -> usize {
+    let removed: HashSet<u32> = removed.iter().copied().collect();
+    let on_hole: HashSet<u32> = hole.iter().copied().collect();
+    // The remaining faces holding a rim edge of this hole.
+    let mut reached: Vec<u32> = removed
+        .iter()
+        .flat_map(|&f| (0..3).map(move |k| 3 * f + k))
+        .filter_map(|c| {
+            let o = mesh.adjacency().opposite[c as usize];
+            let rim = [mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c))];
+            (o != INVALID
+                && !removed.contains(&face_of(o))
+                && rim.iter().all(|v| on_hole.contains(v)))
+            .then(|| face_of(o))
+        })
+        .collect();
+    reached.sort_unstable();
+    reached.dedup();
+    let mut seen: HashSet<u32> = reached.iter().copied().collect();
+    let mut i = 0;
+    while i < reached.len() && reached.len() < limit {
+        let f = reached[i];
+        for k in 0..3 {
+            let o = mesh.adjacency().opposite[(3 * f + k) as usize];
+            if o != INVALID && !removed.contains(&face_of(o)) && seen.insert(face_of(o)) {
+                reached.push(face_of(o));
+            }
+        }
+        i += 1;
+    }
+    reached.len().min(limit)
+}
