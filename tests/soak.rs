@@ -116,6 +116,7 @@ fn soak(kind: SceneKind, seed: u64) {
         let file = StrokeFile {
             version: 1,
             strokes: vec![spec],
+            fuse: Vec::new(),
         };
         let as_json = serde_json::to_string(&file).unwrap_or_default();
         let strokes = match file.resolve(session.mesh(), "soak") {

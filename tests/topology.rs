@@ -2,6 +2,8 @@
 //! and the surface stays closed, manifold and free of intersections; collide layers never
 //! change genus.
 
+mod common;
+
 use glam::Vec3;
 use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
 use slayer::collide::find_intersections;
@@ -358,4 +360,101 @@ fn a_dumbbell_whose_neck_is_deflated_splits_into_two_closed_components() {
     assert_eq!(shapes.len(), 2, "after {strokes} strokes: {shapes:?}");
     assert!(shapes.iter().all(|s| s.genus == 0), "{shapes:?}");
     eprintln!("the neck split after {strokes} strokes: {shapes:?}");
+}
+
+/// A fuse flake grabbed into a collide plaster: the stroke stops it at the collision distance,
+/// and after the stroke nothing joins: layers never weld, whatever their policies.
+#[test]
+fn a_fuse_flake_pushed_into_a_collide_plaster_never_welds() {
+    let one = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.3, 0.0, 0.0)]);
+    let half = one.faces().len() / 2;
+    let layers: Vec<u32> = (0..one.faces().len()).map(|f| (f >= half) as u32).collect();
+    let mut mesh = Mesh::new(
+        one.positions().to_vec(),
+        one.faces().to_vec(),
+        layers,
+        vec!["flake".into(), "plaster".into()],
+    )
+    .expect("two layers");
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let push = line(Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), 12);
+    let report = stroke(
+        &mut pipeline,
+        &mut mesh,
+        (BrushKind::Grab, 0.3, 1.0),
+        &push,
+        true,
+    );
+    assert!(
+        report.clamped > 0,
+        "the flake must reach the plaster: {report:?}"
+    );
+    assert_eq!((report.topology.joins, report.topology.splits), (0, 0));
+    let shapes = closed_and_clean(&mesh);
+    assert_eq!(shapes.len(), 2, "{shapes:?}");
+    assert_eq!(
+        (shapes[0].layer, shapes[1].layer),
+        (0, 1),
+        "each layer keeps its own component"
+    );
+}
+
+/// `slayer sculpt` with the fuse policy from the stroke file (`"fuse": ["sphere"]`) or from
+/// `--policy`: the grab of docs/topology.md tunnels through the sphere, and `check --json`
+/// reports the genus; a layer that does not exist is one line naming the field.
+#[test]
+fn sculpt_fuses_the_layers_its_stroke_file_or_policy_names() {
+    use common::{arg, assert_one_line_error, scratch, slayer, text, write_scene};
+    let dir = scratch("fuse-cli");
+    let sphere = dir.join("sphere.ply");
+    write_scene("sphere", 20_000, &[], &sphere);
+    let grab = r#"{"brush": "grab", "radius": 0.15, "strength": 1.0, "layers": [0],
+        "samples": [{"position": [-0.2, 0.46, 0]}, {"position": [-0.2, -0.6, 0]}]}"#;
+    let genus = |file: &std::path::Path| -> i64 {
+        let out = slayer(&["check", arg(file), "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let shapes = report["component_shapes"]
+            .as_array()
+            .expect("shapes")
+            .clone();
+        assert_eq!(shapes.len(), 1, "{shapes:?}");
+        assert_eq!(shapes[0]["boundary_loops"], 0);
+        shapes[0]["genus"].as_i64().expect("genus")
+    };
+    let with_fuse = dir.join("with-fuse.json");
+    std::fs::write(
+        &with_fuse,
+        format!(r#"{{"version": 1, "fuse": ["sphere"], "strokes": [{grab}]}}"#),
+    )
+    .unwrap();
+    let plain = dir.join("plain.json");
+    std::fs::write(&plain, format!(r#"{{"version": 1, "strokes": [{grab}]}}"#)).unwrap();
+    let sculpt = |strokes: &std::path::Path, output: &std::path::Path, extra: &[&str]| {
+        let mut args = vec!["sculpt", "--input", arg(&sphere), "--strokes", arg(strokes)];
+        args.extend(["--output", arg(output)]);
+        args.extend_from_slice(extra);
+        slayer(&args)
+    };
+    for (strokes, extra, expected) in [
+        (&with_fuse, &[][..], 1),
+        (&plain, &["--policy", "sphere=fuse"][..], 1),
+        (&plain, &[][..], 0),
+    ] {
+        let output = dir.join("out.ply");
+        let out = sculpt(strokes, &output, extra);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_eq!(genus(&output), expected, "{strokes:?} {extra:?}");
+    }
+    let wrong = dir.join("wrong.json");
+    std::fs::write(
+        &wrong,
+        format!(r#"{{"version": 1, "fuse": ["blob"], "strokes": [{grab}]}}"#),
+    )
+    .unwrap();
+    assert_one_line_error(
+        &sculpt(&wrong, &dir.join("x.ply"), &[]),
+        &["fuse[0]", "blob"],
+    );
+    let out = sculpt(&plain, &dir.join("x.ply"), &["--policy", "sphere=melt"]);
+    assert_one_line_error(&out, &["--policy sphere=melt", "collide or fuse"]);
 }

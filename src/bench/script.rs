@@ -111,6 +111,7 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
         return StrokeFile {
             version: 1,
             strokes: Vec::new(),
+            fuse: Vec::new(),
         };
     };
     if spec.mix == BrushMix::StraightDraw {
@@ -184,6 +185,7 @@ pub fn generate_script(mesh: &Mesh, spec: &ScriptSpec) -> StrokeFile {
     StrokeFile {
         version: 1,
         strokes,
+        fuse: Vec::new(),
     }
 }
 
@@ -230,6 +232,7 @@ fn straight_draws(mesh: &Mesh, surface: &Surface<'_>, count: usize) -> StrokeFil
     StrokeFile {
         version: 1,
         strokes,
+        fuse: Vec::new(),
     }
 }
 

@@ -21,7 +21,7 @@ pub const MAX_SAMPLES_PER_FILE: usize = 10_000_000;
 /// A mistake: where (`strokes[0].radius`, empty for the whole file) and what.
 pub(super) type Mistake = (String, String);
 
-const FILE_FIELDS: &[&str] = &["version", "strokes"];
+const FILE_FIELDS: &[&str] = &["version", "strokes", "fuse"];
 const STROKE_FIELDS: &[&str] = &[
     "brush", "radius", "strength", "falloff", "invert", "layers", "paint", "spacing", "symmetry",
     "samples",
@@ -209,7 +209,15 @@ pub(super) fn file(value: &Value) -> Result<StrokeFile, Mistake> {
         }
         strokes.push(stroke);
     }
-    Ok(StrokeFile { version, strokes })
+    let fuse = match object.get("fuse") {
+        None => Vec::new(),
+        Some(value) => layers(value, "fuse")?,
+    };
+    Ok(StrokeFile {
+        version,
+        strokes,
+        fuse,
+    })
 }
 
 fn stroke(value: &Value, at: &str) -> Result<StrokeSpec, Mistake> {

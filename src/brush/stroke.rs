@@ -184,6 +184,10 @@ pub struct StrokeFile {
     #[serde(default = "version_one")]
     pub version: u32,
     pub strokes: Vec<StrokeSpec>,
+    /// Layers whose policy is fuse (`topology::ProximityPolicy`) while the file is applied, by
+    /// index or name; the others keep theirs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fuse: Vec<LayerRef>,
 }
 
 /// A stroke sample, checked.
@@ -297,6 +301,20 @@ impl StrokeFile {
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
 
+    /// The layers the file's `fuse` names, checked against `mesh`.
+    pub fn fuse_layers(&self, mesh: &Mesh, source_name: &str) -> Result<Vec<LayerId>, StrokeError> {
+        if self.fuse.is_empty() {
+            return Ok(Vec::new());
+        }
+        resolve_layers(&self.fuse, mesh, "fuse").map_err(|(location, message)| {
+            StrokeError::Invalid {
+                source_name: source_name.to_string(),
+                location,
+                message,
+            }
+        })
+    }
+
     /// Checks every stroke against `mesh` and resolves layer names.
     pub fn resolve(&self, mesh: &Mesh, source_name: &str) -> Result<Vec<Stroke>, StrokeError> {
         let extent = mesh.extent().unwrap_or(0.0).max(f32::MIN_POSITIVE);
@@ -377,7 +395,7 @@ fn resolve_stroke(
         );
     }
     let samples = resolve_samples(&spec.samples)?;
-    let layers = resolve_layers(&spec.layers, mesh)?;
+    let layers = resolve_layers(&spec.layers, mesh, ".layers")?;
     let paint = resolve_stroke_paint(spec)?;
     Ok(Stroke {
         paint,
@@ -400,11 +418,11 @@ fn resolve_stroke(
     })
 }
 
-/// The active layers, by index or name, sorted and without repeats.
-fn resolve_layers(refs: &[LayerRef], mesh: &Mesh) -> Result<Vec<LayerId>, FieldError> {
+/// Layers by index or name (`field`, for messages), sorted and without repeats.
+fn resolve_layers(refs: &[LayerRef], mesh: &Mesh, field: &str) -> Result<Vec<LayerId>, FieldError> {
     if refs.is_empty() {
         let message = "a stroke needs at least one active layer";
-        return Err((".layers".into(), message.into()));
+        return Err((field.into(), message.into()));
     }
     let mut layers = Vec::new();
     for (k, layer) in refs.iter().enumerate() {
@@ -427,7 +445,7 @@ fn resolve_layers(refs: &[LayerRef], mesh: &Mesh) -> Result<Vec<LayerId>, FieldE
                     )
                 }),
         };
-        layers.push(id.map_err(|message| (format!(".layers[{k}]"), message))?);
+        layers.push(id.map_err(|message| (format!("{field}[{k}]"), message))?);
     }
     layers.sort_unstable();
     layers.dedup();

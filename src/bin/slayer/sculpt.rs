@@ -97,6 +97,13 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         }
     }
     set_policies(&mut session, args.policies)?;
+    for layer in file.fuse_layers(session.mesh(), &name)? {
+        let settings = LayerSettings {
+            policy: ProximityPolicy::Fuse,
+            ..session.layers()[layer as usize]
+        };
+        session.set_layer(layer, settings)?;
+    }
     let strokes = file.resolve(session.mesh(), &name)?;
     let load_peak = slayer::memory::peak_bytes();
     slayer::memory::reset_peak();
