@@ -615,46 +615,32 @@ fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
 #[test]
 fn a_topology_change_after_a_stroke_patches_the_gpu_copy() {
     use glam::Vec3;
-    use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
+    use slayer::brush::{BrushKind, StrokeSettings};
     let sphere = slayer::scene::geodesic_sphere(8, 1.0).unwrap();
-    let settings = |kind: BrushKind, radius: f32| StrokeSettings {
-        brush: Brush {
-            kind,
-            radius,
-            strength: 1.0,
-            falloff: Falloff::default(),
-            invert: false,
-        },
-        paint: None,
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
-        fuse: vec![0],
+    let fused = |kind: BrushKind, radius: f32, points: [Vec3; 2]| {
+        let stroke = common::one_brush_stroke(kind, radius, &points);
+        let settings = StrokeSettings {
+            fuse: vec![0],
+            ..stroke.settings()
+        };
+        (settings, stroke.samples)
     };
-    let at = |points: &[[f32; 3]]| -> Vec<Sample> {
-        points
-            .iter()
-            .map(|&p| Sample {
-                position: Vec3::from(p),
-                pressure: 1.0,
-                normal: None,
-            })
-            .collect()
-    };
-    let push = at(&[[0.0, 1.0, 0.0], [0.0, -1.3, 0.0]]);
-    let draw = at(&[[1.0, 0.0, 0.0], [0.9, 0.3, 0.0]]);
+    let push = fused(BrushKind::Grab, 0.5, [Vec3::Y, Vec3::new(0.0, -1.3, 0.0)]);
+    let draw = fused(BrushKind::Draw, 0.3, [Vec3::X, Vec3::new(0.9, 0.3, 0.0)]);
     let sculpt = |pipeline: &mut Pipeline, mesh: &mut Mesh| {
+        let (settings, samples) = push.clone();
         let first = pipeline
-            .begin_stroke(mesh, settings(BrushKind::Grab, 0.5))
+            .begin_stroke(mesh, settings)
             .unwrap()
-            .finish_with(&push)
+            .finish_with(&samples)
             .unwrap();
         assert_eq!(first.topology.joins, 1, "{:?}", first.topology);
         pipeline.check_kernel_copy(mesh).unwrap();
+        let (settings, samples) = draw.clone();
         pipeline
-            .begin_stroke(mesh, settings(BrushKind::Draw, 0.3))
+            .begin_stroke(mesh, settings)
             .unwrap()
-            .finish_with(&draw)
+            .finish_with(&samples)
             .unwrap();
         pipeline.check_kernel_copy(mesh).unwrap();
     };

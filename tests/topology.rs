@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use slayer::brush::{Brush, BrushKind, Falloff, Sample, StrokeSettings};
+use slayer::brush::{BrushKind, StrokeSettings};
 use slayer::collide::find_intersections;
 use slayer::grid::SpatialHash;
 use slayer::mesh::{ComponentShape, Mesh};
@@ -81,33 +81,16 @@ fn stroke(
     points: &[Vec3],
     fuse: bool,
 ) -> StrokeReport {
-    let brush = Brush {
-        kind,
-        radius,
-        strength,
-        falloff: Falloff::default(),
-        invert: false,
-    };
+    let mut spec = common::one_brush_stroke(kind, radius, points);
+    spec.brush.strength = strength;
     let settings = StrokeSettings {
-        brush,
-        paint: None,
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
         fuse: if fuse { vec![0] } else { Vec::new() },
+        ..spec.settings()
     };
-    let samples: Vec<Sample> = points
-        .iter()
-        .map(|&position| Sample {
-            position,
-            pressure: 1.0,
-            normal: None,
-        })
-        .collect();
     pipeline
         .begin_stroke(mesh, settings)
         .expect("stroke begins")
-        .finish_with(&samples)
+        .finish_with(&spec.samples)
         .expect("stroke runs")
 }
 
