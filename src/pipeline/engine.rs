@@ -331,14 +331,18 @@ pub(super) fn remesh_touched(
     (report, changed)
 }
 
-/// After a stroke with fuse layers: joins and splits them where they touch themselves near
-/// `seeds` (`crate::topology`), keeping `grid` exact and telling `kernels` what changed.
+/// After a stroke: joins and splits its fuse layers where they touch themselves near `seeds`
+/// (`crate::topology`), keeping `grid` exact and telling `kernels` what changed. Nothing
+/// without fuse layers.
 pub(super) fn fuse_touched(
     mesh: &mut Mesh,
     (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
     (fuse_layers, seeds): (&[u32], &[u32]),
     (edge, distance): (f32, f32),
 ) -> TopologyReport {
+    if fuse_layers.is_empty() {
+        return TopologyReport::default();
+    }
     let mut fuse = vec![false; mesh.layer_count()];
     for &l in fuse_layers {
         fuse[l as usize] = true;

@@ -194,7 +194,19 @@ impl<'a> StrokeInProgress<'a> {
         kernels.given(self.mesh, active.samples_run, &[]);
         let mut remeshed =
             active.remesh_after_stroke(kernels, self.mesh, self.pipeline.settings.remeshing);
-        remeshed.extend(active.fuse_after_stroke(kernels, self.mesh, &remeshed));
+        let seeds: Vec<u32> = (active.touched_list.iter().chain(&active.remeshed))
+            .chain(&remeshed)
+            .copied()
+            .collect();
+        let lengths = (active.lengths.edge, active.lengths.collision_distance);
+        let grid = &mut active.prepared.grid;
+        active.report.topology = fuse_touched(
+            self.mesh,
+            (grid, kernels),
+            (&active.stroke.fuse, &seeds),
+            lengths,
+        );
+        remeshed.extend_from_slice(&active.report.topology.changed);
         active.tighten_edge_bound(self.mesh, &remeshed);
         let mut report = std::mem::take(&mut active.report);
         report.changed = last_call.changed;
@@ -706,35 +718,6 @@ impl Active {
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.report.remesh.add(&pass);
         self.report.phases.remesh += millis(started);
-        changed
-    }
-}
-
-impl Active {
-    /// Joins and splits the stroke's fuse layers where it left them touching themselves;
-    /// returns the vertices that changed.
-    fn fuse_after_stroke(
-        &mut self,
-        kernels: &mut dyn StepKernels,
-        mesh: &mut Mesh,
-        remeshed_at_end: &[u32],
-    ) -> Vec<u32> {
-        if self.stroke.fuse.is_empty() {
-            return Vec::new();
-        }
-        let seeds: Vec<u32> = (self.touched_list.iter())
-            .chain(&self.remeshed)
-            .chain(remeshed_at_end)
-            .copied()
-            .collect();
-        let report = fuse_touched(
-            mesh,
-            (&mut self.prepared.grid, kernels),
-            (&self.stroke.fuse, &seeds),
-            (self.lengths.edge, self.lengths.collision_distance),
-        );
-        let changed = report.changed.clone();
-        self.report.topology.add(&report);
         changed
     }
 }
