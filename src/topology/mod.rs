@@ -15,12 +15,14 @@
 //!   (it must be an annulus) and both holes capped. One component becomes two, or a handle is
 //!   cut (genus − 1).
 //!
-//! Each change is remeshed to edge length `L` and then checked: no new boundary, every vertex
-//! around it one closed fan, and no new intersecting pair near it (exact test). A change that
-//! fails is undone, bit for bit, and the contact stays a collision: the stroke already clamped
-//! it at the collision distance. Layers never join each other.
+//! Each change is remeshed to edge length `L` and then checked: every new edge has a face on
+//! both sides, and no pair of faces near it intersects that did not before (exact tests: the
+//! raw new faces first, the remeshed region after). A change that fails is undone, bit for
+//! bit, and the contact stays a collision: the stroke already clamped it at the collision
+//! distance. Layers never join each other.
 //!
-//! Floors: `contacts`, `regions` ← `sew` ← this; below the pipeline, above `collide`, `remesh`.
+//! Floors: `contacts`, `regions`, `checks` ← `sew` ← this; below the pipeline, above `collide`
+//! and `remesh`.
 
 mod checks;
 mod contacts;
@@ -97,7 +99,8 @@ pub struct FuseSettings {
     pub collision_distance: f32,
     /// `d_thickness`: parts of one fuse layer closer than this join or split.
     pub join_distance: f32,
-    /// The neighbourhood ring a vertex skips when looking for contacts (for `join_distance`).
+    /// The neighbourhood ring a vertex skips when looking for contacts (one: see
+    /// `CONTACT_RING`).
     pub exclusion_ring: u32,
     /// The ring the remesher skips (for `collision_distance`).
     pub collision_ring: u32,
