@@ -26,6 +26,22 @@ fn spheres(frequency: u32, radius: f32, centres: &[Vec3]) -> Mesh {
     Mesh::new(positions, faces, layers, vec!["blob".into()]).expect("spheres")
 }
 
+/// Two spheres of radius 0.5 whose centres are `apart` along x, the first on layer "flake",
+/// the second on layer "plaster".
+fn flake_and_plaster(apart: f32) -> Mesh {
+    let one = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(apart, 0.0, 0.0)]);
+    let half = one.faces().len() / 2;
+    let layers: Vec<u32> = (0..one.faces().len()).map(|f| (f >= half) as u32).collect();
+    let names = vec!["flake".into(), "plaster".into()];
+    Mesh::new(
+        one.positions().to_vec(),
+        one.faces().to_vec(),
+        layers,
+        names,
+    )
+    .expect("two layers")
+}
+
 /// Runs the fuse pass over every vertex of a one-layer mesh.
 fn fuse_everywhere(mesh: &mut Mesh) -> TopologyReport {
     let edge = mesh.mean_edge_length();
@@ -191,17 +207,7 @@ fn a_neck_pinched_below_the_join_distance_splits_into_two_closed_components() {
 fn two_fuse_layers_touching_never_weld() {
     let probe = spheres(8, 0.5, &[Vec3::ZERO]);
     let gap = 1.05 * probe.mean_edge_length();
-    let one = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.0 + gap, 0.0, 0.0)]);
-    // The same two spheres, the second on a layer of its own.
-    let half = one.faces().len() / 2;
-    let layers: Vec<u32> = (0..one.faces().len()).map(|f| (f >= half) as u32).collect();
-    let mut mesh = Mesh::new(
-        one.positions().to_vec(),
-        one.faces().to_vec(),
-        layers,
-        vec!["flake".into(), "plaster".into()],
-    )
-    .expect("two layers");
+    let mut mesh = flake_and_plaster(1.0 + gap);
     let edge = mesh.mean_edge_length();
     let settings = FuseSettings::new(&mesh, edge, edge);
     let mut grid = SpatialHash::build(&mesh, edge).expect("grid");
@@ -349,16 +355,7 @@ fn a_dumbbell_whose_neck_is_deflated_splits_into_two_closed_components() {
 /// and after the stroke nothing joins: layers never weld, whatever their policies.
 #[test]
 fn a_fuse_flake_pushed_into_a_collide_plaster_never_welds() {
-    let one = spheres(8, 0.5, &[Vec3::ZERO, Vec3::new(1.3, 0.0, 0.0)]);
-    let half = one.faces().len() / 2;
-    let layers: Vec<u32> = (0..one.faces().len()).map(|f| (f >= half) as u32).collect();
-    let mut mesh = Mesh::new(
-        one.positions().to_vec(),
-        one.faces().to_vec(),
-        layers,
-        vec!["flake".into(), "plaster".into()],
-    )
-    .expect("two layers");
+    let mut mesh = flake_and_plaster(1.3);
     let mut pipeline = Pipeline::new(PipelineSettings::default());
     let push = line(Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), 12);
     let report = stroke(

@@ -338,7 +338,7 @@ pub(super) fn fuse_touched(
     mesh: &mut Mesh,
     (grid, kernels): (&mut SpatialHash, &mut dyn StepKernels),
     (fuse_layers, seeds): (&[u32], &[u32]),
-    (edge, distance): (f32, f32),
+    (edge, distance, ring): (f32, f32, u32),
 ) -> TopologyReport {
     if fuse_layers.is_empty() {
         return TopologyReport::default();
@@ -347,7 +347,7 @@ pub(super) fn fuse_touched(
     for &l in fuse_layers {
         fuse[l as usize] = true;
     }
-    let settings = FuseSettings::new(mesh, edge, distance);
+    let settings = FuseSettings::with_ring(edge, distance, ring);
     let since = mesh.version();
     let report = adapt(mesh, grid, &fuse, seeds, &settings);
     if !report.changed.is_empty() {

@@ -109,14 +109,19 @@ pub struct FuseSettings {
 impl FuseSettings {
     /// Settings for `mesh` at edge length `edge` and collision distance `collision_distance`.
     pub fn new(mesh: &Mesh, edge: f32, collision_distance: f32) -> Self {
-        use crate::collide::neighbourhood::exclusion_ring;
-        let join_distance = (JOIN_OVER_EDGE * edge).max(JOIN_OVER_COLLISION * collision_distance);
+        let ring = crate::collide::neighbourhood::exclusion_ring(mesh, collision_distance);
+        FuseSettings::with_ring(edge, collision_distance, ring)
+    }
+
+    /// [`FuseSettings::new`] with the collision ring already known (the pipeline's, which its
+    /// own remeshing uses).
+    pub fn with_ring(edge: f32, collision_distance: f32, collision_ring: u32) -> Self {
         FuseSettings {
             edge,
             collision_distance,
-            join_distance,
+            join_distance: (JOIN_OVER_EDGE * edge).max(JOIN_OVER_COLLISION * collision_distance),
             exclusion_ring: CONTACT_RING,
-            collision_ring: exclusion_ring(mesh, collision_distance),
+            collision_ring,
         }
     }
 }

@@ -1,0 +1,186 @@
+//! Remeshing during and after a stroke (as `PipelineSettings::remeshing` says, and a grab's
+//! between its samples where it stretched the surface), the fuse layers' topology pass after
+//! it, and the running bound on edge lengths both leave behind.
+
+use std::time::Instant;
+
+use super::{Active, SamplesReport};
+use crate::brush::BrushKind;
+use crate::mesh::Mesh;
+use crate::pipeline::Remeshing;
+use crate::pipeline::engine::{
+    fuse_touched, longest_edge, longest_edge_at, millis, remesh_touched,
+};
+use crate::pipeline::kernels::StepKernels;
+
+impl Active {
+    /// [`Remeshing::AfterSample`]: remeshes around `moved`, what the last sample moved (a
+    /// grab keeps moving what it caught, so its region is remeshed once, after the stroke).
+    pub(super) fn remesh_after_sample(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        moved: &[u32],
+        call: &mut SamplesReport,
+    ) {
+        let started = Instant::now();
+        let lengths = (
+            self.lengths.edge,
+            self.lengths.collision_distance,
+            self.prepared.ring,
+        );
+        let (pass, changed) = remesh_touched(
+            mesh,
+            (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
+            moved,
+            lengths,
+        );
+        self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.report.remesh.add(&pass);
+        self.remeshed.extend_from_slice(&changed);
+        self.scratch.size_for(mesh);
+        call.changed.extend_from_slice(&changed);
+        call.topology_changed |= pass.splits + pass.collapses + pass.flips > 0;
+        call.phases.remesh += millis(started);
+    }
+
+    /// A grab stretches the surface between what it caught and what it left behind. Remeshed
+    /// only at the stroke's end, a long drag leaves edges many times `L` whose splitting
+    /// compounds (slivers split into slivers: a drag of 10 units over a 2K-face sphere spent
+    /// 4.9 s on 15K splits and 12K collapses). Remeshing around the moved vertices whenever
+    /// their faces hold an edge over [`GRAB_STRETCH`]·`L` keeps each remesh local and the
+    /// drag's cost linear in its length. Remeshing between samples adds vertices the grab did
+    /// not catch: [`regrab`] decides which join it.
+    pub(super) fn remesh_stretched_grab(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        moved: &[u32],
+        call: &mut SamplesReport,
+    ) {
+        let mut faces: Vec<u32> = moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
+        faces.sort_unstable();
+        faces.dedup();
+        if longest_edge(mesh, Some(&faces)) <= GRAB_STRETCH * self.lengths.edge {
+            return;
+        }
+        let first_new = mesh.vertex_count() as u32;
+        self.remesh_after_sample(kernels, mesh, moved, call);
+        for captured in [&mut self.captured, &mut self.captured_image]
+            .into_iter()
+            .flatten()
+        {
+            regrab(mesh, captured, first_new);
+        }
+    }
+
+    /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved, and
+    /// returns the vertices remeshing changed.
+    pub(super) fn remesh_after_stroke(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        remeshing: Remeshing,
+    ) -> Vec<u32> {
+        self.touched_list.sort_unstable();
+        self.report.touched = self.touched_list.len();
+        let remesh_now = match remeshing {
+            Remeshing::Off => false,
+            Remeshing::AfterStroke => true,
+            Remeshing::AfterSample => self.stroke.brush.kind == BrushKind::Grab,
+        };
+        if !remesh_now {
+            return Vec::new();
+        }
+        let started = Instant::now();
+        let lengths = (
+            self.lengths.edge,
+            self.lengths.collision_distance,
+            self.prepared.ring,
+        );
+        let seeds = &self.touched_list;
+        let (pass, changed) = remesh_touched(
+            mesh,
+            (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
+            seeds,
+            lengths,
+        );
+        self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.report.remesh.add(&pass);
+        self.report.phases.remesh += millis(started);
+        changed
+    }
+
+    /// Joins and splits the stroke's fuse layers where it left them touching themselves
+    /// (`crate::topology`), over what it moved and what remeshing changed; adds the vertices
+    /// that changed to `remeshed`.
+    pub(super) fn fuse_after_stroke(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        remeshed: &mut Vec<u32>,
+    ) {
+        let seeds: Vec<u32> = (self.touched_list.iter().chain(&self.remeshed))
+            .chain(remeshed.iter())
+            .copied()
+            .collect();
+        let lengths = (
+            self.lengths.edge,
+            self.lengths.collision_distance,
+            self.prepared.ring,
+        );
+        let grid = &mut self.prepared.grid;
+        self.report.topology =
+            fuse_touched(mesh, (grid, kernels), (&self.stroke.fuse, &seeds), lengths);
+        remeshed.extend_from_slice(&self.report.topology.changed);
+    }
+
+    /// The running edge bound only grows during a stroke (a grab stretches edges that its
+    /// remeshing then splits). At the end, every edge the stroke changed has an end it moved
+    /// or remeshing changed, and every other edge is as it was, within the bound the stroke
+    /// began with: the bound becomes the larger of that and the longest changed edge. Without
+    /// this, a grab's passing stretch would stay in the bound until a rescan of the whole mesh.
+    pub(super) fn tighten_edge_bound(&mut self, mesh: &Mesh, remeshed_at_end: &[u32]) {
+        let changed: Vec<u32> = (self.touched_list.iter())
+            .chain(&self.remeshed)
+            .chain(remeshed_at_end)
+            .copied()
+            .filter(|&v| mesh.is_vertex_live(v))
+            .collect();
+        let longest = longest_edge_at(mesh, &changed);
+        self.prepared.max_edge = self.edge_bound_at_start.max(longest);
+    }
+}
+
+/// A grab is remeshed during its stroke once an edge around what it moved is longer than
+/// this many `L` (the remesher splits above 4/3·`L`, so each remesh halves such edges about
+/// once: the work stays local).
+const GRAB_STRETCH: f32 = 2.0;
+
+/// The grab's caught vertices after remeshing between its samples: those remeshing removed
+/// leave; each vertex it added (numbered from `first_new` on) joins with the smallest weight
+/// among its caught neighbours, and only when all its earlier neighbours were caught — so a
+/// vertex split between the grab and the surface it left stays with the surface (the drag
+/// extrudes instead of stretching every edge again), and none moves ahead of its
+/// neighbours. Deterministic: the new vertices are taken in index order.
+fn regrab(mesh: &Mesh, captured: &mut Vec<(u32, f32)>, first_new: u32) {
+    use std::collections::HashMap;
+    captured.retain(|&(v, _)| !mesh.is_vertex_dead(v));
+    let mut weight_of: HashMap<u32, f32> = captured.iter().copied().collect();
+    for v in first_new..mesh.vertex_count() as u32 {
+        if mesh.is_vertex_dead(v) {
+            continue;
+        }
+        // Neighbours added after `v` have no weight yet and do not vote.
+        let weight = mesh
+            .neighbours(v)
+            .into_iter()
+            .filter(|&n| n < v)
+            .map(|n| weight_of.get(&n).copied().unwrap_or(0.0))
+            .fold(f32::INFINITY, f32::min);
+        if weight.is_finite() && weight > 0.0 {
+            weight_of.insert(v, weight);
+            captured.push((v, weight));
+        }
+    }
+}
