@@ -63,7 +63,7 @@ fn phases(c: &mut Criterion) {
             kind: BrushKind::Draw,
             radius: 12.0 * edge,
             strength: 1.0,
-            falloff: Falloff::Blend { n: 3 },
+            falloff: Falloff::blend(3),
             invert: true,
         },
         frame: DabFrame {
@@ -125,7 +125,7 @@ fn collision_alone(c: &mut Criterion, kind: SceneKind, triangles: usize, brush: 
             kind: brush,
             radius: 0.05 * (hi - lo).x,
             strength: 0.5,
-            falloff: Falloff::Blend { n: 3 },
+            falloff: Falloff::blend(3),
             // Pressing into what lies below.
             invert: brush == BrushKind::Draw,
         },

@@ -10,8 +10,9 @@ use slayer::scene::shapes;
 #[test]
 fn falloff_curves_are_one_at_the_centre_zero_at_the_rim_and_decreasing() {
     for falloff in [
-        Falloff::Blend { n: 3 },
-        Falloff::Blend { n: 6 },
+        Falloff::blend(3),
+        Falloff::blend(6),
+        Falloff::Blend { n: 4, inner: 0.5 },
         Falloff::Smooth,
         Falloff::Sphere,
         Falloff::Linear,
@@ -31,10 +32,18 @@ fn falloff_curves_are_one_at_the_centre_zero_at_the_rim_and_decreasing() {
         }
     }
     // Freestyle's blend has zero slope at both ends.
-    let b = Falloff::Blend { n: 3 };
+    let b = Falloff::blend(3);
     let h = 1e-3;
     assert!((b.weight(h) - b.weight(0.0)).abs() / h < 1e-2);
     assert!((b.weight(1.0 - h) - b.weight(1.0)).abs() / h < 1e-2);
+    // With a plateau (Freestyle's R_i), full strength up to it and the same curve over the
+    // rest, still smooth where they meet.
+    let core = Falloff::Blend { n: 3, inner: 0.4 };
+    for k in 0..=40 {
+        assert_eq!(core.weight(k as f32 / 100.0), 1.0);
+    }
+    assert!((core.weight(0.4 + h) - 1.0).abs() / h < 1e-2);
+    assert!((core.weight(0.7) - b.weight(0.5)).abs() < 1e-6);
 }
 
 #[test]
@@ -235,6 +244,7 @@ fn documented_move(
         BrushKind::Inflate => n * (0.1 * r * amount),
         BrushKind::Smooth => (ring - p) * amount.min(1.0),
         BrushKind::Flatten => -Vec3::Z * ((p.z - plane.z) * amount.min(1.0)),
+        BrushKind::Trim => -Vec3::Z * ((p.z - plane.z).max(0.0) * amount.min(1.0)),
         BrushKind::Pinch => towards_axis * (0.25 * amount),
         BrushKind::Crease => -Vec3::Z * (0.1 * r * amount) + towards_axis * (0.25 * amount),
         BrushKind::Twist => {
@@ -254,6 +264,7 @@ fn one_dab_moves_each_vertex_by_the_documented_amount() {
         BrushKind::Inflate,
         BrushKind::Smooth,
         BrushKind::Flatten,
+        BrushKind::Trim,
         BrushKind::Pinch,
         BrushKind::Crease,
         BrushKind::Twist,
@@ -262,7 +273,7 @@ fn one_dab_moves_each_vertex_by_the_documented_amount() {
         for r in [3.0f32, 5.0, 8.0] {
             let start = if matches!(
                 kind,
-                BrushKind::Smooth | BrushKind::Flatten | BrushKind::Inflate
+                BrushKind::Smooth | BrushKind::Flatten | BrushKind::Trim | BrushKind::Inflate
             ) {
                 bumpy()
             } else {
@@ -274,7 +285,7 @@ fn one_dab_moves_each_vertex_by_the_documented_amount() {
             apply(&mut mesh, &s);
             let strength = s.brush.strength;
             let weight = |p: Vec3| Falloff::Smooth.weight(p.distance(CENTER) / r);
-            // Flatten's plane: through the weighted centroid of the vertices under the brush.
+            // Flatten's and trim's plane: through the weighted centroid of the vertices under the brush.
             let (sum, total) =
                 start
                     .positions()
@@ -335,9 +346,16 @@ fn stroke_files_resolve_names_and_defaults() {
     assert_eq!(s.brush.kind, BrushKind::Grab);
     assert_eq!(s.layers, vec![0, 1]);
     assert_eq!(s.spacing, 0.25);
-    assert_eq!(s.brush.falloff, Falloff::Blend { n: 3 });
+    assert_eq!(s.brush.falloff, Falloff::blend(3));
     assert_eq!(s.samples[0].pressure, 1.0);
     assert_eq!(s.samples[1].normal, Some(Vec3::Z));
+    let swept = parse(&one(
+        r#""brush": "sweep-volume", "radius": 1.5, "strength": 0.5, "layers": [0],
+        "falloff": {"curve": "blend", "n": 4, "inner": 0.5}, "samples": [{"position": [1, 1, 2]}]"#,
+    ))
+    .unwrap();
+    assert_eq!(swept[0].brush.kind, BrushKind::SweepVolume);
+    assert_eq!(swept[0].brush.falloff, Falloff::Blend { n: 4, inner: 0.5 });
 }
 
 #[test]
@@ -419,6 +437,18 @@ fn bad_stroke_files_name_the_problem_and_where() {
                 r#""brush": "draw", "radius": 1, "strength": 0.5, "layers": [0], "falloff": {{"curve": "blend", "n": 2}}, {ok_sample}"#
             )),
             "the blend needs n > 2",
+        ),
+        (
+            one(&format!(
+                r#""brush": "sweep", "radius": 1, "strength": 0.5, "layers": [0], "falloff": {{"curve": "blend", "inner": 1.5}}, {ok_sample}"#
+            )),
+            "strokes[0].falloff.inner: 1.5 is outside [0, 0.95]",
+        ),
+        (
+            one(&format!(
+                r#""brush": "sweep", "radius": 1, "strength": 0.5, "layers": [0], "falloff": {{"curve": "smooth", "inner": 0.5}}, {ok_sample}"#
+            )),
+            "only the blend curve takes an `inner`",
         ),
         (
             one(&format!(

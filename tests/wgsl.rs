@@ -357,7 +357,11 @@ fn select_structs_match_naga_layout() {
             capacity,
             layer_count,
             drift,
-            skip_marked
+            skip_marked,
+            blend_inner,
+            _pad0,
+            _pad1,
+            _pad2
         }
     );
     assert_layout!("select", SelectedVertex { vertex, weight });
@@ -442,7 +446,7 @@ fn wgsl_constants_match_the_host() {
         assert_eq!(naga_u32_constant("cell_counts", name), host, "{name}");
     }
     for (name, falloff) in [
-        ("FALLOFF_BLEND", Falloff::Blend { n: 3 }),
+        ("FALLOFF_BLEND", Falloff::blend(3)),
         ("FALLOFF_SMOOTH", Falloff::Smooth),
         ("FALLOFF_SPHERE", Falloff::Sphere),
         ("FALLOFF_LINEAR", Falloff::Linear),
@@ -463,7 +467,7 @@ fn wgsl_constants_match_the_host() {
         assert_eq!(naga_u32_constant("deform", name), flag, "{name}");
     }
     for kind in BrushKind::ALL {
-        let name = format!("BRUSH_{}", kind.name().to_uppercase());
+        let name = format!("BRUSH_{}", kind.name().to_uppercase().replace('-', "_"));
         assert_eq!(
             naga_u32_constant("deform", &name),
             brush_code(kind),

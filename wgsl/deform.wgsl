@@ -20,10 +20,10 @@ struct DeformParams {
     // Unit brush normal.
     normal: vec3<f32>,
     strength: f32,
-    // Flatten's plane point.
+    // Flatten's and trim's plane point.
     plane_point: vec3<f32>,
     pressure: f32,
-    // Grab's motion of the brush centre.
+    // Grab's and the sweeps' motion of the brush centre.
     motion: vec3<f32>,
     // Share of the sample this step carries (1 / steps).
     share: f32,
@@ -149,7 +149,7 @@ fn displacement(v: u32, p: vec3<f32>, weight: f32) -> vec3<f32> {
             let n = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
             return n * lift;
         }
-        case BRUSH_GRAB: {
+        case BRUSH_GRAB, BRUSH_SWEEP, BRUSH_SWEEP_VOLUME: {
             return dab.motion * (weight * dab.share);
         }
         case BRUSH_SMOOTH: {
@@ -162,6 +162,15 @@ fn displacement(v: u32, p: vec3<f32>, weight: f32) -> vec3<f32> {
                 pull = -height;
             }
             return dab.normal * (pull * min(amount, 1.0));
+        }
+        case BRUSH_TRIM: {
+            // Only what stands above the plane (inverted: lies below it) moves to it.
+            let height = dot(p - dab.plane_point, dab.normal);
+            var standing = max(height, 0.0);
+            if sign < 0.0 {
+                standing = min(height, 0.0);
+            }
+            return dab.normal * (-standing * min(amount, 1.0));
         }
         case BRUSH_PINCH: {
             return pinch(p) * (sign * amount);

@@ -43,6 +43,11 @@ struct SelectParams {
     // Nonzero: leave out vertices with a nonzero `marks` entry (filed in another table, the
     // overlay of vertices remeshing changed; their entries in this one are stale).
     skip_marked: u32,
+    // The blend's plateau, a share of the radius held at full strength.
+    blend_inner: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 const WORKGROUP_SIZE: u32 = 64u;
@@ -79,7 +84,7 @@ fn consider(v: u32) {
     if distance_squared > params.radius * params.radius {
         return;
     }
-    var weight = falloff_weight(params.falloff, params.blend_n, sqrt(distance_squared) / params.radius);
+    var weight = falloff_weight(params.falloff, params.blend_n, params.blend_inner, sqrt(distance_squared) / params.radius);
     // A partial mask (bits 8..15, 1 to 254 of 255) moves the vertex that much less; an exact
     // product of exact factors, as the mirror computes it.
     let mask_level = (flags[v] >> 8u) & 255u;

@@ -15,13 +15,14 @@ pub struct BrushSphere {
     pub falloff: Falloff,
 }
 
-/// `(FALLOFF_* code, blend exponent)` of a falloff, as `wgsl/shared/brush.wgsl` reads them.
-pub fn falloff_code(falloff: Falloff) -> (u32, u32) {
+/// `(FALLOFF_* code, blend exponent, blend plateau)` of a falloff, as
+/// `wgsl/shared/brush.wgsl` reads them.
+pub fn falloff_code(falloff: Falloff) -> (u32, u32, f32) {
     match falloff {
-        Falloff::Blend { n } => (0, n),
-        Falloff::Smooth => (1, 0),
-        Falloff::Sphere => (2, 0),
-        Falloff::Linear => (3, 0),
+        Falloff::Blend { n, inner } => (0, n, inner),
+        Falloff::Smooth => (1, 0, 0.0),
+        Falloff::Sphere => (2, 0, 0.0),
+        Falloff::Linear => (3, 0, 0.0),
     }
 }
 
@@ -39,6 +40,9 @@ pub fn brush_code(kind: BrushKind) -> u32 {
         BrushKind::Twist => 8,
         BrushKind::Paint => 9,
         BrushKind::Mask => 10,
+        BrushKind::Sweep => 11,
+        BrushKind::SweepVolume => 12,
+        BrushKind::Trim => 13,
     }
 }
 
@@ -66,6 +70,11 @@ pub struct SelectParams {
     pub drift: f32,
     /// Nonzero: leave out vertices marked as filed in the overlay table.
     pub skip_marked: u32,
+    /// The blend's plateau, a share of the radius (`Falloff::Blend::inner`).
+    pub blend_inner: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `SelectedVertex` in `wgsl/select.wgsl`: one entry of the compacted selection.

@@ -315,6 +315,20 @@ fn ray_point(app: &SlayerApp, rect: Rect, pos: Pos2) -> Option<StrokePoint> {
     })
 }
 
+/// The brushes a number key picks (mask is M; the sweeps and trim are in the Brush panel's
+/// list only).
+pub(super) const BRUSH_KEYS: [(Key, BrushKind); 10] = [
+    (Key::Num1, BrushKind::Draw),
+    (Key::Num2, BrushKind::Inflate),
+    (Key::Num3, BrushKind::Deflate),
+    (Key::Num4, BrushKind::Grab),
+    (Key::Num5, BrushKind::Smooth),
+    (Key::Num6, BrushKind::Flatten),
+    (Key::Num7, BrushKind::Pinch),
+    (Key::Num8, BrushKind::Crease),
+    (Key::Num9, BrushKind::Twist),
+    (Key::Num0, BrushKind::Paint),
+];
 /// The camera's ray through `pos`.
 fn ray_at(app: &SlayerApp, rect: Rect, pos: Pos2) -> Option<Ray> {
     let camera = app.camera.as_ref()?;
@@ -377,19 +391,7 @@ pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
     if pressed((Modifiers::NONE, Key::X)) {
         app.tools.symmetry_x = !app.tools.symmetry_x;
     }
-    let numbers = [
-        Key::Num1,
-        Key::Num2,
-        Key::Num3,
-        Key::Num4,
-        Key::Num5,
-        Key::Num6,
-        Key::Num7,
-        Key::Num8,
-        Key::Num9,
-        Key::Num0,
-    ];
-    for (key, kind) in numbers.into_iter().zip(BrushKind::ALL) {
+    for (key, kind) in BRUSH_KEYS {
         if pressed((Modifiers::NONE, key)) {
             app.tools.brush.kind = kind;
         }

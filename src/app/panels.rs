@@ -6,9 +6,10 @@ use std::time::Duration;
 use eframe::egui::{self, Color32, Painter, Rect, RichText, Stroke as Line, Ui};
 use glam::Vec3;
 
+use super::input::BRUSH_KEYS;
 use super::worker::Command;
 use super::{SlayerApp, StencilChoice, Trace};
-use crate::brush::{BrushKind, Falloff, Pattern};
+use crate::brush::{BrushKind, Falloff, MAX_BLEND_INNER, Pattern};
 use crate::material::{PRESETS, linear_to_srgb, srgb_to_linear};
 use crate::mesh::Brdf;
 use crate::topology::ProximityPolicy;
@@ -90,11 +91,12 @@ fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
     egui::ComboBox::from_label("kind")
         .selected_text(brush.kind.name())
         .show_ui(ui, |ui| {
-            for (i, kind) in BrushKind::ALL.into_iter().enumerate() {
-                let key = match i {
-                    0..=8 => format!("  {}", i + 1),
-                    9 => "  0".into(),
-                    _ => "  M".into(),
+            for kind in BrushKind::ALL {
+                let number = BRUSH_KEYS.iter().find(|(_, k)| *k == kind);
+                let key = match (number, kind) {
+                    (Some((key, _)), _) => format!("  {}", key.symbol_or_name()),
+                    (None, BrushKind::Mask) => "  M".into(),
+                    (None, _) => String::new(),
                 };
                 ui.selectable_value(&mut brush.kind, kind, format!("{}{key}", kind.name()));
             }
@@ -115,8 +117,12 @@ fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
     egui::ComboBox::from_label("falloff")
         .selected_text(brush.falloff.name())
         .show_ui(ui, |ui| {
+            let inner = match brush.falloff {
+                Falloff::Blend { inner, .. } => inner,
+                _ => 0.0,
+            };
             for falloff in [
-                Falloff::default(),
+                Falloff::Blend { n: 3, inner },
                 Falloff::Smooth,
                 Falloff::Sphere,
                 Falloff::Linear,
@@ -124,6 +130,10 @@ fn brush_section(app: &mut SlayerApp, ui: &mut Ui) {
                 ui.selectable_value(&mut brush.falloff, falloff, falloff.name());
             }
         });
+    if let Falloff::Blend { inner, .. } = &mut brush.falloff {
+        // Freestyle's inner radius R_i, as a share of the radius.
+        ui.add(egui::Slider::new(inner, 0.0..=MAX_BLEND_INNER).text("full-strength core"));
+    }
     ui.checkbox(&mut brush.invert, "invert (Ctrl)");
     ui.checkbox(&mut app.tools.symmetry_x, "X symmetry (X)");
     if ui

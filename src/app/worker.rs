@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use super::pick::{Hit, Picker, Ray};
 use super::upload::{MeshUpdate, Mirror};
-use crate::brush::{BrushKind, Sample, StrokeSettings};
+use crate::brush::{Sample, StrokeSettings};
 use crate::mesh::{Brdf, LayerId, Mesh};
 use crate::pipeline::{PhaseTimes, Pipeline, Remeshing, StrokeInProgress, StrokeReport};
 use crate::session::{LayerSettings, Session};
@@ -323,7 +323,7 @@ impl Worker {
 
     /// One stroke, from its settings to its `End`.
     fn stroke(&mut self, settings: StrokeSettings) {
-        let grab = settings.brush.kind == BrushKind::Grab;
+        let grab = settings.brush.kind.drags();
         let label = crate::session::stroke_label(&settings);
         let visible = self.visible();
         let Worker {

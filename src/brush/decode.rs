@@ -312,7 +312,7 @@ fn brush(value: &Value, at: &str) -> Result<BrushKind, Mistake> {
 }
 
 fn falloff(value: &Value, at: &str) -> Result<Falloff, Mistake> {
-    let object = Object::new(value, at, &["curve", "n"])?;
+    let object = Object::new(value, at, &["curve", "n", "inner"])?;
     let curve = object.string("curve", "a curve name")?.ok_or_else(|| {
         (
             object.at("curve"),
@@ -320,8 +320,13 @@ fn falloff(value: &Value, at: &str) -> Result<Falloff, Mistake> {
         )
     })?;
     let n = object.get("n");
-    if n.is_some() && curve != "blend" {
-        return Err((object.at("n"), "only the blend curve takes an `n`".into()));
+    for key in ["n", "inner"] {
+        if object.get(key).is_some() && curve != "blend" {
+            return Err((
+                object.at(key),
+                format!("only the blend curve takes an `{key}`"),
+            ));
+        }
     }
     match curve.as_str() {
         "blend" => {
@@ -337,7 +342,8 @@ fn falloff(value: &Value, at: &str) -> Result<Falloff, Mistake> {
                         )
                     })? as u32,
             };
-            Ok(Falloff::Blend { n })
+            let inner = object.number("inner")?.unwrap_or(0.0);
+            Ok(Falloff::Blend { n, inner })
         }
         "smooth" => Ok(Falloff::Smooth),
         "sphere" => Ok(Falloff::Sphere),

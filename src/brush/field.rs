@@ -59,12 +59,23 @@ pub fn displacement(
         BrushKind::Inflate | BrushKind::Deflate => {
             vertex_normal * (sign * amount * DRAW_RATE * brush.radius)
         }
-        BrushKind::Grab => frame.motion * (weight * dab.share),
+        BrushKind::Grab | BrushKind::Sweep | BrushKind::SweepVolume => {
+            frame.motion * (weight * dab.share)
+        }
         BrushKind::Smooth => (ring_centroid - position) * amount.min(1.0),
         BrushKind::Flatten => {
             let height = (position - frame.plane_point).dot(frame.normal);
             let pull = if sign > 0.0 { -height } else { 0.5 * height };
             frame.normal * (pull * amount.min(1.0))
+        }
+        BrushKind::Trim => {
+            let height = (position - frame.plane_point).dot(frame.normal);
+            let standing = if sign > 0.0 {
+                height.max(0.0)
+            } else {
+                height.min(0.0)
+            };
+            frame.normal * (-standing * amount.min(1.0))
         }
         BrushKind::Pinch => pinch(position) * (sign * amount),
         BrushKind::Crease => {

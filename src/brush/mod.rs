@@ -18,8 +18,8 @@ pub use paint::{Paint, paint_share};
 pub use resample::{DabLimit, MAX_DABS_PER_STROKE, Resampler, dabs_for, resample};
 pub use stencil::{Pattern, Stencil};
 pub use stroke::{
-    LayerRef, MAX_RADIUS_OVER_EXTENT, MAX_STENCIL_BYTES, PaintSpec, Sample, SampleSpec,
-    StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec,
+    LayerRef, MAX_BLEND_INNER, MAX_RADIUS_OVER_EXTENT, MAX_STENCIL_BYTES, PaintSpec, Sample,
+    SampleSpec, StencilSpec, Stroke, StrokeError, StrokeFile, StrokeSettings, StrokeSpec,
 };
 
 use serde::{Deserialize, Serialize};
@@ -47,6 +47,16 @@ pub enum BrushKind {
     Crease,
     /// Turn about the brush normal through the centre.
     Twist,
+    /// Freestyle's sweep: what is under the brush at each sample moves with the brush's motion
+    /// (the blend's plateau at full strength), so dragging off the surface draws it out.
+    Sweep,
+    /// Sweep whose closed layers keep their volume: what the sweep adds or takes is given back
+    /// along the normals of the brush's flanks.
+    #[serde(rename = "sweep-volume")]
+    SweepVolume,
+    /// Cut down to the plane fitted under the brush what stands above it (invert: fill up to
+    /// it what lies below); unlike flatten, the other side is left alone.
+    Trim,
     /// Move nothing; only paint the stroke's material (every brush can paint as it deforms).
     Paint,
     /// Move nothing; paint the mask with the falloff (invert: unmask). Masked vertices move
@@ -56,7 +66,7 @@ pub enum BrushKind {
 
 impl BrushKind {
     /// Every brush.
-    pub const ALL: [BrushKind; 11] = [
+    pub const ALL: [BrushKind; 14] = [
         BrushKind::Draw,
         BrushKind::Inflate,
         BrushKind::Deflate,
@@ -66,6 +76,9 @@ impl BrushKind {
         BrushKind::Pinch,
         BrushKind::Crease,
         BrushKind::Twist,
+        BrushKind::Sweep,
+        BrushKind::SweepVolume,
+        BrushKind::Trim,
         BrushKind::Paint,
         BrushKind::Mask,
     ];
@@ -84,6 +97,9 @@ impl BrushKind {
             BrushKind::Pinch => "pinch",
             BrushKind::Crease => "crease",
             BrushKind::Twist => "twist",
+            BrushKind::Sweep => "sweep",
+            BrushKind::SweepVolume => "sweep-volume",
+            BrushKind::Trim => "trim",
             BrushKind::Paint => "paint",
             BrushKind::Mask => "mask",
         }
@@ -92,6 +108,16 @@ impl BrushKind {
     /// Whether the brush moves vertices (all but `paint` and `mask`).
     pub fn deforms(self) -> bool {
         !matches!(self, BrushKind::Paint | BrushKind::Mask)
+    }
+
+    /// Whether the brush moves what it holds along with the pointer, through space (grab and
+    /// the sweeps), rather than acting on the surface under the pointer; such a stroke
+    /// stretches the surface and is remeshed between its samples where it did.
+    pub fn drags(self) -> bool {
+        matches!(
+            self,
+            BrushKind::Grab | BrushKind::Sweep | BrushKind::SweepVolume
+        )
     }
 }
 

@@ -58,6 +58,10 @@ use crate::mesh::{Brdf, LayerId, MAX_COORDINATE, Mesh};
 /// radius (draw, inflate, crease) would move it by a fifth of its size per sample (a crease of
 /// 5× the diagonal crushed a 5K-face sphere for over ten minutes).
 pub const MAX_RADIUS_OVER_EXTENT: f32 = 2.0;
+
+/// The largest plateau a blend falloff may have (`Falloff::Blend::inner`): past it the blend
+/// is a step, and its rim a cliff.
+pub const MAX_BLEND_INNER: f32 = 0.95;
 /// The largest stencil PNG read (256 MiB): a texture, not a photograph archive.
 pub const MAX_STENCIL_BYTES: u64 = 256 << 20;
 /// A radius below this share of the mean edge length touches nothing and is rejected.
@@ -362,7 +366,17 @@ fn check_brush(
             format!("{spacing} is outside [0.01, 2] (a share of the radius)"),
         ));
     }
-    if let Falloff::Blend { n } = falloff
+    if let Falloff::Blend { inner, .. } = falloff
+        && !(0.0..=MAX_BLEND_INNER).contains(&inner)
+    {
+        return Err((
+            ".falloff.inner",
+            format!(
+                "{inner} is outside [0, {MAX_BLEND_INNER}] (the share of the radius at full strength)"
+            ),
+        ));
+    }
+    if let Falloff::Blend { n, .. } = falloff
         && !(3..=16).contains(&n)
     {
         return Err((

@@ -73,7 +73,7 @@ fn displacement(
     match params.kind {
         0 => normal * lift,
         1 | 2 => inputs.normals[v as usize] * lift,
-        3 => Vec3::from_array(params.motion) * (weight * params.share),
+        3 | 11 | 12 => Vec3::from_array(params.motion) * (weight * params.share),
         4 => (ring_centroid(inputs, v, p) - p) * amount.min(1.0),
         5 => {
             let height = (p - Vec3::from_array(params.plane_point)).dot(normal);
@@ -82,6 +82,15 @@ fn displacement(
         }
         6 => pinch(params, p) * (sign * amount),
         7 => -normal * lift + pinch(params, p) * amount,
+        13 => {
+            let height = (p - Vec3::from_array(params.plane_point)).dot(normal);
+            let standing = if sign > 0.0 {
+                height.max(0.0)
+            } else {
+                height.min(0.0)
+            };
+            normal * (-standing * amount.min(1.0))
+        }
         8 => {
             let turned = rotate(normal, sign * amount * TWIST_RATE, p - center);
             center + turned - p

@@ -45,7 +45,7 @@ fn consider(
     }
     let mut weight = falloff_weight(
         params.falloff,
-        params.blend_n,
+        (params.blend_n, params.blend_inner),
         distance_squared.sqrt() / params.radius,
     );
     if let Some(factor) = partial_mask_factor(inputs.flags[v as usize]) {

@@ -6,7 +6,7 @@ use crate::abi::WORKGROUP_SIZE;
 /// `falloff_weight` of `wgsl/shared/brush.wgsl`: the codes of `crate::abi::falloff_code`, and
 /// blend's powers as repeated products in the shader's order (so the mirror may differ from
 /// `Falloff::weight`'s `powi` by a few ulps).
-pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
+pub fn falloff_weight(kind: u32, (blend_n, blend_inner): (u32, f32), t_in: f32) -> f32 {
     // `t_in.is_nan() || t_in >= 1.0`, spelled as the shader does.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if !(t_in < 1.0) {
@@ -15,6 +15,10 @@ pub fn falloff_weight(kind: u32, blend_n: u32, t_in: f32) -> f32 {
     let t = t_in.max(0.0);
     match kind {
         0 => {
+            if t <= blend_inner {
+                return 1.0;
+            }
+            let t = (t - blend_inner) / (1.0 - blend_inner);
             let mut t_n = 1.0f32;
             for _ in 0..blend_n {
                 t_n *= t;
@@ -59,23 +63,24 @@ mod tests {
     fn falloff_mirror_matches_the_brush_falloff() {
         // Blend's loop and `powi` multiply in different orders: a few ulps apart at most.
         for falloff in [
-            Falloff::Blend { n: 3 },
-            Falloff::Blend { n: 8 },
+            Falloff::blend(3),
+            Falloff::blend(8),
+            Falloff::Blend { n: 4, inner: 0.4 },
             Falloff::Smooth,
             Falloff::Sphere,
             Falloff::Linear,
         ] {
-            let (kind, n) = falloff_code(falloff);
+            let (kind, n, inner) = falloff_code(falloff);
             for k in -10..=1100 {
                 let t = k as f32 / 1000.0;
-                let (mirror, brush) = (falloff_weight(kind, n, t), falloff.weight(t));
+                let (mirror, brush) = (falloff_weight(kind, (n, inner), t), falloff.weight(t));
                 assert!(
                     (mirror - brush).abs() <= 1e-6,
                     "{}: t = {t}: {mirror} vs {brush}",
                     falloff.name()
                 );
             }
-            assert_eq!(falloff_weight(kind, n, f32::NAN), 0.0);
+            assert_eq!(falloff_weight(kind, (n, inner), f32::NAN), 0.0);
         }
     }
 }

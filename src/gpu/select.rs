@@ -30,7 +30,7 @@ pub fn select_params(
     let span = (hi - lo).as_i64vec3() + 1;
     let cells = span.x.max(0) * span.y.max(0) * span.z.max(0);
     let scan_vertices = cells > vertex_count as i64;
-    let (falloff, blend_n) = falloff_code(brush.falloff);
+    let (falloff, blend_n, blend_inner) = falloff_code(brush.falloff);
     SelectParams {
         center: brush.center.to_array(),
         radius: brush.radius,
@@ -54,6 +54,10 @@ pub fn select_params(
         layer_count: layer_count as u32,
         drift,
         skip_marked: 0,
+        blend_inner,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     }
 }
 

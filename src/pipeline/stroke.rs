@@ -7,6 +7,7 @@
 
 mod mirrored;
 mod remeshing;
+mod volume;
 
 use std::time::Instant;
 
@@ -76,6 +77,9 @@ struct Active {
     captured: Option<Vec<(u32, f32)>>,
     /// What a mirrored grab's image caught at its first sample.
     captured_image: Option<Vec<(u32, f32)>>,
+    /// Per layer: whether a volume-keeping sweep holds its volume (it is closed); empty for
+    /// other brushes.
+    closed_layers: Vec<bool>,
     touched_list: Vec<u32>,
     /// Vertices remeshing changed during the stroke, and the edge bound when it began: at
     /// its end the bound is brought back to what the stroke left ([`Active::tighten_edge_bound`]).
@@ -118,6 +122,10 @@ impl<'a> StrokeInProgress<'a> {
         }
         // A new stroke: nothing given to the kernels yet.
         pipeline.kernels.given(mesh, 0, &[]);
+        let closed_layers = match stroke.brush.kind {
+            BrushKind::SweepVolume => volume::closed_layers(mesh),
+            _ => Vec::new(),
+        };
         let (settings, fast) = (pipeline.settings, !pipeline.reference);
         Ok(StrokeInProgress {
             pipeline,
@@ -142,6 +150,7 @@ impl<'a> StrokeInProgress<'a> {
                 samples_run: 0,
                 captured: None,
                 captured_image: None,
+                closed_layers,
                 touched_list: Vec::new(),
                 remeshed: Vec::new(),
                 edge_bound_at_start,
@@ -216,12 +225,12 @@ impl<'a> StrokeInProgress<'a> {
         }
         let mut call = SamplesReport::default();
         let remeshing = pipeline.settings.remeshing;
-        let is_grab = active.stroke.brush.kind == BrushKind::Grab;
+        let drags = active.stroke.brush.kind.drags();
         for sample in samples {
             let Some(moved) = active.run_sample(kernels, self.mesh, sample, &mut call) else {
                 continue;
             };
-            if is_grab && remeshing != Remeshing::Off {
+            if drags && remeshing != Remeshing::Off {
                 active.remesh_stretched_grab(kernels, self.mesh, &moved, &mut call);
             } else if remeshing == Remeshing::AfterSample {
                 active.remesh_after_sample(kernels, self.mesh, &moved, &mut call);
@@ -278,12 +287,13 @@ impl Active {
     }
 
     /// Whether the kernels may run the samples of a call ahead: each is one step that nothing
-    /// else touches between — not a grab (it moves what its first sample caught), not with
-    /// remeshing between samples, not mirrored (two dabs a step).
+    /// else touches between — not a grab (it moves what its first sample caught) nor a sweep
+    /// (both are remeshed between samples where they stretch), not with remeshing between
+    /// samples, not mirrored (two dabs a step).
     fn plans_ahead(&self, remeshing: Remeshing) -> bool {
         let kind = self.stroke.brush.kind;
         kind.deforms()
-            && kind != BrushKind::Grab
+            && !kind.drags()
             && remeshing != Remeshing::AfterSample
             && self.stroke.symmetry.is_none()
     }
@@ -540,6 +550,14 @@ impl Active {
         for (i, &(v, _)) in selection.iter().enumerate() {
             target_of[v as usize] = i as u32;
         }
+        let kept;
+        let targets = if self.closed_layers.is_empty() {
+            targets
+        } else {
+            let closed = &self.closed_layers;
+            kept = volume::keep_volume(mesh, selection, targets, closed, target_of);
+            &kept[..]
+        };
         let before: Vec<Vec3> = selection
             .iter()
             .map(|&(v, _)| mesh.positions()[v as usize])

@@ -84,9 +84,10 @@ pub fn random_flags(count: usize, seed: u64) -> Vec<u32> {
         .collect()
 }
 
-pub const FALLOFFS: [Falloff; 5] = [
-    Falloff::Blend { n: 3 },
-    Falloff::Blend { n: 6 },
+pub const FALLOFFS: [Falloff; 6] = [
+    Falloff::blend(3),
+    Falloff::blend(6),
+    Falloff::Blend { n: 4, inner: 0.5 },
     Falloff::Smooth,
     Falloff::Sphere,
     Falloff::Linear,

@@ -5,7 +5,6 @@
 use std::time::Instant;
 
 use super::{Active, SamplesReport};
-use crate::brush::BrushKind;
 use crate::mesh::Mesh;
 use crate::pipeline::Remeshing;
 use crate::pipeline::engine::{
@@ -87,7 +86,7 @@ impl Active {
         let remesh_now = match remeshing {
             Remeshing::Off => false,
             Remeshing::AfterStroke => true,
-            Remeshing::AfterSample => self.stroke.brush.kind == BrushKind::Grab,
+            Remeshing::AfterSample => self.stroke.brush.kind.drags(),
         };
         if !remesh_now {
             return Vec::new();
