@@ -433,7 +433,7 @@ pub const KEY_MAP: &[(&str, &str)] = &[
     ("[  ]", "smaller / larger radius"),
     (
         "1 … 9, 0",
-        "draw, inflate, deflate, grab, smooth, flatten, pinch, crease, twist, paint",
+        "draw, inflate, deflate, grab, smooth, flatten, pinch, crease, twist, paint (sweeps, trim: Brush panel)",
     ),
     ("M", "mask brush"),
     ("Alt-M", "clear the mask"),
