@@ -27,6 +27,9 @@ pub struct CheckReport {
     pub faces_per_layer: Vec<usize>,
     pub components: usize,
     pub components_per_layer: Vec<usize>,
+    /// The layers whose proximity policy is fuse, as the file says (a slayer PLY's header, a
+    /// session's layer settings); the others collide.
+    pub fuse_layers: Vec<crate::mesh::LayerId>,
     /// Each component's topology: layer, faces, boundary loops (0: closed), Euler
     /// characteristic and genus.
     pub component_shapes: Vec<crate::mesh::ComponentShape>,
@@ -223,6 +226,7 @@ pub fn check_mesh(
         faces_per_layer: mesh.faces_per_layer(),
         components: components.count(),
         components_per_layer: components.per_layer(mesh.layer_count()),
+        fuse_layers: notes.fuse_layers.clone(),
         component_shapes: mesh.component_shapes(),
         mean_edge_length: stats.mean,
         edge_length_cv: stats.coefficient_of_variation(),
@@ -373,11 +377,13 @@ impl std::fmt::Display for CheckReport {
         for (i, name) in self.layer_names.iter().enumerate() {
             // Names come from the file: escaped, so that they cannot drive the terminal.
             let name = crate::files::escape(name);
+            let fuses = self.fuse_layers.contains(&(i as u32));
             writeln!(
                 f,
-                "    {i}: {name:<14} {:>9} faces  {:>5} components",
+                "    {i}: {name:<14} {:>9} faces  {:>5} components  {}",
                 self.faces_per_layer.get(i).copied().unwrap_or(0),
-                self.components_per_layer.get(i).copied().unwrap_or(0)
+                self.components_per_layer.get(i).copied().unwrap_or(0),
+                if fuses { "fuse" } else { "collide" }
             )?;
             writeln!(f, "{}", self.layer_topology(i as u32))?;
         }

@@ -58,6 +58,29 @@ fn ply_round_trip_keeps_brdfs_layers_and_masks() {
 }
 
 #[test]
+fn ply_keeps_which_layers_fuse() {
+    let mesh = small_scene();
+    assert!(mesh.layer_count() >= 2);
+    let mut bytes = Vec::new();
+    slayer::io::write_ply_with(&mesh, &[1], &mut bytes).unwrap();
+    let options = ImportOptions::default();
+    let (_, report) = import_bytes(&bytes, Format::Ply, "p.ply", &options).unwrap();
+    assert_eq!(report.fuse_layers, vec![1]);
+    assert!(report.lines().is_empty(), "a policy is not a repair");
+    // A mark for a layer the file does not have is dropped; other formats keep none.
+    let line = b"comment slayer fuse 1\n";
+    let at = bytes.windows(line.len()).position(|w| w == line).unwrap() + line.len();
+    let mut marked = bytes[..at].to_vec();
+    marked.extend_from_slice(b"comment slayer fuse 99\n");
+    marked.extend_from_slice(&bytes[at..]);
+    let (_, report) = import_bytes(&marked, Format::Ply, "p.ply", &options).unwrap();
+    assert_eq!(report.fuse_layers, vec![1]);
+    let plain = encode_mesh(&mesh, Format::Ply);
+    let (_, report) = import_bytes(&plain, Format::Ply, "p.ply", &options).unwrap();
+    assert!(report.fuse_layers.is_empty());
+}
+
+#[test]
 fn ascii_ply_with_quads_and_extra_properties() {
     let text = "ply\nformat ascii 1.0\ncomment hand made\nelement vertex 7\nproperty double x\n\
                 property double y\nproperty double z\nproperty uchar red\nelement face 2\n\

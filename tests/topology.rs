@@ -415,6 +415,11 @@ fn sculpt_fuses_the_layers_its_stroke_file_or_policy_names() {
         args.extend_from_slice(extra);
         slayer(&args)
     };
+    let policy_of = |file: &std::path::Path| {
+        let out = slayer(&["check", arg(file), "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        report["fuse_layers"].clone()
+    };
     for (strokes, extra, expected) in [
         (&with_fuse, &[][..], 1),
         (&plain, &["--policy", "sphere=fuse"][..], 1),
@@ -424,6 +429,29 @@ fn sculpt_fuses_the_layers_its_stroke_file_or_policy_names() {
         let out = sculpt(strokes, &output, extra);
         assert!(out.status.success(), "{}", text(&out.stderr));
         assert_eq!(genus(&output), expected, "{strokes:?} {extra:?}");
+        // The PLY keeps the policy, and `check` reports it.
+        let fuses = serde_json::json!(if expected == 1 { vec![0] } else { vec![] });
+        assert_eq!(policy_of(&output), fuses, "{strokes:?} {extra:?}");
+    }
+    // A fuse layer read back from the PLY stays fuse in the next sculpt (a session keeps it
+    // too), until `--policy` says otherwise.
+    let kept = dir.join("kept.ply");
+    let out = sculpt(&plain, &kept, &["--policy", "fuse"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for (output, extra, fuses) in [
+        (dir.join("again.slayer"), &[][..], serde_json::json!([0])),
+        (
+            dir.join("again.ply"),
+            &["--policy", "0=collide"][..],
+            serde_json::json!([]),
+        ),
+    ] {
+        let mut args = vec!["sculpt", "--input", arg(&kept), "--strokes", arg(&plain)];
+        args.extend(["--output", arg(&output)]);
+        args.extend_from_slice(extra);
+        let out = slayer(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_eq!(policy_of(&output), fuses, "{output:?}");
     }
     let wrong = dir.join("wrong.json");
     std::fs::write(

@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::IoError;
-use crate::mesh::{Brdf, Mesh, Repairs, Soup, VertexFlags, repair, without_unreferenced};
+use crate::mesh::{Brdf, LayerId, Mesh, Repairs, Soup, VertexFlags, repair, without_unreferenced};
 
 /// How an import treats a file that reads fine but is not a clean manifold mesh.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -29,6 +29,9 @@ pub struct ImportReport {
     /// lines; [`read_mesh`](super::read_mesh) refuses them, `check` reports them.
     pub non_finite_vertices: usize,
     pub first_non_finite_line: Option<usize>,
+    /// The layers a slayer PLY marks as fuse (their proximity policy; `docs/topology.md`),
+    /// ascending, each an existing layer.
+    pub fuse_layers: Vec<LayerId>,
 }
 
 impl ImportReport {
@@ -103,6 +106,11 @@ pub(crate) fn build(
     let positions = soup.positions.clone();
     let mut mesh = Mesh::new(soup.positions, soup.faces, soup.face_layers, layer_names)
         .map_err(|e| IoError::building(name, e, &positions))?;
+    report
+        .fuse_layers
+        .retain(|&l| (l as usize) < mesh.layer_count());
+    report.fuse_layers.sort_unstable();
+    report.fuse_layers.dedup();
     let follow = |v: &u32| *v as usize;
     if let Some(brdfs) = brdfs {
         let per_vertex = repaired.source.iter().map(|v| brdfs[follow(v)]).collect();

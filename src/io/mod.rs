@@ -24,13 +24,13 @@ pub use gltf_write::{write_glb, write_gltf};
 pub use import::{ImportOptions, ImportReport};
 pub use mtl::{layer_materials, material_brdf, write_mtl};
 pub use obj::{LibraryReader, write_obj, write_obj_with_materials};
-pub use ply::write_ply;
+pub use ply::{write_ply, write_ply_with};
 pub use stl::write_stl;
 
 use std::io::Write;
 use std::path::{Component, Path};
 
-use crate::mesh::Mesh;
+use crate::mesh::{LayerId, Mesh};
 use import::Parsed;
 
 /// File formats by extension.
@@ -262,8 +262,21 @@ pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<(), IoError> {
 /// Stages a mesh's file (and an OBJ's `.mtl`) in `batch`, to be written with other files as
 /// one unit. The file is streamed: a mesh is never held twice in memory, once as bytes.
 pub fn stage_mesh(batch: &mut AtomicBatch, mesh: &Mesh, path: &Path) -> Result<(), IoError> {
+    stage_mesh_with(batch, mesh, path, &[])
+}
+
+/// [`stage_mesh`] with the layers whose proximity policy is fuse: a PLY keeps them in its
+/// header; the other formats have no place for them.
+pub fn stage_mesh_with(
+    batch: &mut AtomicBatch,
+    mesh: &Mesh,
+    path: &Path,
+    fuse_layers: &[LayerId],
+) -> Result<(), IoError> {
     match Format::of_path(path)? {
-        Format::Ply => batch.stage_with(path, |mut out| write_ply(mesh, &mut out)),
+        Format::Ply => {
+            batch.stage_with(path, |mut out| write_ply_with(mesh, fuse_layers, &mut out))
+        }
         Format::Stl => batch.stage_with(path, |mut out| write_stl(mesh, &mut out)),
         Format::Glb => batch.stage_with(path, |mut out| write_glb(mesh, &mut out)),
         Format::Gltf => batch.stage_with(path, |mut out| write_gltf(mesh, &mut out)),

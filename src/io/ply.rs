@@ -96,6 +96,8 @@ struct Header {
     ours: bool,
     elements: Vec<Element>,
     layer_names: Vec<(u32, String)>,
+    /// Layers marked `comment slayer fuse ID`: their proximity policy is fuse.
+    fuse_layers: Vec<u32>,
     /// Byte offset of the body.
     body: usize,
     /// Lines in the header, for ASCII line numbers.
@@ -144,6 +146,7 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header, IoError> {
         ours: lines.ours,
         elements: lines.elements,
         layer_names: lines.layer_names,
+        fuse_layers: lines.fuse_layers,
         body: offset,
         lines: line_number,
     })
@@ -156,6 +159,7 @@ struct HeaderLines {
     ours: bool,
     elements: Vec<Element>,
     layer_names: Vec<(u32, String)>,
+    fuse_layers: Vec<u32>,
 }
 
 /// Why a header line was refused.
@@ -183,6 +187,11 @@ impl HeaderLines {
                 })
             }
             ["comment", "written", "by", "slayer"] => self.ours = true,
+            ["comment", "slayer", "fuse", id] => {
+                if let Ok(id) = id.parse::<u32>() {
+                    self.fuse_layers.push(id);
+                }
+            }
             ["comment", "slayer", "layer", id, rest @ ..] => {
                 if let Ok(id) = id.parse::<u32>() {
                     self.layer_names.push((id, rest.join(" ")));
@@ -357,6 +366,7 @@ pub(crate) fn parse_ply(bytes: &[u8], name: &str) -> Result<Parsed, IoError> {
     }
     let mut report = ImportReport {
         not_kept: not_kept(&header),
+        fuse_layers: header.fuse_layers.clone(),
         ..ImportReport::default()
     };
     report.non_finite_vertices = rows.positions.iter().filter(|p| !p.is_finite()).count();
@@ -685,6 +695,16 @@ fn layer_names(named: &[(u32, String)], face_layers: &[LayerId]) -> Vec<String> 
 
 /// Writes the live mesh as binary little-endian PLY.
 pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
+    write_ply_with(mesh, &[], out)
+}
+
+/// [`write_ply`] with the layers whose proximity policy is fuse marked in the header
+/// (`comment slayer fuse ID`), so that the file keeps them.
+pub fn write_ply_with(
+    mesh: &Mesh,
+    fuse_layers: &[LayerId],
+    out: &mut impl Write,
+) -> io::Result<()> {
     let mut file_index = vec![INVALID; mesh.vertex_count()];
     let mut live_vertices = 0u32;
     for (v, index) in file_index.iter_mut().enumerate() {
@@ -699,6 +719,9 @@ pub fn write_ply(mesh: &Mesh, out: &mut impl Write) -> io::Result<()> {
     writeln!(out, "comment written by slayer")?;
     for (id, layer_name) in mesh.layer_names().iter().enumerate() {
         writeln!(out, "comment slayer layer {id} {layer_name}")?;
+    }
+    for id in fuse_layers {
+        writeln!(out, "comment slayer fuse {id}")?;
     }
     writeln!(out, "element vertex {live_vertices}")?;
     for p in ["x", "y", "z", "nx", "ny", "nz"]

@@ -17,7 +17,7 @@ use super::history::Entry;
 use super::{BrushSettings, History, LayerSettings, ProximityPolicy, Session};
 use crate::codec::{DecodeError, Reader, Writer};
 use crate::io::{AtomicBatch, ImportOptions, ImportReport, IoError};
-use crate::mesh::{Brdf, Mesh, MeshDelta, RawMeshError};
+use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta, RawMeshError};
 
 /// The first bytes of every session file: a high byte and a CR-LF/LF pair catch transfers
 /// that mangle binary files, as PNG's do.
@@ -318,7 +318,11 @@ pub fn open_with(
 ) -> Result<(Session, ImportReport), SessionFileError> {
     if !is_session_path(path) {
         let (mesh, report) = crate::io::import_mesh(path, options)?;
-        return Ok((Session::new(mesh), report));
+        let mut session = Session::new(mesh);
+        for &layer in &report.fuse_layers {
+            session.layers[layer as usize].policy = ProximityPolicy::Fuse;
+        }
+        return Ok((session, report));
     }
     let bytes =
         crate::files::read_input(path, crate::files::MAX_INPUT_BYTES).map_err(|source| {
@@ -332,7 +336,8 @@ pub fn open_with(
 }
 
 /// Saves a session atomically: a `.slayer` path gets the session file (with its history when
-/// `with_history`), a mesh path (OBJ, PLY, STL) the mesh alone.
+/// `with_history`), a mesh path (OBJ, PLY, STL) the mesh alone (a PLY with the layers that
+/// fuse marked).
 pub fn save(session: &Session, path: &Path, with_history: bool) -> Result<(), IoError> {
     let mut batch = AtomicBatch::new();
     stage(&mut batch, session, path, with_history)?;
@@ -349,6 +354,8 @@ pub fn stage(
     if is_session_path(path) {
         batch.stage(path, &write_session(session, with_history))
     } else {
-        crate::io::stage_mesh(batch, &session.mesh, path)
+        let all: Vec<LayerId> = (0..session.layers.len() as LayerId).collect();
+        let fuse = session.fuse_layers(&all);
+        crate::io::stage_mesh_with(batch, &session.mesh, path, &fuse)
     }
 }
