@@ -660,3 +660,46 @@ fn a_topology_change_after_a_stroke_patches_the_gpu_copy() {
     let deviation = largest_deviation(&on_cpu, &on_gpu);
     assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
 }
+
+/// Freestyle's brushes on the GPU backend: a volume-keeping sweep drawn off a sphere (its
+/// correction runs in the pipeline on the targets the GPU deformed, and the proximity passes
+/// the GPU ran ahead for the uncorrected targets are dropped) and a trim across it end as on the
+/// CPU pipeline, the GPU's copy the mesh, the volume kept.
+#[test]
+fn the_sweeps_and_trim_on_the_gpu_match_the_cpu_pipeline() {
+    use glam::Vec3;
+    use slayer::brush::{BrushKind, Falloff, Stroke};
+    let sphere = slayer::scene::geodesic_sphere(10, 1.0).unwrap();
+    let volume = |mesh: &Mesh| mesh.closed_components()[0].volume;
+    let stroke = |kind: BrushKind, points: [Vec3; 2]| -> Stroke {
+        let mut stroke = common::one_brush_stroke(kind, 0.4, &points);
+        stroke.brush.falloff = Falloff::Blend { n: 3, inner: 0.5 };
+        stroke
+    };
+    let strokes = [
+        stroke(BrushKind::SweepVolume, [Vec3::Z, Vec3::new(0.2, 0.0, 1.7)]),
+        stroke(BrushKind::Sweep, [Vec3::X, Vec3::new(1.4, 0.3, 0.0)]),
+        stroke(BrushKind::Trim, [Vec3::Y, Vec3::new(0.3, 0.95, 0.0)]),
+    ];
+    let sculpt = |pipeline: &mut Pipeline, mesh: &mut Mesh| {
+        let before = volume(mesh);
+        pipeline.apply_stroke(mesh, &strokes[0]).unwrap();
+        let change = volume(mesh) / before - 1.0;
+        assert!(change.abs() < 0.01, "volume {change:+.4}");
+        for s in &strokes[1..] {
+            pipeline.apply_stroke(mesh, s).unwrap();
+        }
+        pipeline.check_kernel_copy(mesh).unwrap();
+    };
+    let mut on_cpu = sphere.clone();
+    sculpt(&mut Pipeline::new(PipelineSettings::default()), &mut on_cpu);
+    let mut on_gpu = sphere;
+    let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), Box::new(all_on_gpu()));
+    sculpt(&mut pipeline, &mut on_gpu);
+    assert_eq!(pipeline.kernel_failure(), None);
+    on_gpu.validate().unwrap();
+    assert_eq!(find_intersections(&on_gpu).total(), 0);
+    assert_eq!(on_gpu.vertex_count(), on_cpu.vertex_count());
+    let deviation = largest_deviation(&on_cpu, &on_gpu);
+    assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
+}
