@@ -187,3 +187,68 @@ fn check_against_the_original_reports_a_lost_volume() {
         String::from_utf8_lossy(&same.stdout)
     );
 }
+
+/// The distance from each vertex of `mesh` and each face's centroid to the sphere of `radius`
+/// about the origin, the largest.
+fn off_sphere(mesh: &Mesh, radius: f32) -> f32 {
+    let centroids = (0..mesh.face_count()).map(|f| {
+        let [a, b, c] = mesh.face_positions(f);
+        (a + b + c) / 3.0
+    });
+    (mesh.positions().iter().copied())
+        .chain(centroids)
+        .map(|p| (p.length() - radius).abs())
+        .fold(0.0, f32::max)
+}
+
+/// Refining by a large factor goes through whole subdivision levels: a sphere stays a sphere
+/// (new vertices on the curve of the normals, not on the old flat faces), the result is as
+/// regular as the input, and the same input gives the same output.
+#[test]
+fn refining_a_sphere_eightfold_keeps_it_round_and_even() {
+    let start = slayer::scene::geodesic_sphere(10, 1.0).unwrap();
+    let mean = start.mean_edge_length();
+    let target = mean / 7.75;
+    let mut mesh = start.clone();
+    let report = remesh_all(&mut mesh, &RemeshSettings::new(target)).unwrap();
+    assert_eq!(report.subdivisions, 3, "{report:?}");
+    mesh.validate().unwrap();
+    assert_eq!(slayer::collide::find_intersections(&mesh).total(), 0);
+    let faces = mesh.live_face_count() as f64 / start.live_face_count() as f64;
+    assert!((50.0..70.0).contains(&faces), "{faces}× the faces");
+    let stats = mesh.edge_length_stats();
+    assert!(stats.coefficient_of_variation() <= 0.15, "{stats:?}");
+    assert!((stats.mean as f32 / target - 1.0).abs() < 0.1, "{stats:?}");
+    let off = off_sphere(&mesh, 1.0);
+    // The input's own faces lie up to 0.19·L (of the new L) inside the sphere: subdividing
+    // them flat would leave the refined mesh that far off.
+    assert!(off_sphere(&start, 1.0) > 0.15 * target);
+    assert!(off <= 0.05 * target, "{:.3} L off the sphere", off / target);
+    let mut again = start.clone();
+    remesh_all(&mut again, &RemeshSettings::new(target)).unwrap();
+    assert_eq!(again.positions(), mesh.positions());
+    assert_eq!(again.faces(), mesh.faces());
+}
+
+/// A cube refined by a large factor keeps its flat sides and sharp edges: every vertex stays
+/// on its surface, and the volume is the cube's.
+#[test]
+fn refining_a_cube_eightfold_keeps_it_a_cube() {
+    let start = cube(4);
+    let target = start.mean_edge_length() / 8.0;
+    let mut mesh = start.clone();
+    let report = remesh_all(&mut mesh, &RemeshSettings::new(target)).unwrap();
+    assert!(report.subdivisions >= 2, "{report:?}");
+    mesh.validate().unwrap();
+    let worst = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            let q = (*p - Vec3::splat(0.5)).abs();
+            (q.max_element() - 0.5).abs()
+        })
+        .fold(0.0, f32::max);
+    assert!(worst <= 1e-4, "a vertex {worst} off the cube's sides");
+    let volume = closed_volume(&mesh);
+    assert!((volume - 1.0).abs() < 1e-3, "volume {volume}");
+}

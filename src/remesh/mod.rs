@@ -15,6 +15,7 @@
 //! [`VOLUME_TOLERANCE`] or takes it below [`MIN_CLOSED_FACES`] faces.
 
 mod reference;
+mod refine;
 mod safety;
 mod shape;
 
@@ -29,6 +30,7 @@ use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh, next, prev};
 use reference::ReferenceSurface;
+pub use refine::{subdivide, subdivision_levels};
 use shape::ClosedParts;
 pub use shape::{MIN_CLOSED_FACES, SHAPE_TOLERANCE, VOLUME_TOLERANCE};
 
@@ -77,6 +79,9 @@ impl RemeshSettings {
 pub struct RemeshReport {
     /// Remeshing passes summed here (one per stroke or per sample).
     pub passes: usize,
+    /// Whole levels of 1-to-4 subdivision before the passes ([`remesh_all`] refining by a
+    /// large factor).
+    pub subdivisions: u32,
     pub region_vertices: usize,
     pub splits: usize,
     pub collapses: usize,
@@ -97,6 +102,7 @@ pub struct RemeshReport {
 impl RemeshReport {
     pub fn add(&mut self, other: &RemeshReport) {
         self.passes += other.passes;
+        self.subdivisions += other.subdivisions;
         self.region_vertices += other.region_vertices;
         self.splits += other.splits;
         self.collapses += other.collapses;
@@ -188,9 +194,29 @@ fn remesh(
     (report, changed)
 }
 
-/// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`). Fails only where the
-/// grid does: a `target_edge` that is no positive finite length.
-pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshReport, GridError> {
+/// Why a whole-mesh remesh could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum RemeshError {
+    /// The grid refused the target: no positive finite length.
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    /// Subdividing made no valid mesh (the input was not one).
+    #[error("subdividing: {0}")]
+    Subdivision(#[from] crate::mesh::MeshError),
+}
+
+/// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`). A target several
+/// times shorter than the mean edge is first approached by whole levels of subdivision
+/// ([`subdivision_levels`], [`subdivide`]), then the passes run over every vertex.
+pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshReport, RemeshError> {
+    // Before anything changes: a target the grid refuses leaves the mesh as it was.
+    SpatialHash::new(settings.target_edge, 0)?;
+    let started = Instant::now();
+    let levels = subdivision_levels(mesh.edge_length_stats().mean as f32, settings.target_edge);
+    for _ in 0..levels {
+        *mesh = subdivide(mesh)?;
+    }
+    let subdivided_ms = started.elapsed().as_secs_f64() * 1e3;
     let mut grid = SpatialHash::build(mesh, settings.target_edge)?;
     let seeds: Vec<u32> = (0..mesh.vertex_count() as u32)
         .filter(|&v| {
@@ -208,7 +234,11 @@ pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshRe
         (Start::Everywhere, &mut RemeshSets::default()),
     );
     mesh.compact();
-    Ok(report)
+    Ok(RemeshReport {
+        subdivisions: levels,
+        millis: report.millis + subdivided_ms,
+        ..report
+    })
 }
 
 struct Remesher<'a> {
@@ -723,6 +753,13 @@ impl<'a> Remesher<'a> {
                     / ring.len() as f32;
                 let n = self.mesh.normals()[v as usize];
                 let tangential = (centroid - p) - n * n.dot(centroid - p);
+                // Projection back onto the surface barely changes a move along it: one this
+                // short would not be worth its checks after it either (most vertices of an
+                // even mesh, and the projection is most of a whole-mesh pass).
+                let least = RELAX_MIN_MOVE * self.settings.target_edge;
+                if tangential.length_squared() < (0.9 * least) * (0.9 * least) {
+                    return None;
+                }
                 let moved = p + tangential;
                 let layer = self.mesh.vertex_layers()[v as usize];
                 let projected = self.surface.project(moved, layer).unwrap_or(moved);
