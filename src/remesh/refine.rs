@@ -73,9 +73,9 @@ pub fn subdivide(mesh: &Mesh) -> Result<Mesh, MeshError> {
 fn live_positions(mesh: &Mesh) -> (Vec<Vec3>, Vec<u32>) {
     let mut old_index = vec![INVALID; mesh.vertex_count()];
     let mut positions = Vec::with_capacity(mesh.live_vertex_count());
-    for v in 0..mesh.vertex_count() {
+    for (v, index) in old_index.iter_mut().enumerate() {
         if mesh.is_vertex_live(v as u32) {
-            old_index[v] = positions.len() as u32;
+            *index = positions.len() as u32;
             positions.push(mesh.positions()[v]);
         }
     }
