@@ -495,6 +495,84 @@ fn remesh_makes_a_jittered_scene_uniform_and_clean() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `remesh --faces N` lands near N faces, `--scale F` multiplies the edge by F (refining a
+/// sphere eightfold through subdivision), and `--json` reports the quality before and after
+/// and the distance to the input; conflicting or absurd targets are one-line errors.
+#[test]
+fn remesh_to_a_face_count_or_a_scale_reports_its_quality() {
+    let dir = scratch("remesh-targets");
+    let (sphere, out_file) = (dir.join("sphere.ply"), dir.join("out.ply"));
+    write_scene("sphere", 2000, &[], &sphere);
+    let remesh = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["remesh", arg(&sphere), "-o", arg(&out_file), "--json"];
+        args.extend_from_slice(extra);
+        let out = slayer(&args);
+        assert!(out.status.success(), "{extra:?}: {}", text(&out.stderr));
+        serde_json::from_slice(&out.stdout).expect("JSON")
+    };
+    let report = remesh(&["--faces", "8000"]);
+    let faces = report["after"]["faces"].as_f64().unwrap();
+    assert!((faces / 8000.0 - 1.0).abs() < 0.1, "{faces} faces for 8000");
+    let report = remesh(&["--scale", "0.125"]);
+    assert_eq!(report["remesh"]["subdivisions"], 3);
+    let ratio =
+        report["after"]["faces"].as_f64().unwrap() / report["before"]["faces"].as_f64().unwrap();
+    assert!((50.0..75.0).contains(&ratio), "{ratio}× the faces");
+    assert!(report["after"]["edge_cv"].as_f64().unwrap() <= 0.15);
+    assert!(report["after"]["smallest_angle"]["p1"].as_f64().unwrap() >= 30.0);
+    assert!(report["after"]["valence_6"].as_f64().unwrap() > 0.8);
+    // Refined on the curve of the normals, the result lies off the input's flat faces by
+    // their own distance to the sphere (0.19 of the new edge here; tests/shape.rs measures
+    // the distance to the sphere itself), nowhere farther.
+    let distance = &report["distance_to_input"];
+    assert!(distance["max"].as_f64().unwrap() < 0.25, "{distance}");
+    assert!(distance["samples"].as_u64().unwrap() > 100_000);
+    // Remeshed at its own resolution, the result stays on the input's faces.
+    let same = remesh(&[]);
+    let distance = &same["distance_to_input"];
+    assert!(distance["max"].as_f64().unwrap() < 0.1, "{distance}");
+    assert_eq!(same["remesh"]["subdivisions"], 0);
+    let lines = slayer(&[
+        "remesh",
+        arg(&sphere),
+        "-o",
+        arg(&out_file),
+        "--scale",
+        "0.5",
+    ]);
+    let shown = text(&lines.stdout);
+    assert!(
+        shown.contains("valence of interior vertices") && shown.contains("distance to the input"),
+        "{shown}"
+    );
+    let both = slayer(&[
+        "remesh",
+        arg(&sphere),
+        "-o",
+        arg(&out_file),
+        "--edge",
+        "0.01",
+        "--faces",
+        "100",
+    ]);
+    assert!(!both.status.success());
+    assert!(
+        text(&both.stderr).contains("cannot be used with"),
+        "{}",
+        text(&both.stderr)
+    );
+    for (args, expected) in [
+        (vec!["--scale=-2"], "--scale -2 is not a positive factor"),
+        (vec!["--faces", "0"], "--faces 0"),
+        (vec!["--scale", "0.0001"], "the limit is"),
+    ] {
+        let mut all = vec!["remesh", arg(&sphere), "-o", arg(&out_file)];
+        all.extend(args);
+        assert_one_line_error(&slayer(&all), &[expected]);
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// A missing file is named once, with the system's reason once.
 #[test]
 fn a_missing_file_is_one_plain_line() {

@@ -241,9 +241,11 @@ fn torus(around: u32, across: u32, (major, minor): (f32, f32)) -> Mesh {
     Mesh::new(positions, faces, layers, vec!["ring".into()]).expect("torus")
 }
 
-/// 300 seeded strokes of every deforming brush over `start` (each from a vertex of the fuse
-/// copy, brush radii and reach scaled by `size`), the same on a fuse and on a collide copy: after each, both are closed, valid and free of intersections; the collide copy keeps
-/// its genus. Returns the joins and splits made.
+/// 300 seeded strokes of the brushes that move a surface into itself, Freestyle's sweeps
+/// among them, over `start` (each from a vertex of the fuse copy, brush radii and reach scaled
+/// by `size`), the same on a fuse and on a collide copy: after each, both are closed, valid
+/// and free of intersections; the collide copy keeps its genus. Returns the joins and splits
+/// made.
 fn random_strokes(start: &Mesh, size: f32, seed: u64) -> usize {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -254,6 +256,8 @@ fn random_strokes(start: &Mesh, size: f32, seed: u64) -> usize {
         BrushKind::Deflate,
         BrushKind::Smooth,
         BrushKind::Pinch,
+        BrushKind::Sweep,
+        BrushKind::SweepVolume,
     ];
     let genus = start.component_shapes()[0].genus;
     let (mut fused, mut kept) = (start.clone(), start.clone());

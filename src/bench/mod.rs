@@ -16,57 +16,8 @@ use crate::pipeline::{
     BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, StrokeReport, Uploads,
 };
 use crate::remesh::RemeshReport;
+pub use crate::remesh::{AngleSummary, smallest_angle_degrees};
 use crate::topology::TopologyReport;
-
-/// The distribution of the smallest angle of a set of faces, in degrees.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct AngleSummary {
-    pub faces: usize,
-    pub p1: f64,
-    pub p5: f64,
-    pub median: f64,
-    /// Share of faces whose smallest angle is below 20° and below 30°.
-    pub below_20: f64,
-    pub below_30: f64,
-}
-
-impl AngleSummary {
-    pub fn of(triangles: impl Iterator<Item = [glam::Vec3; 3]>) -> AngleSummary {
-        let mut angles: Vec<f64> = triangles.map(smallest_angle_degrees).collect();
-        if angles.is_empty() {
-            return AngleSummary::default();
-        }
-        angles.sort_unstable_by(f64::total_cmp);
-        let n = angles.len();
-        let at = |q: f64| angles[((n - 1) as f64 * q).round() as usize];
-        let share = |limit: f64| angles.partition_point(|&a| a < limit) as f64 / n as f64;
-        AngleSummary {
-            faces: n,
-            p1: at(0.01),
-            p5: at(0.05),
-            median: at(0.5),
-            below_20: share(20.0),
-            below_30: share(30.0),
-        }
-    }
-}
-
-/// Smallest interior angle of a triangle, in degrees (0 for a degenerate one).
-pub fn smallest_angle_degrees([a, b, c]: [glam::Vec3; 3]) -> f64 {
-    let angle = |p: glam::Vec3, q: glam::Vec3, r: glam::Vec3| {
-        let (u, v) = ((q - p).as_dvec3(), (r - p).as_dvec3());
-        let denominator = u.length() * v.length();
-        if denominator == 0.0 {
-            0.0
-        } else {
-            (u.dot(v) / denominator)
-                .clamp(-1.0, 1.0)
-                .acos()
-                .to_degrees()
-        }
-    };
-    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
-}
 
 /// Figures for one scene; field names are the fixed JSON interface of docs/bench.md.
 #[derive(Debug, Clone, Serialize)]

@@ -14,6 +14,7 @@
 //! [`SHAPE_TOLERANCE`]·L from where it was, nor changes a closed component's volume past
 //! [`VOLUME_TOLERANCE`] or takes it below [`MIN_CLOSED_FACES`] faces.
 
+mod quality;
 mod reference;
 mod refine;
 mod safety;
@@ -29,6 +30,9 @@ use crate::collide::Stamps;
 use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh, next, prev};
+pub use quality::{
+    AngleSummary, Distance, Quality, Surface, VALENCE_BUCKETS, smallest_angle_degrees,
+};
 use reference::ReferenceSurface;
 pub use refine::{subdivide, subdivision_levels};
 use shape::ClosedParts;
@@ -261,6 +265,9 @@ struct Remesher<'a> {
     report: RemeshReport,
     scratch: Vec<u32>,
     near: Vec<NearFace>,
+    /// A whole-mesh remesh ([`Start::Everywhere`]): relaxation passes over vertices whose
+    /// move is short before projecting them.
+    whole: bool,
 }
 
 impl<'a> Remesher<'a> {
@@ -331,6 +338,7 @@ impl<'a> Remesher<'a> {
             closed,
             scratch: Vec::new(),
             near: Vec::new(),
+            whole: start == Start::Everywhere,
         };
         for v in starting {
             remesher.mark_dirty(v);
@@ -755,9 +763,11 @@ impl<'a> Remesher<'a> {
                 let tangential = (centroid - p) - n * n.dot(centroid - p);
                 // Projection back onto the surface barely changes a move along it: one this
                 // short would not be worth its checks after it either (most vertices of an
-                // even mesh, and the projection is most of a whole-mesh pass).
+                // even mesh, and the projection is most of a whole-mesh pass). Left out of
+                // the remeshing after a stroke, whose results it would shift by an ulp here
+                // and there, and whose regions are small.
                 let least = RELAX_MIN_MOVE * self.settings.target_edge;
-                if tangential.length_squared() < (0.9 * least) * (0.9 * least) {
+                if self.whole && tangential.length_squared() < (0.9 * least) * (0.9 * least) {
                     return None;
                 }
                 let moved = p + tangential;

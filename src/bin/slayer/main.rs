@@ -168,12 +168,26 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax).
+    /// Remesh a whole mesh toward a uniform edge length (split, collapse, flip, relax; whole
+    /// levels of subdivision first when refining by a large factor), and report the result's
+    /// quality and its distance to the input.
     Remesh {
         file: PathBuf,
         /// Target edge length; the mesh's mean edge length by default.
-        #[arg(long)]
+        #[arg(long, conflicts_with_all = ["faces", "scale"])]
         edge: Option<f32>,
+        /// Target face count: the edge length whose equilateral triangles cover the mesh's
+        /// area this many times.
+        #[arg(long, conflicts_with = "scale")]
+        faces: Option<u64>,
+        /// Target edge length as a multiple of the mean edge: 0.5 halves the edges (about 4×
+        /// the faces), 2 doubles them.
+        #[arg(long)]
+        scale: Option<f32>,
+        /// Print one JSON object (the quality before and after, the distance to the input, what
+        /// the remesh did) instead of the lines.
+        #[arg(long)]
+        json: bool,
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -411,7 +425,22 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             cull: !no_cull,
             policies: &policy,
         }),
-        Command::Remesh { file, edge, output } => remesh::run(&file, edge, &output, strict),
+        Command::Remesh {
+            file,
+            edge,
+            faces,
+            scale,
+            json,
+            output,
+        } => {
+            let target = match (edge, faces, scale) {
+                (Some(edge), _, _) => remesh::Target::Edge(edge),
+                (_, Some(faces), _) => remesh::Target::Faces(faces),
+                (_, _, Some(scale)) => remesh::Target::Scale(scale),
+                _ => remesh::Target::MeanEdge,
+            };
+            remesh::run(&file, target, (&output, json), strict)
+        }
         Command::Undo {
             session,
             steps,
