@@ -644,21 +644,29 @@ fn a_topology_change_after_a_stroke_patches_the_gpu_copy() {
             .unwrap();
         pipeline.check_kernel_copy(mesh).unwrap();
     };
-    let mut on_cpu = sphere.clone();
+    let (on_gpu, pipeline) = sculpted_on_both(&sphere, sculpt);
+    let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
+    assert_eq!(uploads.whole, 1, "patched, not sent again: {uploads:?}");
+    let shapes = on_gpu.component_shapes();
+    assert_eq!((shapes.len(), shapes[0].genus), (1, 1), "{shapes:?}");
+}
+
+/// `start` sculpted by `sculpt` on the CPU pipeline and on the GPU kernels (every pass on the
+/// GPU): the GPU's result is valid, crosses nothing and has the CPU's vertices within 1e-4·L.
+/// Returns it, with the GPU pipeline.
+fn sculpted_on_both(start: &Mesh, sculpt: impl Fn(&mut Pipeline, &mut Mesh)) -> (Mesh, Pipeline) {
+    let mut on_cpu = start.clone();
     sculpt(&mut Pipeline::new(PipelineSettings::default()), &mut on_cpu);
-    let mut on_gpu = sphere;
+    let mut on_gpu = start.clone();
     let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), Box::new(all_on_gpu()));
     sculpt(&mut pipeline, &mut on_gpu);
     assert_eq!(pipeline.kernel_failure(), None);
-    let uploads = pipeline.uploads().expect("GPU kernels keep a copy");
-    assert_eq!(uploads.whole, 1, "patched, not sent again: {uploads:?}");
     on_gpu.validate().unwrap();
     assert_eq!(find_intersections(&on_gpu).total(), 0);
-    let shapes = on_gpu.component_shapes();
-    assert_eq!((shapes.len(), shapes[0].genus), (1, 1), "{shapes:?}");
     assert_eq!(on_gpu.vertex_count(), on_cpu.vertex_count());
     let deviation = largest_deviation(&on_cpu, &on_gpu);
     assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
+    (on_gpu, pipeline)
 }
 
 /// Freestyle's brushes on the GPU backend: a volume-keeping sweep drawn off a sphere (its
@@ -691,15 +699,5 @@ fn the_sweeps_and_trim_on_the_gpu_match_the_cpu_pipeline() {
         }
         pipeline.check_kernel_copy(mesh).unwrap();
     };
-    let mut on_cpu = sphere.clone();
-    sculpt(&mut Pipeline::new(PipelineSettings::default()), &mut on_cpu);
-    let mut on_gpu = sphere;
-    let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), Box::new(all_on_gpu()));
-    sculpt(&mut pipeline, &mut on_gpu);
-    assert_eq!(pipeline.kernel_failure(), None);
-    on_gpu.validate().unwrap();
-    assert_eq!(find_intersections(&on_gpu).total(), 0);
-    assert_eq!(on_gpu.vertex_count(), on_cpu.vertex_count());
-    let deviation = largest_deviation(&on_cpu, &on_gpu);
-    assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
+    sculpted_on_both(&sphere, sculpt);
 }
