@@ -14,8 +14,8 @@ use glam::{DVec3, Vec3};
 use crate::mesh::{INVALID, Mesh};
 use crate::pipeline::step::longest_move;
 
-/// Newton rounds per step: the second leaves a relative error of about the square of the
-/// first's (below 1e-6 of a step's change in the tests).
+/// Newton rounds per step: the second takes out what the first's linearization missed (the
+/// correction's own effect on the faces' normals), about the square of the first's error.
 const ROUNDS: usize = 2;
 
 /// Per layer: whether it is closed (no boundary edge), so that it encloses a volume to keep.
