@@ -239,9 +239,10 @@ fn straight_draws(mesh: &Mesh, surface: &Surface<'_>, count: usize) -> StrokeFil
 /// The torture mix's brushes: the nine it was tuned with (those before Freestyle's in
 /// [`BrushKind::ALL`]), so that its scripts, and every torture suite's strokes, stay what they
 /// were when Freestyle's brushes came. Random sweeps across stacked layers made the remeshing
-/// torture test about twice as slow (140 s against 61–72 s); `tests/sweep.rs` and the deform parity tests cover sweep,
-/// sweep-volume and trim.
+/// torture test about twice as slow (140 s against 61–72 s); `tests/sweep.rs` and the deform
+/// parity tests cover sweep, sweep-volume and trim.
 const TORTURE_BRUSHES: &[BrushKind] = BrushKind::ALL.split_at(9).0;
+
 fn pick_brush(rng: &mut ChaCha8Rng, mix: BrushMix) -> (BrushKind, bool, f32) {
     match mix {
         BrushMix::StraightDraw => (BrushKind::Draw, false, 0.5),
