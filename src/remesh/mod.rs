@@ -164,11 +164,13 @@ impl RemeshSets {
 
 /// Where remeshing starts: after a stroke, at the vertices with an edge outside the band (the
 /// rest of the stroke's footprint is already as the remesher would leave it, and is left
-/// alone); for a whole-mesh remesh, everywhere.
+/// alone); for a whole-mesh remesh, everywhere, or, on a mesh just subdivided (as even as its
+/// input), at its vertices out of band again.
 #[derive(Clone, Copy, PartialEq)]
 enum Start {
     OutOfBand,
     Everywhere,
+    Subdivided,
 }
 
 fn remesh(
@@ -227,15 +229,22 @@ pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshRe
             !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
         })
         .collect();
+    // A subdivided mesh is as even as its input: only where an edge left the band is there
+    // work, as after a stroke (most of a million vertices need nothing).
+    let (start, rings) = if levels > 0 {
+        (Start::Subdivided, 1)
+    } else {
+        (Start::Everywhere, 0)
+    };
     let (report, _) = remesh(
         mesh,
         &mut grid,
         &seeds,
         &RemeshSettings {
-            region_rings: 0,
+            region_rings: rings,
             ..*settings
         },
-        (Start::Everywhere, &mut RemeshSets::default()),
+        (start, &mut RemeshSets::default()),
     );
     mesh.compact();
     Ok(RemeshReport {
@@ -265,8 +274,8 @@ struct Remesher<'a> {
     report: RemeshReport,
     scratch: Vec<u32>,
     near: Vec<NearFace>,
-    /// A whole-mesh remesh ([`Start::Everywhere`]): relaxation passes over vertices whose
-    /// move is short before projecting them.
+    /// A whole-mesh remesh ([`Start::Everywhere`], [`Start::Subdivided`]): relaxation passes
+    /// over vertices whose move is short before projecting them.
     whole: bool,
 }
 
@@ -338,7 +347,7 @@ impl<'a> Remesher<'a> {
             closed,
             scratch: Vec::new(),
             near: Vec::new(),
-            whole: start == Start::Everywhere,
+            whole: start != Start::OutOfBand,
         };
         for v in starting {
             remesher.mark_dirty(v);

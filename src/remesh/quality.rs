@@ -128,7 +128,8 @@ pub struct Distance {
 pub struct Surface {
     triangles: Vec<[Vec3; 3]>,
     grid: LocalFaceGrid,
-    /// The first query radius; doubled until a face is found within it.
+    /// The first query radius (a quarter edge: most samples lie that near), doubled until a
+    /// face is found within it.
     reach: f32,
     diagonal: f32,
 }
@@ -142,16 +143,16 @@ impl Surface {
             .collect();
         let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.including_box(t));
-        let reach = mesh.mean_edge_length().max(f32::MIN_POSITIVE);
+        let edge = mesh.mean_edge_length().max(f32::MIN_POSITIVE);
         let mut grid = LocalFaceGrid::default();
         if !triangles.is_empty() {
-            grid.build(&boxes, bounds, 1.5 * reach);
+            grid.build(&boxes, bounds, 1.5 * edge);
         }
         let diagonal = (bounds.max - bounds.min).length();
         Surface {
             triangles,
             grid,
-            reach,
+            reach: 0.25 * edge,
             diagonal,
         }
     }
