@@ -58,22 +58,19 @@ fn cube(n: u32) -> Mesh {
     Mesh::new(positions, faces, layers, vec!["cube".into()]).unwrap()
 }
 
-fn closed_volume(mesh: &Mesh) -> f64 {
-    let closed = mesh.closed_components();
-    assert_eq!(closed.len(), 1, "one closed component");
-    closed[0].volume
-}
-
 #[test]
 fn remeshing_coarse_cubes_at_their_mean_edge_keeps_their_volume() {
     for n in [1, 2, 4] {
         let mut mesh = cube(n);
-        assert!((closed_volume(&mesh) - 1.0).abs() < 1e-6, "a unit cube");
+        assert!(
+            (common::closed_volume(&mesh) - 1.0).abs() < 1e-6,
+            "a unit cube"
+        );
         let faces = mesh.live_face_count();
         let edge = mesh.edge_length_stats().mean as f32;
         let report = remesh_all(&mut mesh, &RemeshSettings::new(edge)).unwrap();
         mesh.validate().unwrap();
-        let volume = closed_volume(&mesh);
+        let volume = common::closed_volume(&mesh);
         assert!(
             (volume - 1.0).abs() <= CUBE_VOLUME_TOLERANCE,
             "{n}×{n} cube: volume {volume}, {} of {faces} faces left ({report:?})",
@@ -97,7 +94,7 @@ fn a_coarse_cube_remeshed_finer_is_refined() {
             report.splits > 0 && mesh.live_face_count() > 4 * faces,
             "{report:?}"
         );
-        let volume = closed_volume(&mesh);
+        let volume = common::closed_volume(&mesh);
         assert!((volume - 1.0).abs() <= VOLUME_TOLERANCE, "{volume}");
     }
 }
@@ -121,7 +118,10 @@ fn smooth_dab_at_corner(remeshing: Remeshing) -> Mesh {
 fn a_smooth_dab_at_a_cube_corner_keeps_the_cube() {
     let brushed = smooth_dab_at_corner(Remeshing::Off);
     let remeshed = smooth_dab_at_corner(Remeshing::AfterStroke);
-    let (before, after) = (closed_volume(&brushed), closed_volume(&remeshed));
+    let (before, after) = (
+        common::closed_volume(&brushed),
+        common::closed_volume(&remeshed),
+    );
     assert!(
         (after - before).abs() <= CUBE_VOLUME_TOLERANCE * before,
         "volume {before} after the dab, {after} after remeshing"
@@ -249,6 +249,6 @@ fn refining_a_cube_eightfold_keeps_it_a_cube() {
         })
         .fold(0.0, f32::max);
     assert!(worst <= 1e-4, "a vertex {worst} off the cube's sides");
-    let volume = closed_volume(&mesh);
+    let volume = common::closed_volume(&mesh);
     assert!((volume - 1.0).abs() < 1e-3, "volume {volume}");
 }

@@ -12,24 +12,11 @@ use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing, StrokeReport};
 use slayer::scene::geodesic_sphere;
 
-fn closed_volume(mesh: &Mesh) -> f64 {
-    let closed = mesh.closed_components();
-    assert_eq!(closed.len(), 1, "one closed component");
-    closed[0].volume
-}
-
 /// A stroke of `kind` on layer 0 along `points`, with a blend falloff of plateau `inner`.
 fn swept(kind: BrushKind, radius: f32, inner: f32, points: &[Vec3]) -> Stroke {
     let mut stroke = common::one_brush_stroke(kind, radius, points);
     stroke.brush.falloff = Falloff::Blend { n: 3, inner };
     stroke
-}
-
-/// Points from `from` to `to`, `count` of them, ends included.
-fn line(from: Vec3, to: Vec3, count: usize) -> Vec<Vec3> {
-    (0..count)
-        .map(|i| from.lerp(to, i as f32 / (count - 1) as f32))
-        .collect()
 }
 
 fn apply(mesh: &mut Mesh, stroke: &Stroke) -> StrokeReport {
@@ -50,7 +37,7 @@ fn highest(mesh: &Mesh) -> f32 {
 
 /// From the north pole of a unit sphere straight up by `lift`.
 fn pull_up(lift: f32) -> Vec<Vec3> {
-    line(Vec3::Z, Vec3::new(0.0, 0.0, 1.0 + lift), 16)
+    common::line(Vec3::Z, Vec3::new(0.0, 0.0, 1.0 + lift), 16)
 }
 
 #[test]
@@ -70,9 +57,13 @@ fn sweep_draws_the_surface_out_with_the_brush() {
     // Unlike a grab, a sweep selects anew at each sample: a sweep that turns back along the
     // surface leaves its first catch behind.
     let mut there_and_back = geodesic_sphere(24, 1.0).expect("sphere");
-    let path: Vec<Vec3> = line(Vec3::Z, Vec3::new(0.0, 0.0, 1.4), 8)
+    let path: Vec<Vec3> = common::line(Vec3::Z, Vec3::new(0.0, 0.0, 1.4), 8)
         .into_iter()
-        .chain(line(Vec3::new(0.0, 0.0, 1.4), Vec3::new(0.6, 0.0, 1.4), 8))
+        .chain(common::line(
+            Vec3::new(0.0, 0.0, 1.4),
+            Vec3::new(0.6, 0.0, 1.4),
+            8,
+        ))
         .collect();
     apply(
         &mut there_and_back,
@@ -84,25 +75,25 @@ fn sweep_draws_the_surface_out_with_the_brush() {
 #[test]
 fn sweep_volume_keeps_a_closed_layer_within_one_percent_over_a_stroke() {
     let start = geodesic_sphere(24, 1.0).expect("sphere");
-    let before = closed_volume(&start);
+    let before = common::closed_volume(&start);
     let mut plain = start.clone();
     apply(
         &mut plain,
         &swept(BrushKind::Sweep, 0.35, 0.5, &pull_up(0.8)),
     );
-    let grown = closed_volume(&plain) / before - 1.0;
+    let grown = common::closed_volume(&plain) / before - 1.0;
     assert!(grown > 0.02, "a plain sweep adds volume: {grown:+.4}");
 
     for path in [
         pull_up(0.8),
         // Along the surface and off it at once.
-        line(Vec3::Z, Vec3::new(0.7, 0.2, 1.3), 16),
+        common::line(Vec3::Z, Vec3::new(0.7, 0.2, 1.3), 16),
         // Pressed in.
-        line(Vec3::Z, Vec3::new(0.0, 0.0, 0.5), 12),
+        common::line(Vec3::Z, Vec3::new(0.0, 0.0, 0.5), 12),
     ] {
         let mut kept = start.clone();
         let report = apply(&mut kept, &swept(BrushKind::SweepVolume, 0.35, 0.5, &path));
-        let change = closed_volume(&kept) / before - 1.0;
+        let change = common::closed_volume(&kept) / before - 1.0;
         assert!(
             change.abs() < 0.01,
             "volume changed {change:+.4}: {report:?}"

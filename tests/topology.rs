@@ -110,18 +110,11 @@ fn stroke(
         .expect("stroke runs")
 }
 
-/// Points from `from` to `to`, `count` of them, ends included.
-fn line(from: Vec3, to: Vec3, count: usize) -> Vec<Vec3> {
-    (0..count)
-        .map(|i| from.lerp(to, i as f32 / (count - 1) as f32))
-        .collect()
-}
-
 #[test]
 fn a_grab_pushing_the_north_pole_through_the_south_pole_makes_a_torus() {
     let mut mesh = spheres(16, 1.0, &[Vec3::ZERO]);
     let mut pipeline = Pipeline::new(PipelineSettings::default());
-    let push = line(Vec3::Y, Vec3::new(0.0, -1.3, 0.0), 24);
+    let push = common::line(Vec3::Y, Vec3::new(0.0, -1.3, 0.0), 24);
     let report = stroke(
         &mut pipeline,
         &mut mesh,
@@ -285,7 +278,7 @@ fn random_strokes(start: &Mesh, size: f32, seed: u64) -> usize {
             .collect();
         let start = fused.positions()[live[rng.random_range(0..live.len())] as usize];
         let end = start + random_vec(&mut rng, 0.8 * size);
-        let points = line(start, end, 6);
+        let points = common::line(start, end, 6);
         let report = stroke(&mut fuse_pipeline, &mut fused, brush, &points, true);
         changes += report.topology.joins + report.topology.splits;
         closed_and_clean(&fused);
@@ -336,7 +329,7 @@ fn a_dumbbell_whose_neck_is_deflated_splits_into_two_closed_components() {
     assert_eq!(closed_and_clean(&mesh).len(), 1);
 
     let neck = Vec3::new(0.5 + gap / 2.0, 0.0, 0.0);
-    let across = line(neck - 0.02 * Vec3::X, neck + 0.02 * Vec3::X, 5);
+    let across = common::line(neck - 0.02 * Vec3::X, neck + 0.02 * Vec3::X, 5);
     let mut pipeline = Pipeline::new(PipelineSettings::default());
     let mut strokes = 0;
     while strokes < 16 {
@@ -361,7 +354,7 @@ fn a_dumbbell_whose_neck_is_deflated_splits_into_two_closed_components() {
 fn a_fuse_flake_pushed_into_a_collide_plaster_never_welds() {
     let mut mesh = flake_and_plaster(1.3);
     let mut pipeline = Pipeline::new(PipelineSettings::default());
-    let push = line(Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), 12);
+    let push = common::line(Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), 12);
     let report = stroke(
         &mut pipeline,
         &mut mesh,

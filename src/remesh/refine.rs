@@ -49,7 +49,10 @@ pub fn subdivide(mesh: &Mesh) -> Result<Mesh, MeshError> {
             let tri = mesh.faces()[face];
             let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
             let smooth = across == INVALID
-                || face_normal(mesh, face).dot(face_normal(mesh, across as usize / 3)) >= bend;
+                || mesh
+                    .face_normal(face)
+                    .dot(mesh.face_normal(across as usize / 3))
+                    >= bend;
             midpoint[corner] = (vertex_count + ends.len()) as u32;
             positions.push(edge_point(mesh, (a, b), smooth, bend));
             ends.push((old_index[a as usize], old_index[b as usize]));
@@ -80,11 +83,6 @@ fn live_positions(mesh: &Mesh) -> (Vec<Vec3>, Vec<u32>) {
         }
     }
     (positions, old_index)
-}
-
-fn face_normal(mesh: &Mesh, face: usize) -> Vec3 {
-    let [a, b, c] = mesh.face_positions(face);
-    (b - a).cross(c - a).normalize_or_zero()
 }
 
 /// The new vertex on edge `(a, b)`: lifted toward the curve of the two vertex normals where the

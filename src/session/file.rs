@@ -17,7 +17,7 @@ use super::history::Entry;
 use super::{BrushSettings, History, LayerSettings, ProximityPolicy, Session};
 use crate::codec::{DecodeError, Reader, Writer};
 use crate::io::{AtomicBatch, ImportOptions, ImportReport, IoError};
-use crate::mesh::{Brdf, LayerId, Mesh, MeshDelta, RawMeshError};
+use crate::mesh::{Brdf, Mesh, MeshDelta, RawMeshError};
 
 /// The first bytes of every session file: a high byte and a CR-LF/LF pair catch transfers
 /// that mangle binary files, as PNG's do.
@@ -354,8 +354,7 @@ pub fn stage(
     if is_session_path(path) {
         batch.stage(path, &write_session(session, with_history))
     } else {
-        let all: Vec<LayerId> = (0..session.layers.len() as LayerId).collect();
-        let fuse = session.fuse_layers(&all);
+        let fuse = session.all_fuse_layers();
         crate::io::stage_mesh_with(batch, &session.mesh, path, &fuse)
     }
 }

@@ -239,6 +239,12 @@ impl Session {
             .collect()
     }
 
+    /// Every layer whose policy is fuse (what a slayer PLY marks, what `check` reports).
+    pub fn all_fuse_layers(&self) -> Vec<LayerId> {
+        let all: Vec<LayerId> = (0..self.layers.len() as LayerId).collect();
+        self.fuse_layers(&all)
+    }
+
     /// A whole stroke through `pipeline`, as one history entry named after its brush.
     pub fn apply_stroke(
         &mut self,

@@ -121,3 +121,17 @@ pub fn crossing_edges(h: f32) -> (slayer::mesh::Mesh, slayer::brush::Stroke) {
     );
     (mesh, stroke)
 }
+
+/// Points from `from` to `to`, `count` of them, ends included: a stroke's path.
+pub fn line(from: glam::Vec3, to: glam::Vec3, count: usize) -> Vec<glam::Vec3> {
+    (0..count)
+        .map(|i| from.lerp(to, i as f32 / (count - 1) as f32))
+        .collect()
+}
+
+/// The volume `mesh` encloses, which must be one closed component.
+pub fn closed_volume(mesh: &slayer::mesh::Mesh) -> f64 {
+    let closed = mesh.closed_components();
+    assert_eq!(closed.len(), 1, "one closed component");
+    closed[0].volume
+}

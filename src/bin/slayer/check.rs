@@ -29,9 +29,8 @@ pub fn report(file: &Path, against: Option<&Path>, strict: bool) -> anyhow::Resu
 fn load(file: &Path, strict: bool) -> anyhow::Result<(slayer::mesh::Mesh, ImportReport)> {
     Ok(if slayer::session::is_session_path(file) {
         let session = slayer::session::open(file)?;
-        let all: Vec<u32> = (0..session.layers().len() as u32).collect();
         let notes = ImportReport {
-            fuse_layers: session.fuse_layers(&all),
+            fuse_layers: session.all_fuse_layers(),
             ..ImportReport::default()
         };
         (session.into_mesh(), notes)
