@@ -224,8 +224,15 @@ fn remeshing_after_strokes_keeps_layers_apart() {
                 .get(v as usize)
                 .is_none_or(|&p| p != mesh.positions()[v as usize])
         };
+        // Remeshing keeps the layers the collision distance apart, as the strokes do.
+        let d = PipelineSettings::default().collision_distance * pipeline.edge_length().unwrap();
+        let gap = slayer::collide::smallest_layer_gap(&mesh, 3.0 * d).unwrap();
         let band = edge_band_fraction_where(&mesh, edge as f64, |a, b| worked(a) || worked(b));
-        eprintln!("{kind}: band {band}");
+        eprintln!("{kind}: band {band}, layer gap {gap:?} (d = {d})");
+        assert!(
+            gap.is_some_and(|g| g >= 0.99 * d),
+            "{kind}: layers came {gap:?} apart (d = {d})"
+        );
         assert!(band > 0.7, "{kind}: {band} of the worked edges in band");
         assert!(
             edits > 100,

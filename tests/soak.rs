@@ -1,7 +1,8 @@
 //! The soak test: random strokes of every brush, with random layers, radii (extreme ones
 //! included), strengths and pressures, remeshing on, over plaster and a closed sphere, checked
-//! exactly every 25 strokes — 0 intersecting triangle pairs, `validate()`, bounded growth —
-//! through the session, so every stroke is also undone at the end back to the input.
+//! exactly every 25 strokes — 0 intersecting triangle pairs, layers at least the collision
+//! distance apart, `validate()`, bounded growth — through the session, so every stroke is also
+//! undone at the end back to the input.
 //!
 //! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 2.5 minutes
 //! on two cores). The full one, 10⁴ strokes on ~20K faces:
@@ -16,7 +17,7 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::brush::{BrushKind, LayerRef, SampleSpec, StrokeFile, StrokeSpec};
-use slayer::collide::find_intersections;
+use slayer::collide::{find_intersections, smallest_layer_gap};
 use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings};
 use slayer::scene::{SceneKind, SceneSpec, generate};
@@ -166,6 +167,15 @@ fn soak(kind: SceneKind, seed: u64) {
             assert_eq!(
                 crossings, 0,
                 "{kind:?}: {crossings} crossings after stroke {i}, the last {as_json}"
+            );
+            // Layers stay the collision distance apart (the pipeline's `d`, 1·L), remeshing
+            // included.
+            let d = pipeline.edge_length().unwrap_or(edge_at_start)
+                * PipelineSettings::default().collision_distance;
+            let gap = smallest_layer_gap(mesh, 3.0 * d).unwrap();
+            assert!(
+                gap.is_none_or(|g| g >= 0.99 * d),
+                "{kind:?}: layers {gap:?} apart after stroke {i} (d = {d}), the last {as_json}"
             );
             // Remeshing keeps the edge length; the surface grows where grabs pull it out (a
             // grab as wide as the sphere dragged five of its radii out of a crumpled side

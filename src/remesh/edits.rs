@@ -238,7 +238,7 @@ impl Remesher<'_> {
                 continue;
             };
             let new_faces = [([x, a, y], after[0]), ([y, b, x], after[1])];
-            if !self.faces_clear(&new_faces, &[], &[c / 3, o / 3]) {
+            if !self.flip_is_clear(&new_faces, [c / 3, o / 3], &before) {
                 self.report.refused += 1;
                 continue;
             }

@@ -7,8 +7,10 @@
 //! Remeshing never creates interpenetration: a vertex moved by a collapse or by relaxation may
 //! not come closer than the collision distance to another layer (or to a part of its own layer
 //! outside its neighbourhood) than it already was, and the triangles a flip or a collapse
-//! creates are tested exactly against the other layers' triangles nearby. Splits do not move
-//! the surface. The grid is kept up to date through every edit.
+//! creates are tested exactly against the other layers' triangles nearby. The layer gap is kept
+//! both ways: no other layer's vertex within the collision distance of the faces an edit makes
+//! may be nearer to them than to the faces they replace, and a split's new vertex no nearer to
+//! another layer than its edge's ends. The grid is kept up to date through every edit.
 //!
 //! Remeshing keeps the shape (`shape`): no edit moves the surface more than
 //! [`SHAPE_TOLERANCE`]·L from where it was, nor changes a closed component's volume past

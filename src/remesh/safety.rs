@@ -48,12 +48,11 @@ impl Remesher<'_> {
                 Some((ids, at))
             })
             .collect();
-        // One gathering serves both tests: faces near the move (for the distance test) and near
-        // the moved faces (for the crossing test).
+        // One gathering serves every test: faces near the move (for the distance test), near
+        // the moved faces (for the crossing test) and, with other layers about, within the
+        // collision distance of the moved faces (their corners for the layer gap).
         let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = moved.iter().fold(reach, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
+        let around = self.gap_reach(&moved).including_box(&reach);
         let near = self.gather_near(&around);
         let mut safe = true;
         for candidate in &near {
@@ -77,9 +76,95 @@ impl Remesher<'_> {
         }
         self.scratch = ring;
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
-        let clear = safe && self.faces_clear_among(&moved, &involved, &[], &near);
+        let clear = safe
+            && self.faces_clear_among(&moved, &involved, &[], &near)
+            && self.keeps_layer_gap(layer, &self.faces_now(&involved), &moved, &near);
         self.near = near;
         clear
+    }
+
+    /// Flipping an edge replaces the two faces `before` by `after`: the new faces cross nothing
+    /// and keep the layer gap.
+    pub(super) fn flip_is_clear(
+        &mut self,
+        after: &[([u32; 3], [Vec3; 3])],
+        replaced: [u32; 2],
+        before: &[[Vec3; 3]],
+    ) -> bool {
+        let layer = self.mesh.face_layers()[replaced[0] as usize];
+        let near = self.gather_near(&self.gap_reach(after));
+        let clear = self.faces_clear_among(after, &[], &replaced, &near)
+            && self.keeps_layer_gap(layer, before, after, &near);
+        self.near = near;
+        clear
+    }
+
+    /// The box to gather faces in around `triangles`: their bounds, widened by the collision
+    /// distance where other layers may be near (so that every other layer's vertex within
+    /// that distance is a corner of a gathered face).
+    fn gap_reach(&self, triangles: &[([u32; 3], [Vec3; 3])]) -> Aabb {
+        let bounds = triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
+        if self.mesh.layer_count() > 1 {
+            bounds.expanded(self.settings.collision_distance)
+        } else {
+            bounds
+        }
+    }
+
+    /// The faces around `vertices` at their positions now (each once).
+    fn faces_now(&self, vertices: &[u32]) -> Vec<[Vec3; 3]> {
+        let positions = self.mesh.positions();
+        let mut faces: Vec<u32> = vertices
+            .iter()
+            .flat_map(|&w| self.mesh.faces_around(w).collect::<Vec<_>>())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+            .iter()
+            .map(|&f| self.mesh.faces()[f as usize].map(|w| positions[w as usize]))
+            .collect()
+    }
+
+    /// The layer gap kept through an edit that replaces the surface `before` (triangles of
+    /// `layer`) by `after`: no vertex of another layer within the collision distance of `after`
+    /// may be nearer to it than it was to `before`. The collision response keeps this for a
+    /// stroke's moves (`collide::gap_guard`); without it here, relaxing and collapsing faces
+    /// toward a still vertex of a layer beneath brought layers to 0.86·d.
+    fn keeps_layer_gap(
+        &self,
+        layer: crate::mesh::LayerId,
+        before: &[[Vec3; 3]],
+        after: &[([u32; 3], [Vec3; 3])],
+        near: &[NearFace],
+    ) -> bool {
+        let d = self.settings.collision_distance;
+        let bounds = after.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
+        let nearest = |p: Vec3, triangles: &mut dyn Iterator<Item = [Vec3; 3]>| {
+            triangles
+                .map(|[a, b, c]| closest_point_on_triangle(p, a, b, c).distance(p))
+                .fold(f32::INFINITY, f32::min)
+        };
+        let face_layers = self.mesh.face_layers();
+        for candidate in near {
+            if face_layers[candidate.face as usize] == layer {
+                continue;
+            }
+            for p in candidate.at {
+                if !bounds.within(p, d) {
+                    continue;
+                }
+                let now = nearest(p, &mut after.iter().map(|(_, t)| *t));
+                if now < d && now < nearest(p, &mut before.iter().copied()) {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// Splitting the edge opposite corner `c` puts the new vertex where floats round the
@@ -106,7 +191,35 @@ impl Remesher<'_> {
             halves.push(([y, m, a], [p(y), at_m, p(a)]));
             replaced.push(o / 3);
         }
-        self.faces_clear(&halves, &[], &replaced)
+        let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
+        let near = self.gather_near(&self.gap_reach(&halves));
+        let clear = self.faces_clear_among(&halves, &[], &replaced, &near)
+            && self.midpoint_keeps_gap(layer, ends, at_m, &near);
+        self.near = near;
+        clear
+    }
+
+    /// A split's new vertex `m` on the edge `ends` is no nearer to another layer's face within
+    /// the collision distance than the nearer end is: distance to a face is convex along the
+    /// edge, so the midpoint of an edge that passes over another layer's ridge can be nearer
+    /// than either end, and the vertex would show a gap the vertices never had.
+    fn midpoint_keeps_gap(
+        &self,
+        layer: crate::mesh::LayerId,
+        (a, b): (Vec3, Vec3),
+        m: Vec3,
+        near: &[NearFace],
+    ) -> bool {
+        let d = self.settings.collision_distance;
+        let face_layers = self.mesh.face_layers();
+        near.iter()
+            .filter(|c| face_layers[c.face as usize] != layer && c.bounds.within(m, d))
+            .all(|c| {
+                let [x, y, z] = c.at;
+                let distance = |p: Vec3| closest_point_on_triangle(p, x, y, z).distance(p);
+                let now = distance(m);
+                now >= d || now >= distance(a).min(distance(b))
+            })
     }
 
     /// The faces filed near `query` (live ones, at their current positions), in the reusable
@@ -133,22 +246,6 @@ impl Remesher<'_> {
             }
         });
         near
-    }
-
-    /// [`faces_clear_among`](Self::faces_clear_among) the faces near the triangles.
-    pub(super) fn faces_clear(
-        &mut self,
-        triangles: &[([u32; 3], [Vec3; 3])],
-        moving: &[u32],
-        replaced: &[u32],
-    ) -> bool {
-        let bounds = triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
-        let near = self.gather_near(&bounds);
-        let clear = self.faces_clear_among(triangles, moving, replaced, &near);
-        self.near = near;
-        clear
     }
 
     /// No triangle in `triangles` (vertex ids and the positions they will have) crosses a nearby
