@@ -26,10 +26,28 @@ fn all_on_gpu() -> GpuKernels {
     kernels
 }
 
+/// How large a test's strokes are. On lavapipe every proximity pass costs in proportion to the
+/// vertices a step moves (about 9 s a sample for the bench's strokes, radius 12·L, all on the
+/// GPU), so each test takes the fewest and smallest strokes that still run what it checks
+/// (and asserts that they do: collisions, runs ahead, extra steps, remeshing).
+#[derive(Clone, Copy)]
+struct Size {
+    strokes: usize,
+    samples: usize,
+    radius_edges: f32,
+}
+
+/// Two short strokes of a brush half the bench's: enough to collide on every path.
+const SHORT: Size = Size {
+    strokes: 2,
+    samples: 10,
+    radius_edges: 6.0,
+};
+
 /// The plaster scene, remeshed once to its mean edge as sculpting keeps it: the generated
 /// scene has a few edges 3.5 times the mean around its holes, and the broad phase's reach
 /// (and the GPU's work per moving vertex, cubed) follows the longest edge.
-fn plaster_and_strokes(strokes: usize) -> (Mesh, Vec<slayer::brush::Stroke>) {
+fn plaster_and_strokes(size: Size) -> (Mesh, Vec<slayer::brush::Stroke>) {
     let mut mesh = generate(&SceneSpec {
         kind: SceneKind::Plaster,
         triangles: 2_000,
@@ -41,8 +59,10 @@ fn plaster_and_strokes(strokes: usize) -> (Mesh, Vec<slayer::brush::Stroke>) {
     let script = generate_script(
         &mesh,
         &ScriptSpec {
-            strokes,
+            strokes: size.strokes,
             seed: 9,
+            samples: size.samples,
+            radius_edges: size.radius_edges,
             ..ScriptSpec::default()
         },
     );
@@ -69,7 +89,7 @@ fn largest_deviation(a: &Mesh, b: &Mesh) -> f32 {
 
 #[test]
 fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
-    let (start, strokes) = plaster_and_strokes(3);
+    let (start, strokes) = plaster_and_strokes(SHORT);
     let edge = start.mean_edge_length();
     // Without remeshing the two meshes keep the same vertices and can be compared one by one.
     let settings = PipelineSettings {
@@ -106,7 +126,13 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
 /// mesh row for row after the stroke.
 #[test]
 fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
-    let (start, strokes) = plaster_and_strokes(1);
+    // The bench's stroke, whose samples each move less than a step (smaller brushes, with
+    // the same path, press harder per sample and take several).
+    let (start, strokes) = plaster_and_strokes(Size {
+        strokes: 1,
+        samples: 32,
+        radius_edges: 12.0,
+    });
     let report = check_run_ahead(&start, &strokes);
     assert_eq!(report.steps, report.samples, "one step a sample");
     assert!(report.uploads.read_backs < report.samples, "{report:?}");
@@ -122,7 +148,11 @@ fn samples_run_ahead_in_one_submission_match_the_cpu_pipeline() {
 /// they must go back with the move.)
 #[test]
 fn samples_of_several_steps_run_their_steps_ahead_and_match_the_cpu_pipeline() {
-    let (start, mut strokes) = plaster_and_strokes(2);
+    let (start, mut strokes) = plaster_and_strokes(Size {
+        samples: 12,
+        radius_edges: 12.0,
+        ..SHORT
+    });
     for stroke in &mut strokes {
         stroke.brush.kind = slayer::brush::BrushKind::Inflate;
         stroke.brush.strength = 1.0;
@@ -220,7 +250,7 @@ fn check_run_ahead(start: &Mesh, strokes: &[slayer::brush::Stroke]) -> RunAheadR
 /// selection rebuilds it only after a quarter of the brush radius of drift).
 #[test]
 fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
-    let (start, strokes) = plaster_and_strokes(2);
+    let (start, strokes) = plaster_and_strokes(SHORT);
     let settings = PipelineSettings::default();
     let mut on_cpu = start.clone();
     let mut cpu_pipeline = Pipeline::new(settings);
@@ -308,7 +338,7 @@ fn the_backstop_undoes_a_crossing_the_gpu_passes_cannot_see() {
 /// reported, and the result is what the CPU alone makes.
 #[test]
 fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
-    let (start, strokes) = plaster_and_strokes(2);
+    let (start, strokes) = plaster_and_strokes(SHORT);
     let settings = PipelineSettings {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
@@ -334,7 +364,7 @@ fn a_gpu_lost_mid_stroke_finishes_on_the_cpu() {
 /// run on the CPU with the CPU's result.
 #[test]
 fn a_mesh_over_the_gpu_budget_runs_on_the_cpu() {
-    let (start, strokes) = plaster_and_strokes(1);
+    let (start, strokes) = plaster_and_strokes(SHORT);
     let settings = PipelineSettings {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
@@ -359,7 +389,7 @@ fn a_mesh_over_the_gpu_budget_runs_on_the_cpu() {
 /// neighbours are bound as several pages, and the strokes give the CPU's result.
 #[test]
 fn arrays_past_the_binding_limit_are_split_into_pages() {
-    let (start, strokes) = plaster_and_strokes(2);
+    let (start, strokes) = plaster_and_strokes(SHORT);
     let settings = PipelineSettings {
         remeshing: Remeshing::Off,
         ..PipelineSettings::default()
@@ -424,7 +454,10 @@ fn selection_after_remeshing_finds_new_vertices_through_the_overlay() {
     use slayer::grid::SpatialHash;
     use slayer::pipeline::{CpuKernels, StepKernels};
 
-    let (mut mesh, _) = plaster_and_strokes(0);
+    let (mut mesh, _) = plaster_and_strokes(Size {
+        strokes: 0,
+        ..SHORT
+    });
     let edge = mesh.mean_edge_length();
     let center = mesh.positions()[mesh.vertex_count() / 2];
     let dab = Dab {
