@@ -173,72 +173,80 @@ fn remeshing_an_irregular_sheet_makes_edges_uniform() {
 /// more than `remesh::SHAPE_TOLERANCE`·L (measured: 86–87 % in band before the shape bound,
 /// 75–77 % with it; the bench's strokes reach 99 %).
 #[test]
-fn remeshing_after_strokes_keeps_layers_apart() {
+fn remeshing_after_strokes_keeps_plaster_layers_apart() {
+    remeshing_after_strokes_keeps_layers_apart(SceneKind::Plaster, 21);
+}
+
+#[test]
+fn remeshing_after_strokes_keeps_bark_layers_apart() {
+    remeshing_after_strokes_keeps_layers_apart(SceneKind::Bark, 22);
+}
+
+#[test]
+fn remeshing_after_strokes_keeps_metal_layers_apart() {
+    remeshing_after_strokes_keeps_layers_apart(SceneKind::Metal, 23);
+}
+
+fn remeshing_after_strokes_keeps_layers_apart(kind: SceneKind, seed: u64) {
     use slayer::bench::{BrushMix, ScriptSpec, edge_band_fraction_where, generate_script};
     use slayer::pipeline::{Pipeline, PipelineSettings, Remeshing};
-    for (kind, seed) in [
-        (SceneKind::Plaster, 21),
-        (SceneKind::Bark, 22),
-        (SceneKind::Metal, 23),
-    ] {
-        let mut mesh = generate(&SceneSpec {
-            kind,
-            triangles: 6_000,
+    let mut mesh = generate(&SceneSpec {
+        kind,
+        triangles: 6_000,
+        seed,
+    })
+    .unwrap();
+    let edge = mesh.mean_edge_length();
+    let start = mesh.positions().to_vec();
+    let script = generate_script(
+        &mesh,
+        &ScriptSpec {
+            strokes: 30,
             seed,
-        })
-        .unwrap();
-        let edge = mesh.mean_edge_length();
-        let start = mesh.positions().to_vec();
-        let script = generate_script(
-            &mesh,
-            &ScriptSpec {
-                strokes: 30,
-                seed,
-                samples: 16,
-                mix: BrushMix::Torture,
-                ..ScriptSpec::default()
-            },
-        );
-        let strokes = script.resolve(&mesh, "script").unwrap();
-        let mut pipeline = Pipeline::new(PipelineSettings {
-            remeshing: Remeshing::AfterStroke,
-            ..PipelineSettings::default()
-        });
-        let mut edits = 0;
-        for (i, stroke) in strokes.iter().enumerate() {
-            let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
-            edits += report.remesh.splits + report.remesh.collapses + report.remesh.flips;
-            if i % 8 == 7 {
-                mesh.validate()
-                    .unwrap_or_else(|e| panic!("{kind} stroke {i}: {e}"));
-                let x = find_intersections(&mesh);
-                assert_eq!(x.total(), 0, "{kind} after stroke {i}: {x:?}");
-            }
+            samples: 16,
+            mix: BrushMix::Torture,
+            ..ScriptSpec::default()
+        },
+    );
+    let strokes = script.resolve(&mesh, "script").unwrap();
+    let mut pipeline = Pipeline::new(PipelineSettings {
+        remeshing: Remeshing::AfterStroke,
+        ..PipelineSettings::default()
+    });
+    let mut edits = 0;
+    for (i, stroke) in strokes.iter().enumerate() {
+        let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+        edits += report.remesh.splits + report.remesh.collapses + report.remesh.flips;
+        if i % 8 == 7 {
+            mesh.validate()
+                .unwrap_or_else(|e| panic!("{kind} stroke {i}: {e}"));
+            let x = find_intersections(&mesh);
+            assert_eq!(x.total(), 0, "{kind} after stroke {i}: {x:?}");
         }
-        mesh.validate().unwrap();
-        assert!(mesh.positions().iter().all(|p| p.is_finite()));
-        let x = find_intersections(&mesh);
-        assert_eq!(x.total(), 0, "{kind}: {x:?}");
-        let worked = |v: u32| {
-            start
-                .get(v as usize)
-                .is_none_or(|&p| p != mesh.positions()[v as usize])
-        };
-        // Remeshing keeps the layers the collision distance apart, as the strokes do.
-        let d = PipelineSettings::default().collision_distance * pipeline.edge_length().unwrap();
-        let gap = slayer::collide::smallest_layer_gap(&mesh, 3.0 * d).unwrap();
-        let band = edge_band_fraction_where(&mesh, edge as f64, |a, b| worked(a) || worked(b));
-        eprintln!("{kind}: band {band}, layer gap {gap:?} (d = {d})");
-        assert!(
-            gap.is_some_and(|g| g >= 0.99 * d),
-            "{kind}: layers came {gap:?} apart (d = {d})"
-        );
-        assert!(band > 0.7, "{kind}: {band} of the worked edges in band");
-        assert!(
-            edits > 100,
-            "{kind}: the torture strokes called for only {edits} edits"
-        );
     }
+    mesh.validate().unwrap();
+    assert!(mesh.positions().iter().all(|p| p.is_finite()));
+    let x = find_intersections(&mesh);
+    assert_eq!(x.total(), 0, "{kind}: {x:?}");
+    let worked = |v: u32| {
+        start
+            .get(v as usize)
+            .is_none_or(|&p| p != mesh.positions()[v as usize])
+    };
+    // Remeshing keeps the layers the collision distance apart, as the strokes do.
+    let d = PipelineSettings::default().collision_distance * pipeline.edge_length().unwrap();
+    let gap = slayer::collide::smallest_layer_gap(&mesh, 3.0 * d).unwrap();
+    let band = edge_band_fraction_where(&mesh, edge as f64, |a, b| worked(a) || worked(b));
+    eprintln!("{kind}: band {band}, layer gap {gap:?} (d = {d})");
+    assert!(
+        gap.is_some_and(|g| g >= 0.99 * d),
+        "{kind}: layers came {gap:?} apart (d = {d})"
+    );
+    assert!(band > 0.7, "{kind}: {band} of the worked edges in band");
+    assert!(
+        edits > 100,
+        "{kind}: the torture strokes called for only {edits} edits"
+    );
 }
 
 /// Remeshing after every sample: more passes than strokes, and the same guarantees.

@@ -141,30 +141,32 @@ impl Remesher<'_> {
         near: &[NearFace],
     ) -> bool {
         let d = self.settings.collision_distance;
-        let bounds = after.iter().fold(Aabb::EMPTY, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
-        let nearest = |p: Vec3, triangles: &mut dyn Iterator<Item = [Vec3; 3]>| {
+        let boxes: Vec<Aabb> = after.iter().map(|(_, t)| Aabb::of_points(t)).collect();
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.including_box(t));
+        // The other layers' vertices within reach, each once (a vertex has several faces).
+        let face_layers = self.mesh.face_layers();
+        let mut vertices: Vec<(u32, Vec3)> = near
+            .iter()
+            .filter(|c| face_layers[c.face as usize] != layer)
+            .flat_map(|c| c.ids.into_iter().zip(c.at))
+            .filter(|&(_, p)| bounds.within(p, d))
+            .collect();
+        vertices.sort_unstable_by_key(|&(w, _)| w);
+        vertices.dedup_by_key(|&mut (w, _)| w);
+        let nearest = |p: Vec3, triangles: &mut dyn Iterator<Item = &[Vec3; 3]>| {
             triangles
-                .map(|[a, b, c]| closest_point_on_triangle(p, a, b, c).distance(p))
+                .map(|&[a, b, c]| closest_point_on_triangle(p, a, b, c).distance(p))
                 .fold(f32::INFINITY, f32::min)
         };
-        let face_layers = self.mesh.face_layers();
-        for candidate in near {
-            if face_layers[candidate.face as usize] == layer {
-                continue;
-            }
-            for p in candidate.at {
-                if !bounds.within(p, d) {
-                    continue;
-                }
-                let now = nearest(p, &mut after.iter().map(|(_, t)| *t));
-                if now < d && now < nearest(p, &mut before.iter().copied()) {
-                    return false;
-                }
-            }
-        }
-        true
+        vertices.iter().all(|&(_, p)| {
+            let mut within_reach = after
+                .iter()
+                .zip(&boxes)
+                .filter(|(_, b)| b.within(p, d))
+                .map(|((_, t), _)| t);
+            let now = nearest(p, &mut within_reach);
+            now >= d || now >= nearest(p, &mut before.iter())
+        })
     }
 
     /// Splitting the edge opposite corner `c` puts the new vertex where floats round the
