@@ -48,11 +48,12 @@ impl Remesher<'_> {
                 Some((ids, at))
             })
             .collect();
-        // One gathering serves every test: faces near the move (for the distance test), near
-        // the moved faces (for the crossing test) and, with other layers about, within the
-        // collision distance of the moved faces (their corners for the layer gap).
+        // One gathering serves both tests: faces near the move (for the distance test) and near
+        // the moved faces (for the crossing test).
         let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = self.gap_reach(&moved).including_box(&reach);
+        let around = moved.iter().fold(reach, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
         let near = self.gather_near(&around);
         let mut safe = true;
         for candidate in &near {
@@ -78,7 +79,7 @@ impl Remesher<'_> {
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
         let clear = safe
             && self.faces_clear_among(&moved, &involved, &[], &near)
-            && self.keeps_layer_gap(layer, &self.faces_now(&involved), &moved, &near);
+            && self.keeps_layer_gap(layer, &self.faces_now(&involved), &moved);
         self.near = near;
         clear
     }
@@ -92,25 +93,14 @@ impl Remesher<'_> {
         before: &[[Vec3; 3]],
     ) -> bool {
         let layer = self.mesh.face_layers()[replaced[0] as usize];
-        let near = self.gather_near(&self.gap_reach(after));
-        let clear = self.faces_clear_among(after, &[], &replaced, &near)
-            && self.keeps_layer_gap(layer, before, after, &near);
-        self.near = near;
-        clear
-    }
-
-    /// The box to gather faces in around `triangles`: their bounds, widened by the collision
-    /// distance where other layers may be near (so that every other layer's vertex within
-    /// that distance is a corner of a gathered face).
-    fn gap_reach(&self, triangles: &[([u32; 3], [Vec3; 3])]) -> Aabb {
-        let bounds = triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+        let bounds = after.iter().fold(Aabb::EMPTY, |b, (_, t)| {
             b.including(t[0]).including(t[1]).including(t[2])
         });
-        if self.mesh.layer_count() > 1 {
-            bounds.expanded(self.settings.collision_distance)
-        } else {
-            bounds
-        }
+        let near = self.gather_near(&bounds);
+        let clear = self.faces_clear_among(after, &[], &replaced, &near)
+            && self.keeps_layer_gap(layer, before, after);
+        self.near = near;
+        clear
     }
 
     /// The faces around `vertices` at their positions now (each once).
@@ -132,41 +122,42 @@ impl Remesher<'_> {
     /// `layer`) by `after`: no vertex of another layer within the collision distance of `after`
     /// may be nearer to it than it was to `before`. The collision response keeps this for a
     /// stroke's moves (`collide::gap_guard`); without it here, relaxing and collapsing faces
-    /// toward a still vertex of a layer beneath brought layers to 0.86·d.
+    /// toward a still vertex of a layer beneath brought layers to 0.94·d. The vertices are
+    /// found through the vertex grid, which every edit keeps filed where its vertices are.
     fn keeps_layer_gap(
         &self,
         layer: crate::mesh::LayerId,
         before: &[[Vec3; 3]],
         after: &[([u32; 3], [Vec3; 3])],
-        near: &[NearFace],
     ) -> bool {
+        if self.mesh.layer_count() < 2 {
+            return true;
+        }
         let d = self.settings.collision_distance;
         let boxes: Vec<Aabb> = after.iter().map(|(_, t)| Aabb::of_points(t)).collect();
         let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.including_box(t));
-        // The other layers' vertices within reach, each once (a vertex has several faces).
-        let face_layers = self.mesh.face_layers();
-        let mut vertices: Vec<(u32, Vec3)> = near
-            .iter()
-            .filter(|c| face_layers[c.face as usize] != layer)
-            .flat_map(|c| c.ids.into_iter().zip(c.at))
-            .filter(|&(_, p)| bounds.within(p, d))
-            .collect();
-        vertices.sort_unstable_by_key(|&(w, _)| w);
-        vertices.dedup_by_key(|&mut (w, _)| w);
         let nearest = |p: Vec3, triangles: &mut dyn Iterator<Item = &[Vec3; 3]>| {
             triangles
                 .map(|&[a, b, c]| closest_point_on_triangle(p, a, b, c).distance(p))
                 .fold(f32::INFINITY, f32::min)
         };
-        vertices.iter().all(|&(_, p)| {
+        let (positions, layers) = (self.mesh.positions(), self.mesh.vertex_layers());
+        let mut kept = true;
+        let reach = bounds.expanded(d);
+        self.grid.for_each_in_box(reach.min, reach.max, |w| {
+            let p = positions[w as usize];
+            if !kept || layers[w as usize] == layer || !bounds.within(p, d) {
+                return;
+            }
             let mut within_reach = after
                 .iter()
                 .zip(&boxes)
                 .filter(|(_, b)| b.within(p, d))
                 .map(|((_, t), _)| t);
             let now = nearest(p, &mut within_reach);
-            now >= d || now >= nearest(p, &mut before.iter())
-        })
+            kept = now >= d || now >= nearest(p, &mut before.iter());
+        });
+        kept
     }
 
     /// Splitting the edge opposite corner `c` puts the new vertex where floats round the
@@ -194,7 +185,15 @@ impl Remesher<'_> {
             replaced.push(o / 3);
         }
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
-        let near = self.gather_near(&self.gap_reach(&halves));
+        // The halves lie on the faces they replace: only the new vertex needs the wider reach.
+        let mut reach = halves.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+            b.including(t[0]).including(t[1]).including(t[2])
+        });
+        if self.mesh.layer_count() > 1 {
+            let d = self.settings.collision_distance;
+            reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
+        }
+        let near = self.gather_near(&reach);
         let clear = self.faces_clear_among(&halves, &[], &replaced, &near)
             && self.midpoint_keeps_gap(layer, ends, at_m, &near);
         self.near = near;
