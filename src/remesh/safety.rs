@@ -51,9 +51,7 @@ impl Remesher<'_> {
         // One gathering serves both tests: faces near the move (for the distance test) and near
         // the moved faces (for the crossing test).
         let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = moved.iter().fold(reach, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
+        let around = bounds_of(&moved).including_box(&reach);
         let near = self.gather_near(&around);
         let mut safe = true;
         for candidate in &near {
@@ -93,10 +91,7 @@ impl Remesher<'_> {
         before: &[[Vec3; 3]],
     ) -> bool {
         let layer = self.mesh.face_layers()[replaced[0] as usize];
-        let bounds = after.iter().fold(Aabb::EMPTY, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
-        let near = self.gather_near(&bounds);
+        let near = self.gather_near(&bounds_of(after));
         let clear = self.faces_clear_among(after, &[], &replaced, &near)
             && self.keeps_layer_gap(layer, before, after);
         self.near = near;
@@ -186,9 +181,7 @@ impl Remesher<'_> {
         }
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
         // The halves lie on the faces they replace: only the new vertex needs the wider reach.
-        let mut reach = halves.iter().fold(Aabb::EMPTY, |b, (_, t)| {
-            b.including(t[0]).including(t[1]).including(t[2])
-        });
+        let mut reach = bounds_of(&halves);
         if self.mesh.layer_count() > 1 {
             let d = self.settings.collision_distance;
             reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
@@ -295,4 +288,11 @@ impl Remesher<'_> {
         }
         true
     }
+}
+
+/// The box around triangles given as (vertex ids, positions).
+fn bounds_of(triangles: &[([u32; 3], [Vec3; 3])]) -> Aabb {
+    triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
+        b.including(t[0]).including(t[1]).including(t[2])
+    })
 }
