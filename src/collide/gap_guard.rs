@@ -16,7 +16,7 @@ use super::LocalFaceGrid;
 use super::region::{Region, StepMoves, map_with_scratch, start_position, triangle};
 use super::state::StrokeState;
 use crate::abi::CLAMP_SLACK;
-use crate::geom::{Aabb, closest_point_on_triangle};
+use crate::geom::{Aabb, point_triangle_distance};
 use crate::mesh::{INVALID, Mesh};
 
 /// Undoes the moves of every face and vertex of different layers that came closer than the
@@ -123,10 +123,8 @@ fn vertices_too_close(
         if !(p.cmpge(near.min).all() && p.cmple(near.max).all()) {
             return;
         }
-        let distance =
-            |p: Vec3, t: [Vec3; 3]| closest_point_on_triangle(p, t[0], t[1], t[2]).distance(p);
-        let here = distance(p, now);
-        if here < d && here < d.min(distance(start_of(y), then)) - CLAMP_SLACK * d {
+        let here = point_triangle_distance(p, now);
+        if here < d && here < d.min(point_triangle_distance(start_of(y), then)) - CLAMP_SLACK * d {
             found.push(y);
         }
     };

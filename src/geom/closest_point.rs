@@ -81,6 +81,12 @@ fn closest_point_in_order(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     a + ab * v + ac * w
 }
 
+/// Distance from `p` to the triangle `[a, b, c]`.
+#[inline]
+pub fn point_triangle_distance(p: Vec3, [a, b, c]: [Vec3; 3]) -> f32 {
+    closest_point_on_triangle(p, a, b, c).distance(p)
+}
+
 /// Squared distance from `p` to triangle `abc`.
 pub fn point_triangle_distance_squared(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     closest_point_on_triangle(p, a, b, c).distance_squared(p)

@@ -8,7 +8,9 @@ mod ray;
 mod separation;
 mod tri_tri;
 
-pub use closest_point::{closest_point_on_triangle, point_triangle_distance_squared};
+pub use closest_point::{
+    closest_point_on_triangle, point_triangle_distance, point_triangle_distance_squared,
+};
 pub use order_free::{corner_cross, fan_normal, order_free_sum};
 pub use ray::{Ray, ray_triangle};
 pub use separation::surely_disjoint;

@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::{NearFace, Remesher, SPLIT_AT};
 use crate::collide::neighbourhood::ring_vertices;
-use crate::geom::{Aabb, closest_point_on_triangle, neighbours_overlap, triangles_intersect};
+use crate::geom::{Aabb, neighbours_overlap, point_triangle_distance, triangles_intersect};
 use crate::mesh::INVALID;
 
 impl Remesher<'_> {
@@ -27,12 +27,21 @@ impl Remesher<'_> {
         let layer = self.mesh.vertex_layers()[v as usize];
         let positions = self.mesh.positions();
         let faces = self.mesh.faces();
-        // The faces that will carry the vertex, at their new positions.
-        let moved: Vec<([u32; 3], [Vec3; 3])> = [Some(v), merged]
+        let carrying: Vec<u32> = [Some(v), merged]
             .into_iter()
             .flatten()
             .flat_map(|w| self.mesh.faces_around(w).collect::<Vec<_>>())
-            .filter_map(|f| {
+            .collect();
+        // The surface the edit replaces, as it is now (a face around both ends comes twice,
+        // which a nearest distance does not mind).
+        let before: Vec<[Vec3; 3]> = carrying
+            .iter()
+            .map(|&f| faces[f as usize].map(|w| positions[w as usize]))
+            .collect();
+        // The faces that will carry the vertex, at their new positions.
+        let moved: Vec<([u32; 3], [Vec3; 3])> = carrying
+            .iter()
+            .filter_map(|&f| {
                 let tri = faces[f as usize];
                 if merged.is_some_and(|m| tri.contains(&m) && tri.contains(&v)) {
                     return None;
@@ -66,9 +75,8 @@ impl Remesher<'_> {
             if !candidate.bounds.within(target, d) {
                 continue;
             }
-            let [a, b, c] = candidate.at;
-            let now = closest_point_on_triangle(target, a, b, c).distance(target);
-            if now < d && now < closest_point_on_triangle(from, a, b, c).distance(from) {
+            let now = point_triangle_distance(target, candidate.at);
+            if now < d && now < point_triangle_distance(from, candidate.at) {
                 safe = false;
                 break;
             }
@@ -77,7 +85,7 @@ impl Remesher<'_> {
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
         let clear = safe
             && self.faces_clear_among(&moved, &involved, &[], &near)
-            && self.keeps_layer_gap(layer, &self.faces_now(&involved), &moved);
+            && self.keeps_layer_gap(layer, &before, &moved);
         self.near = near;
         clear
     }
@@ -96,21 +104,6 @@ impl Remesher<'_> {
             && self.keeps_layer_gap(layer, before, after);
         self.near = near;
         clear
-    }
-
-    /// The faces around `vertices` at their positions now (each once).
-    fn faces_now(&self, vertices: &[u32]) -> Vec<[Vec3; 3]> {
-        let positions = self.mesh.positions();
-        let mut faces: Vec<u32> = vertices
-            .iter()
-            .flat_map(|&w| self.mesh.faces_around(w).collect::<Vec<_>>())
-            .collect();
-        faces.sort_unstable();
-        faces.dedup();
-        faces
-            .iter()
-            .map(|&f| self.mesh.faces()[f as usize].map(|w| positions[w as usize]))
-            .collect()
     }
 
     /// The layer gap kept through an edit that replaces the surface `before` (triangles of
@@ -133,7 +126,7 @@ impl Remesher<'_> {
         let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.including_box(t));
         let nearest = |p: Vec3, triangles: &mut dyn Iterator<Item = &[Vec3; 3]>| {
             triangles
-                .map(|&[a, b, c]| closest_point_on_triangle(p, a, b, c).distance(p))
+                .map(|&t| point_triangle_distance(p, t))
                 .fold(f32::INFINITY, f32::min)
         };
         let (positions, layers) = (self.mesh.positions(), self.mesh.vertex_layers());
@@ -209,8 +202,7 @@ impl Remesher<'_> {
         near.iter()
             .filter(|c| face_layers[c.face as usize] != layer && c.bounds.within(m, d))
             .all(|c| {
-                let [x, y, z] = c.at;
-                let distance = |p: Vec3| closest_point_on_triangle(p, x, y, z).distance(p);
+                let distance = |p: Vec3| point_triangle_distance(p, c.at);
                 let now = distance(m);
                 now >= d || now >= distance(a).min(distance(b))
             })
