@@ -56,6 +56,11 @@ fn assert_sound(mesh: &Mesh, context: &str) {
         "{context}: a layer crosses itself: {:?}",
         report.examples
     );
+    assert_eq!(
+        report.folded_neighbours, 0,
+        "{context}: a face folded onto its neighbour: {:?}",
+        report.examples
+    );
 }
 
 /// A straight push of the upper layers down through everything, at full strength.

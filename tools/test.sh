@@ -70,6 +70,13 @@ cargo build --release --all-targets --quiet
 echo "tools/test.sh: GPU adapters, best first (the GPU tests use the first):"
 target/release/slayer adapters | sed 's/^/    /'
 
-cargo test --release --all-targets
+# cargo-nextest (on our machines) shares the cores across every test binary and starts the
+# longest tests first (.config/nextest.toml); plain cargo test runs the same tests otherwise.
+if cargo nextest --version >/dev/null 2>&1; then
+    cargo nextest run --release --all-targets --no-fail-fast
+else
+    echo "tools/test.sh: cargo-nextest not installed; running cargo test (the same tests, one binary at a time)"
+    cargo test --release --all-targets
+fi
 cargo test --release --doc --quiet
 echo "tools/test.sh: all tests passed"

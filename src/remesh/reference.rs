@@ -13,6 +13,10 @@ use crate::mesh::Mesh;
 /// How far (× L) a face may drift from where it was filed while remeshing. Relaxation moves a
 /// vertex a fraction of an edge per round and flips stay within the quad they replace.
 const MOVE_MARGIN: f32 = 1.0;
+/// Share of the search radius and of the point's size by which a triangle's box must lie
+/// beyond the best distance so far to be skipped: `f32` closest points are off by a few ulps
+/// of the coordinates, far less.
+const PRUNE_SLACK: f32 = 1e-4;
 
 pub struct ReferenceSurface {
     /// Faces near the region when remeshing began, their triangles then, and their layers.
@@ -28,6 +32,8 @@ pub struct ReferenceSurface {
     local: FxHashMap<u32, u32>,
     search: f32,
     seen: std::cell::RefCell<Stamps>,
+    /// The local face that last answered [`Self::is_near`].
+    last_near: std::cell::Cell<u32>,
 }
 
 impl ReferenceSurface {
@@ -79,6 +85,7 @@ impl ReferenceSurface {
         ReferenceSurface {
             descendants: vec![Vec::new(); faces.len()],
             seen: std::cell::RefCell::new(Stamps::default()),
+            last_near: std::cell::Cell::new(u32::MAX),
             faces,
             triangles,
             layers,
@@ -120,9 +127,8 @@ impl ReferenceSurface {
     /// Whether the original surface of `layer` comes within `distance` (at most an edge
     /// length) of `p`.
     pub fn is_near(&self, p: Vec3, layer: u32, distance: f32) -> bool {
-        let query = Aabb { min: p, max: p }.expanded(distance);
         let d2 = distance * distance;
-        self.grid.any_candidate(&query, |local| {
+        let near = |local: u32| {
             let i = local as usize;
             if self.layers[i] != layer {
                 return false;
@@ -134,6 +140,20 @@ impl ReferenceSurface {
                 return false;
             }
             closest_point_on_triangle(p, a, b, c).distance_squared(p) <= d2
+        };
+        // An edit asks about a few points close together: the face that answered the last
+        // question usually answers this one, without walking the grid.
+        let hint = self.last_near.get();
+        if (hint as usize) < self.faces.len() && near(hint) {
+            return true;
+        }
+        let query = Aabb { min: p, max: p }.expanded(distance);
+        self.grid.any_candidate(&query, |local| {
+            let found = near(local);
+            if found {
+                self.last_near.set(local);
+            }
+            found
         })
     }
 
@@ -141,6 +161,7 @@ impl ReferenceSurface {
     pub fn project(&self, p: Vec3, layer: u32) -> Option<Vec3> {
         let query = Aabb { min: p, max: p }.expanded(self.search);
         let mut best: Option<(f32, Vec3)> = None;
+        let slack = PRUNE_SLACK * (self.search + p.abs().max_element());
         let mut seen = self.seen.borrow_mut();
         seen.start(self.faces.len());
         self.grid.for_each_candidate(&query, |local| {
@@ -149,6 +170,14 @@ impl ReferenceSurface {
                 return;
             }
             let [a, b, c] = self.triangles[i];
+            // A triangle whose box is farther than the best so far cannot beat it; the slack
+            // keeps the skip clear of the closest point's rounding, so the answer is the same.
+            if let Some((best_d, _)) = best {
+                let gap = Aabb::of_points(&[a, b, c]).distance_squared_to(p).sqrt();
+                if gap > best_d.sqrt() + slack {
+                    return;
+                }
+            }
             let q = closest_point_on_triangle(p, a, b, c);
             let d = q.distance_squared(p);
             if best.is_none_or(|(bd, _)| d < bd) {
