@@ -106,6 +106,22 @@ impl LocalFaceGrid {
         }
     }
 
+    /// Calls `f` with the index of every cell overlapping `b` (clamped to the grid, as filing
+    /// and queries are): for callers that file more faces beside the grid's own.
+    pub fn for_each_cell(&self, b: &Aabb, mut f: impl FnMut(usize)) {
+        if self.offsets.is_empty() {
+            return;
+        }
+        let (lo, hi) = self.cell_range(b);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    f(self.index(IVec3::new(x, y, z)));
+                }
+            }
+        }
+    }
+
     /// Whether `f` holds for some local face filed in a cell overlapping `query`; stops at the
     /// first.
     pub fn any_candidate(&self, query: &Aabb, mut f: impl FnMut(u32) -> bool) -> bool {

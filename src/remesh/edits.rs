@@ -56,15 +56,11 @@ impl Remesher<'_> {
                 self.report.refused += 1;
                 continue;
             }
-            let (f, o) = (c / 3, self.mesh.adjacency().opposite[c as usize]);
-            let first_new = self.mesh.face_count() as u32;
+            let o = self.mesh.adjacency().opposite[c as usize];
             let m = self.mesh.split_edge(c, SPLIT_AT);
             self.closed.adopt(m, a);
             self.closed.record(a, 0.0, if o == INVALID { 1 } else { 2 });
-            self.surface.record_split(f, first_new);
-            if o != INVALID {
-                self.surface.record_split(o / 3, first_new + 1);
-            }
+            self.refile_faces_around(m);
             self.grid.insert(m, self.mesh.positions()[m as usize]);
             self.add_to_region(m);
             self.mark_dirty_around(m);
@@ -149,6 +145,7 @@ impl Remesher<'_> {
                 let removed = before.len() - after.len();
                 self.closed.record(survivor, volume, -(removed as isize));
                 self.grid.move_to(survivor, target);
+                self.refile_faces_around(survivor);
                 self.mark_dirty_around(survivor);
                 self.report.collapses += 1;
                 done = true;
@@ -244,6 +241,7 @@ impl Remesher<'_> {
             }
             self.closed.record(a, volume, 0);
             self.mesh.flip_edge(c);
+            self.surface.faces_changed(self.mesh, [c / 3, o / 3]);
             for w in [a, b, x, y] {
                 self.mark_dirty(w);
             }
@@ -348,6 +346,7 @@ impl Remesher<'_> {
             self.closed.record(v, volume, 0);
             self.mesh.positions_mut()[v as usize] = target;
             self.grid.move_to(v, target);
+            self.refile_faces_around(v);
             self.report.relaxed += 1;
         }
     }

@@ -369,6 +369,13 @@ impl<'a> Remesher<'a> {
         }
     }
 
+    /// The faces around `v` changed (an edit moved, added or rewired `v`): the reference
+    /// surface finds them where they are now.
+    fn refile_faces_around(&mut self, v: u32) {
+        let faces: Vec<u32> = self.mesh.faces_around(v).collect();
+        self.surface.faces_changed(self.mesh, faces);
+    }
+
     /// Marks `v` and its neighbours dirty: an edit at `v` changed all their one-rings.
     fn mark_dirty_around(&mut self, v: u32) {
         self.mark_dirty(v);

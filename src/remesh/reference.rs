@@ -8,28 +8,25 @@ use super::RemeshSettings;
 use crate::collide::{LocalFaceGrid, Stamps};
 use crate::geom::{Aabb, closest_point_on_triangle};
 use crate::grid::SpatialHash;
-use crate::mesh::Mesh;
+use crate::mesh::{INVALID, Mesh};
 
-/// How far (× L) a face may drift from where it was filed while remeshing. Relaxation moves a
-/// vertex a fraction of an edge per round and flips stay within the quad they replace.
-const MOVE_MARGIN: f32 = 1.0;
 /// Share of the search radius and of the point's size by which a triangle's box must lie
 /// beyond the best distance so far to be skipped: `f32` closest points are off by a few ulps
 /// of the coordinates, far less.
 const PRUNE_SLACK: f32 = 1e-4;
 
 pub struct ReferenceSurface {
-    /// Faces near the region when remeshing began, their triangles then, and their layers.
+    /// Faces near the region when remeshing began, their triangles then, and their layers,
+    /// filed in `grid` under their own boxes.
     faces: Vec<u32>,
     triangles: Vec<[Vec3; 3]>,
     layers: Vec<u32>,
     grid: LocalFaceGrid,
-    /// Faces split off during remeshing, by the captured face they descend from.
-    descendants: Vec<Vec<u32>>,
-    /// For a face created during remeshing: the captured face it descends from.
-    ancestor: FxHashMap<u32, u32>,
-    /// Local index of each captured face.
-    local: FxHashMap<u32, u32>,
+    /// The faces edits made or changed since (by mesh index), filed by `grid`'s cells under
+    /// their boxes when last changed: a captured face in `changed` is looked up here instead,
+    /// and an entry whose face has moved on since is filtered by its box now.
+    moved: FxHashMap<usize, Vec<u32>>,
+    changed: Stamps,
     search: f32,
     seen: std::cell::RefCell<Stamps>,
     /// The local face that last answered [`Self::is_near`].
@@ -67,59 +64,69 @@ impl ReferenceSurface {
             .iter()
             .map(|&f| mesh.face_layers()[f as usize])
             .collect();
-        // Boxes widened: faces move and flip while remeshing and must stay inside the boxes
-        // they are filed under.
-        let boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| Aabb::of_points(t).expanded(MOVE_MARGIN * l))
-            .collect();
+        let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of_points(t)).collect();
         let mut local_grid = LocalFaceGrid::default();
         if !faces.is_empty() {
             local_grid.build(&boxes, area.expanded(l), 1.5 * l);
         }
-        let local = faces
-            .iter()
-            .enumerate()
-            .map(|(i, &f)| (f, i as u32))
-            .collect();
+        let mut changed = Stamps::default();
+        changed.start(mesh.face_count());
         ReferenceSurface {
-            descendants: vec![Vec::new(); faces.len()],
             seen: std::cell::RefCell::new(Stamps::default()),
             last_near: std::cell::Cell::new(u32::MAX),
             faces,
             triangles,
             layers,
             grid: local_grid,
-            ancestor: FxHashMap::default(),
-            local,
+            moved: FxHashMap::default(),
+            changed,
             search: l,
         }
     }
 
-    /// `child` was split off `parent` (geometrically inside it when made).
-    pub fn record_split(&mut self, parent: u32, child: u32) {
-        let root = match self.local.get(&parent) {
-            Some(&i) => Some(i),
-            None => self.ancestor.get(&parent).copied(),
-        };
-        if let Some(root) = root {
-            self.descendants[root as usize].push(child);
-            self.ancestor.insert(child, root);
+    /// An edit made or changed `faces` (their vertices or where those are): they are found
+    /// where they are now from here on.
+    pub fn faces_changed(&mut self, mesh: &Mesh, faces: impl IntoIterator<Item = u32>) {
+        for face in faces {
+            self.changed.size_for(face as usize + 1);
+            self.changed.insert(face as usize);
+            let ids = mesh.faces()[face as usize];
+            if ids[0] == INVALID {
+                continue;
+            }
+            let now = Aabb::of_points(&ids.map(|w| mesh.positions()[w as usize]));
+            let moved = &mut self.moved;
+            self.grid
+                .for_each_cell(&now, |cell| moved.entry(cell).or_default().push(face));
         }
     }
 
-    /// Calls `f` with every face (by mesh index) filed near `query`, once each, and the faces
-    /// split off them since.
+    /// Calls `f` with every face (by mesh index) that may overlap `query` where it is now,
+    /// once each: the captured faces no edit changed whose boxes overlap it, and the changed
+    /// ones filed in the cells it covers.
     pub fn for_each_near(&self, query: &Aabb, mut f: impl FnMut(u32)) {
         let mut seen = self.seen.borrow_mut();
         seen.start(self.faces.len());
         self.grid.for_each_candidate(query, |local| {
-            if !seen.insert(local as usize) {
+            let i = local as usize;
+            let face = self.faces[i];
+            if self.changed.contains(face as usize) || !seen.insert(i) {
                 return;
             }
-            f(self.faces[local as usize]);
-            for &child in &self.descendants[local as usize] {
-                f(child);
+            if Aabb::of_points(&self.triangles[i]).overlaps(query) {
+                f(face);
+            }
+        });
+        if self.moved.is_empty() {
+            return;
+        }
+        // Changed faces are numbered by the mesh, which grows as edits split faces.
+        seen.start(self.changed.capacity());
+        self.grid.for_each_cell(query, |cell| {
+            for &face in self.moved.get(&cell).map_or(&[][..], Vec::as_slice) {
+                if seen.insert(face as usize) {
+                    f(face);
+                }
             }
         });
     }
@@ -160,7 +167,9 @@ impl ReferenceSurface {
     /// The closest point of the original surface of `layer` to `p`, within an edge length.
     pub fn project(&self, p: Vec3, layer: u32) -> Option<Vec3> {
         let query = Aabb { min: p, max: p }.expanded(self.search);
-        let mut best: Option<(f32, Vec3)> = None;
+        // The nearest, and of equally near ones the first captured: the answer does not
+        // depend on the order the grid lists faces in.
+        let mut best: Option<(f32, usize, Vec3)> = None;
         let slack = PRUNE_SLACK * (self.search + p.abs().max_element());
         let mut seen = self.seen.borrow_mut();
         seen.start(self.faces.len());
@@ -172,7 +181,7 @@ impl ReferenceSurface {
             let [a, b, c] = self.triangles[i];
             // A triangle whose box is farther than the best so far cannot beat it; the slack
             // keeps the skip clear of the closest point's rounding, so the answer is the same.
-            if let Some((best_d, _)) = best {
+            if let Some((best_d, _, _)) = best {
                 let gap = Aabb::of_points(&[a, b, c]).distance_squared_to(p).sqrt();
                 if gap > best_d.sqrt() + slack {
                     return;
@@ -180,11 +189,11 @@ impl ReferenceSurface {
             }
             let q = closest_point_on_triangle(p, a, b, c);
             let d = q.distance_squared(p);
-            if best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, q));
+            if best.is_none_or(|(bd, bi, _)| d < bd || (d == bd && i < bi)) {
+                best = Some((d, i, q));
             }
         });
-        best.filter(|(d, _)| *d <= self.search * self.search)
-            .map(|(_, q)| q)
+        best.filter(|(d, _, _)| *d <= self.search * self.search)
+            .map(|(_, _, q)| q)
     }
 }
