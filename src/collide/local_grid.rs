@@ -106,17 +106,22 @@ impl LocalFaceGrid {
         }
     }
 
-    /// Calls `f` with the index of every cell overlapping `b` (clamped to the grid, as filing
-    /// and queries are): for callers that file more faces beside the grid's own.
-    pub fn for_each_cell(&self, b: &Aabb, mut f: impl FnMut(usize)) {
+    /// The cells overlapping `b`, lowest and highest (clamped to the grid, as filing and
+    /// queries are): for callers that file more faces beside the grid's own.
+    pub fn cell_span(&self, b: &Aabb) -> (IVec3, IVec3) {
+        self.cell_range(b)
+    }
+
+    /// Calls `f` with the index and coordinates of every cell of `span`.
+    pub fn for_each_cell(&self, (lo, hi): (IVec3, IVec3), mut f: impl FnMut(usize, IVec3)) {
         if self.offsets.is_empty() {
             return;
         }
-        let (lo, hi) = self.cell_range(b);
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
-                    f(self.index(IVec3::new(x, y, z)));
+                    let at = IVec3::new(x, y, z);
+                    f(self.index(at), at);
                 }
             }
         }

@@ -1,7 +1,7 @@
 //! The surface as it was before remeshing: where relaxed vertices are projected back to, and the
 //! index of every face near the region that collision checks read (at current positions).
 
-use glam::Vec3;
+use glam::{IVec3, Vec3};
 use rustc_hash::FxHashMap;
 
 use super::RemeshSettings;
@@ -26,6 +26,8 @@ pub struct ReferenceSurface {
     /// their boxes when last changed: a captured face in `changed` is looked up here instead,
     /// and an entry whose face has moved on since is filtered by its box now.
     moved: FxHashMap<usize, Vec<u32>>,
+    /// The cells each changed face was last filed in.
+    filed: FxHashMap<u32, (IVec3, IVec3)>,
     changed: Stamps,
     search: f32,
     seen: std::cell::RefCell<Stamps>,
@@ -79,6 +81,7 @@ impl ReferenceSurface {
             layers,
             grid: local_grid,
             moved: FxHashMap::default(),
+            filed: FxHashMap::default(),
             changed,
             search: l,
         }
@@ -95,9 +98,20 @@ impl ReferenceSurface {
                 continue;
             }
             let now = Aabb::of_points(&ids.map(|w| mesh.positions()[w as usize]));
+            let span = self.grid.cell_span(&now);
+            // Most edits move a face less than a cell: it is filed once per cell it reaches.
+            let before = self.filed.insert(face, span);
+            if before == Some(span) {
+                continue;
+            }
+            let filed_before =
+                |at: IVec3| before.is_some_and(|(lo, hi)| at.cmpge(lo).all() && at.cmple(hi).all());
             let moved = &mut self.moved;
-            self.grid
-                .for_each_cell(&now, |cell| moved.entry(cell).or_default().push(face));
+            self.grid.for_each_cell(span, |cell, at| {
+                if !filed_before(at) {
+                    moved.entry(cell).or_default().push(face);
+                }
+            });
         }
     }
 
@@ -122,13 +136,14 @@ impl ReferenceSurface {
         }
         // Changed faces are numbered by the mesh, which grows as edits split faces.
         seen.start(self.changed.capacity());
-        self.grid.for_each_cell(query, |cell| {
-            for &face in self.moved.get(&cell).map_or(&[][..], Vec::as_slice) {
-                if seen.insert(face as usize) {
-                    f(face);
+        self.grid
+            .for_each_cell(self.grid.cell_span(query), |cell, _| {
+                for &face in self.moved.get(&cell).map_or(&[][..], Vec::as_slice) {
+                    if seen.insert(face as usize) {
+                        f(face);
+                    }
                 }
-            }
-        });
+            });
     }
 
     /// Whether the original surface of `layer` comes within `distance` (at most an edge
