@@ -25,11 +25,6 @@ impl Stamps {
         crate::grow::grow_to(&mut self.marks, len, 0);
     }
 
-    /// One past the largest index there is room for.
-    pub fn capacity(&self) -> usize {
-        self.marks.len()
-    }
-
     /// Adds `index`; true when it was not in the set yet this round.
     #[inline]
     pub fn insert(&mut self, index: usize) -> bool {

@@ -3,6 +3,7 @@
 
 use glam::{IVec3, Vec3};
 use rustc_hash::FxHashMap;
+use std::collections::hash_map::Entry;
 
 use super::RemeshSettings;
 use crate::collide::{LocalFaceGrid, Stamps};
@@ -22,13 +23,18 @@ pub struct ReferenceSurface {
     triangles: Vec<[Vec3; 3]>,
     layers: Vec<u32>,
     grid: LocalFaceGrid,
-    /// The faces edits made or changed since (by mesh index), filed by `grid`'s cells under
-    /// their boxes when last changed: a captured face in `changed` is looked up here instead,
-    /// and an entry whose face has moved on since is filtered by its box now.
+    /// Local index of each captured face, and which of them an edit changed since: those are
+    /// looked up in `moved` instead.
+    local: FxHashMap<u32, u32>,
+    captured_changed: Stamps,
+    /// The faces edits made or changed (mesh indices), numbered in the order they first
+    /// changed, and each one's number and the cells it was last filed in.
+    changed: Vec<u32>,
+    filed: FxHashMap<u32, (u32, (IVec3, IVec3))>,
+    /// Changed faces by number, filed by `grid`'s cells under their boxes when they changed;
+    /// an entry whose face has moved on since is filtered by its box now. Everything here is
+    /// as large as the pass's work, never as the mesh.
     moved: FxHashMap<usize, Vec<u32>>,
-    /// The cells each changed face was last filed in.
-    filed: FxHashMap<u32, (IVec3, IVec3)>,
-    changed: Stamps,
     search: f32,
     seen: std::cell::RefCell<Stamps>,
     /// The local face that last answered [`Self::is_near`].
@@ -71,8 +77,13 @@ impl ReferenceSurface {
         if !faces.is_empty() {
             local_grid.build(&boxes, area.expanded(l), 1.5 * l);
         }
-        let mut changed = Stamps::default();
-        changed.start(mesh.face_count());
+        let local = faces
+            .iter()
+            .enumerate()
+            .map(|(i, &f)| (f, i as u32))
+            .collect();
+        let mut captured_changed = Stamps::default();
+        captured_changed.start(faces.len());
         ReferenceSurface {
             seen: std::cell::RefCell::new(Stamps::default()),
             last_near: std::cell::Cell::new(u32::MAX),
@@ -80,9 +91,11 @@ impl ReferenceSurface {
             triangles,
             layers,
             grid: local_grid,
-            moved: FxHashMap::default(),
+            local,
+            captured_changed,
+            changed: Vec::new(),
             filed: FxHashMap::default(),
-            changed,
+            moved: FxHashMap::default(),
             search: l,
         }
     }
@@ -91,16 +104,29 @@ impl ReferenceSurface {
     /// where they are now from here on.
     pub fn faces_changed(&mut self, mesh: &Mesh, faces: impl IntoIterator<Item = u32>) {
         for face in faces {
-            self.changed.size_for(face as usize + 1);
-            self.changed.insert(face as usize);
+            if let Some(&i) = self.local.get(&face) {
+                self.captured_changed.insert(i as usize);
+            }
             let ids = mesh.faces()[face as usize];
             if ids[0] == INVALID {
                 continue;
             }
             let now = Aabb::of_points(&ids.map(|w| mesh.positions()[w as usize]));
             let span = self.grid.cell_span(&now);
+            let (number, before) = match self.filed.entry(face) {
+                Entry::Occupied(mut filed) => {
+                    let (number, before) = *filed.get();
+                    filed.insert((number, span));
+                    (number, Some(before))
+                }
+                Entry::Vacant(filed) => {
+                    let number = self.changed.len() as u32;
+                    filed.insert((number, span));
+                    self.changed.push(face);
+                    (number, None)
+                }
+            };
             // Most edits move a face less than a cell: it is filed once per cell it reaches.
-            let before = self.filed.insert(face, span);
             if before == Some(span) {
                 continue;
             }
@@ -109,7 +135,7 @@ impl ReferenceSurface {
             let moved = &mut self.moved;
             self.grid.for_each_cell(span, |cell, at| {
                 if !filed_before(at) {
-                    moved.entry(cell).or_default().push(face);
+                    moved.entry(cell).or_default().push(number);
                 }
             });
         }
@@ -123,24 +149,22 @@ impl ReferenceSurface {
         seen.start(self.faces.len());
         self.grid.for_each_candidate(query, |local| {
             let i = local as usize;
-            let face = self.faces[i];
-            if self.changed.contains(face as usize) || !seen.insert(i) {
+            if self.captured_changed.contains(i) || !seen.insert(i) {
                 return;
             }
             if Aabb::of_points(&self.triangles[i]).overlaps(query) {
-                f(face);
+                f(self.faces[i]);
             }
         });
-        if self.moved.is_empty() {
+        if self.changed.is_empty() {
             return;
         }
-        // Changed faces are numbered by the mesh, which grows as edits split faces.
-        seen.start(self.changed.capacity());
+        seen.start(self.changed.len());
         self.grid
             .for_each_cell(self.grid.cell_span(query), |cell, _| {
-                for &face in self.moved.get(&cell).map_or(&[][..], Vec::as_slice) {
-                    if seen.insert(face as usize) {
-                        f(face);
+                for &number in self.moved.get(&cell).map_or(&[][..], Vec::as_slice) {
+                    if seen.insert(number as usize) {
+                        f(self.changed[number as usize]);
                     }
                 }
             });
