@@ -53,7 +53,7 @@ impl LocalFaceGrid {
         self.offsets.clear();
         self.offsets.resize(cell_count + 1, 0);
         for b in boxes {
-            let (lo, hi) = self.cell_range(b);
+            let (lo, hi) = self.cell_span(b);
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
@@ -72,7 +72,7 @@ impl LocalFaceGrid {
         cursor.clear();
         cursor.extend_from_slice(&self.offsets);
         for (i, b) in boxes.iter().enumerate() {
-            let (lo, hi) = self.cell_range(b);
+            let (lo, hi) = self.cell_span(b);
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
@@ -92,24 +92,11 @@ impl LocalFaceGrid {
         if self.offsets.is_empty() {
             return;
         }
-        let (lo, hi) = self.cell_range(query);
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
-                    let c = self.index(IVec3::new(x, y, z));
-                    for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize]
-                    {
-                        f(e);
-                    }
-                }
+        self.for_each_cell(self.cell_span(query), |c, _| {
+            for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                f(e);
             }
-        }
-    }
-
-    /// The cells overlapping `b`, lowest and highest (clamped to the grid, as filing and
-    /// queries are): for callers that file more faces beside the grid's own.
-    pub fn cell_span(&self, b: &Aabb) -> (IVec3, IVec3) {
-        self.cell_range(b)
+        });
     }
 
     /// Calls `f` with the index and coordinates of every cell of `span`.
@@ -133,7 +120,7 @@ impl LocalFaceGrid {
         if self.offsets.is_empty() {
             return false;
         }
-        let (lo, hi) = self.cell_range(query);
+        let (lo, hi) = self.cell_span(query);
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
@@ -149,7 +136,9 @@ impl LocalFaceGrid {
         false
     }
 
-    fn cell_range(&self, b: &Aabb) -> (IVec3, IVec3) {
+    /// The cells overlapping `b`, lowest and highest (clamped to the grid, as filing and
+    /// queries are): also for callers that file more faces beside the grid's own.
+    pub fn cell_span(&self, b: &Aabb) -> (IVec3, IVec3) {
         // Truncation is floor here: everything below the origin clamps to cell 0 anyway.
         let clamp = |p: Vec3| {
             ((p - self.origin) * self.inv_cell)

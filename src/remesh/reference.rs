@@ -21,6 +21,7 @@ pub struct ReferenceSurface {
     /// filed in `grid` under their own boxes.
     faces: Vec<u32>,
     triangles: Vec<[Vec3; 3]>,
+    boxes: Vec<Aabb>,
     layers: Vec<u32>,
     grid: LocalFaceGrid,
     /// Local index of each captured face, and which of them an edit changed since: those are
@@ -89,6 +90,7 @@ impl ReferenceSurface {
             last_near: std::cell::Cell::new(u32::MAX),
             faces,
             triangles,
+            boxes,
             layers,
             grid: local_grid,
             local,
@@ -152,7 +154,7 @@ impl ReferenceSurface {
             if self.captured_changed.contains(i) || !seen.insert(i) {
                 return;
             }
-            if Aabb::of_points(&self.triangles[i]).overlaps(query) {
+            if self.boxes[i].overlaps(query) {
                 f(self.faces[i]);
             }
         });
@@ -179,12 +181,12 @@ impl ReferenceSurface {
             if self.layers[i] != layer {
                 return false;
             }
-            let [a, b, c] = self.triangles[i];
-            // Most candidates are filed under padded boxes: reject on the triangle's own first.
-            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            // Most candidates are filed in cells the query only grazes: their boxes reject them.
+            let Aabb { min: lo, max: hi } = self.boxes[i];
             if (p.cmplt(lo - distance) | p.cmpgt(hi + distance)).any() {
                 return false;
             }
+            let [a, b, c] = self.triangles[i];
             closest_point_on_triangle(p, a, b, c).distance_squared(p) <= d2
         };
         // An edit asks about a few points close together: the face that answered the last
@@ -221,7 +223,7 @@ impl ReferenceSurface {
             // A triangle whose box is farther than the best so far cannot beat it; the slack
             // keeps the skip clear of the closest point's rounding, so the answer is the same.
             if let Some((best_d, _, _)) = best {
-                let gap = Aabb::of_points(&[a, b, c]).distance_squared_to(p).sqrt();
+                let gap = self.boxes[i].distance_squared_to(p).sqrt();
                 if gap > best_d.sqrt() + slack {
                     return;
                 }
