@@ -83,25 +83,44 @@ fn drag(harness: &mut Harness<'_, SlayerApp>, from: Pos2, to: Pos2, modifiers: M
 
 /// A drag along `path` with the primary button, waiting until it is recorded in the history.
 fn drag_through(harness: &mut Harness<'_, SlayerApp>, path: &[Pos2], modifiers: Modifiers) {
-    let (from, to) = (path[0], path[path.len() - 1]);
     let strokes_before = harness.state().status.history.len();
-    harness.hover_at(from);
-    settle(harness, "the pointer is over the mesh", |app| {
-        app.hover().is_some()
-    });
-    let button = |pos, pressed| Event::PointerButton {
+    press_along(harness, path, modifiers);
+    release(harness, path[path.len() - 1], modifiers, strokes_before);
+}
+
+fn primary(pos: Pos2, pressed: bool, modifiers: Modifiers) -> Event {
+    Event::PointerButton {
         pos,
         button: PointerButton::Primary,
         pressed,
         modifiers,
-    };
-    harness.event(button(from, true));
+    }
+}
+
+/// Hovers at the path's start until the pointer is over the mesh, presses there and moves
+/// along the rest of the path, one frame a point, the button held.
+fn press_along(harness: &mut Harness<'_, SlayerApp>, path: &[Pos2], modifiers: Modifiers) {
+    harness.hover_at(path[0]);
+    settle(harness, "the pointer is over the mesh", |app| {
+        app.hover().is_some()
+    });
+    harness.event(primary(path[0], true, modifiers));
     harness.step();
     for &p in &path[1..] {
         harness.hover_at(p);
         harness.step();
     }
-    harness.event(button(to, false));
+}
+
+/// Releases the button at `to` and waits until the history has grown past `strokes_before`
+/// entries; no message may have come.
+fn release(
+    harness: &mut Harness<'_, SlayerApp>,
+    to: Pos2,
+    modifiers: Modifiers,
+    strokes_before: usize,
+) {
+    harness.event(primary(to, false, modifiers));
     settle(harness, "the stroke is recorded or refused", |app| {
         app.idle() && app.status.history.len() > strokes_before || app.messages().count() > 0
     });
@@ -573,14 +592,8 @@ fn cut_and_patch_are_traced_on_the_surface() {
     assert_eq!(checked(&harness), (Some("cut".to_string()), true, 1));
     harness.get_by_label("patch").click();
     harness.step();
-    let c = centre(&harness);
-    let ring: Vec<Pos2> = (0..=24)
-        .map(|k| {
-            let a = k as f32 / 24.0 * std::f32::consts::TAU;
-            c + egui::vec2(55.0 * a.cos(), 55.0 * a.sin() + 90.0)
-        })
-        .collect();
-    drag_through(&mut harness, &ring, Modifiers::NONE);
+    let outline = ring(centre(&harness), egui::vec2(0.0, 90.0), 55.0, 24);
+    drag_through(&mut harness, &outline, Modifiers::NONE);
     assert_eq!(
         checked(&harness),
         (Some("patch layer".to_string()), true, 2)
@@ -593,6 +606,102 @@ fn cut_and_patch_are_traced_on_the_surface() {
         app.status.layers.len() == 1 && app.idle()
     });
     assert_eq!(digest(&harness), start);
+}
+
+/// A ring of `count` + 1 screen points around `c` + `offset` (the first repeated at the end).
+fn ring(c: Pos2, offset: egui::Vec2, radius: f32, count: usize) -> Vec<Pos2> {
+    (0..=count)
+        .map(|k| {
+            let a = k as f32 / count as f32 * std::f32::consts::TAU;
+            c + offset + egui::vec2(radius * a.cos(), radius * a.sin())
+        })
+        .collect()
+}
+
+/// A trace is drawn while it is dragged (every pointer point of it), dropped by Esc without a
+/// change, and gone once released; the patch it makes is lifted and as thick as the Brush
+/// panel's new-layer sliders say (on the unit-diameter sphere: the shell's faces between the
+/// lift and the lift plus the thickness off the surface, where the default would be an open
+/// sheet two edges off). The mid-drag picture is left in the temp folder.
+#[test]
+fn a_trace_is_drawn_while_dragged_and_the_patch_follows_the_new_layer_sliders() {
+    let sphere = generate(&SceneSpec {
+        triangles: 5_000,
+        ..SceneSpec::new(SceneKind::Sphere)
+    })
+    .unwrap();
+    let edge = sphere.mean_edge_length();
+    let mut harness = app(Session::new(sphere));
+    let start = digest(&harness);
+    harness.get_by_label("patch").click();
+    harness.step();
+    let path = ring(centre(&harness), egui::vec2(0.0, 90.0), 55.0, 24);
+
+    // Dropped: Esc mid-drag, then the release changes nothing.
+    press_along(&mut harness, &path[..10], Modifiers::NONE);
+    assert_eq!(harness.state().trace_outline(), &path[..10]);
+    harness.key_press(Key::Escape);
+    harness.step();
+    assert!(harness.state().trace_outline().is_empty());
+    harness.event(primary(path[9], false, Modifiers::NONE));
+    settle(&mut harness, "the engine is idle", |app| app.idle());
+    assert_eq!(digest(&harness), start);
+    assert_eq!(harness.state().status.history.len(), 0);
+
+    {
+        let tools = &mut harness.state_mut().tools;
+        tools.lift_edges = 3.0;
+        tools.thickness_edges = 2.0;
+    }
+    press_along(&mut harness, &path, Modifiers::NONE);
+    assert_eq!(harness.state().trace_outline(), &path[..]);
+    let picture = harness.render().unwrap();
+    let shot = std::env::temp_dir().join(format!("slayer-gui-trace-{}.png", std::process::id()));
+    picture.save(&shot).unwrap();
+    release(&mut harness, path[path.len() - 1], Modifiers::NONE, 0);
+    assert!(harness.state().trace_outline().is_empty());
+    let (open_edges, lowest, highest) = harness
+        .state()
+        .query(|s| {
+            let mesh = s.mesh();
+            let patch: Vec<usize> = (0..mesh.face_count())
+                .filter(|&f| mesh.face_layers()[f] == 1)
+                .collect();
+            let heights: Vec<f32> = patch
+                .iter()
+                .flat_map(|&f| mesh.faces()[f])
+                .map(|v| mesh.positions()[v as usize].length() - 0.5)
+                .collect();
+            let mut edges = std::collections::HashMap::new();
+            for &f in &patch {
+                let [a, b, c] = mesh.faces()[f];
+                for (u, v) in [(a, b), (b, c), (c, a)] {
+                    *edges.entry((u.min(v), u.max(v))).or_insert(0) += 1;
+                }
+            }
+            let open = edges.values().filter(|&&n| n == 1).count();
+            let (lo, hi) = heights
+                .iter()
+                .fold((f32::MAX, f32::MIN), |(lo, hi), &h| (lo.min(h), hi.max(h)));
+            (open, lo, hi)
+        })
+        .unwrap();
+    eprintln!(
+        "patch: {open_edges} open edges, {:.2}-{:.2} edges off the sphere",
+        lowest / edge,
+        highest / edge
+    );
+    assert_eq!(open_edges, 0, "a thick patch is a closed shell");
+    assert!(
+        lowest > 2.5 * edge,
+        "lifted 3 edges: lowest {:.2} L",
+        lowest / edge
+    );
+    assert!(
+        highest > 4.5 * edge,
+        "3 + 2 edges: highest {:.2} L",
+        highest / edge
+    );
 }
 
 /// The Layers panel's policy switch: a click makes one layer fuse, as an undoable entry.

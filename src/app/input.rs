@@ -51,11 +51,22 @@ pub struct PointerState {
     pub orbiting_by_replay: bool,
     /// The rays of a layer tool's trace so far.
     trace: Vec<Ray>,
+    /// The same trace in screen points, drawn over the viewport while it is traced.
+    outline: Vec<Pos2>,
 }
 
 impl PointerState {
     pub fn stroking(&self) -> bool {
         self.gesture == Gesture::Stroke
+    }
+
+    pub fn trace_outline(&self) -> &[Pos2] {
+        &self.outline
+    }
+
+    fn drop_trace(&mut self) {
+        self.trace.clear();
+        self.outline.clear();
     }
 
     /// What this frame did (`samples_pending`: the engine has stroke samples to run, the
@@ -106,10 +117,12 @@ pub fn pointer(app: &mut SlayerApp, ui: &egui::Ui, rect: Rect, response: &egui::
                 moved(app, rect, pos, &mut points);
                 app.pointer.last = Some(pos);
             }
-            // The release may never come: the stroke ends here.
+            // The release may never come: the stroke ends here, a trace is dropped.
             Event::PointerGone | Event::WindowFocused(false) => {
-                if app.pointer.gesture == Gesture::Stroke {
-                    end_stroke(app, &mut points);
+                match app.pointer.gesture {
+                    Gesture::Stroke => end_stroke(app, &mut points),
+                    Gesture::Trace => app.pointer.drop_trace(),
+                    _ => {}
                 }
                 app.pointer.gesture = Gesture::None;
                 app.hover = None;
@@ -156,6 +169,7 @@ fn button_event(
             app.pointer.gesture = match (app.hover.is_some(), app.tools.trace) {
                 (true, Some(_)) => {
                     app.pointer.trace = ray_at(app, rect, pos).into_iter().collect();
+                    app.pointer.outline = vec![pos];
                     Gesture::Trace
                 }
                 (true, None) => begin_stroke(app, modifiers, rect, pos, points),
@@ -212,9 +226,10 @@ fn end_stroke(app: &mut SlayerApp, points: &mut Vec<StrokePoint>) {
 /// Hands the traced rays to the engine for the chosen layer tool.
 fn end_trace(app: &mut SlayerApp) {
     let rays = std::mem::take(&mut app.pointer.trace);
+    app.pointer.drop_trace();
     let tool = match app.tools.trace {
         Some(Trace::Cut) => LayerTool::Cut,
-        Some(Trace::Patch) => LayerTool::Patch(app.tools.material),
+        Some(Trace::Patch) => LayerTool::Patch(app.new_layer()),
         None => return,
     };
     app.send(Command::Trace(tool, rays));
@@ -253,6 +268,7 @@ fn moved(app: &mut SlayerApp, rect: Rect, pos: Pos2, points: &mut Vec<StrokePoin
         Gesture::Trace => {
             let ray = ray_at(app, rect, pos);
             app.pointer.trace.extend(ray);
+            app.pointer.outline.push(pos);
         }
         Gesture::Orbit => {
             if let Some(camera) = &mut app.camera {
@@ -414,12 +430,20 @@ pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
             set_adjusted(app, strength, start);
             app.pointer.gesture = Gesture::None;
         }
+        if app.pointer.gesture == Gesture::Trace {
+            app.pointer.drop_trace();
+            app.pointer.gesture = Gesture::None;
+        }
     }
 }
 
 /// The key map as the help overlay lists it.
 pub const KEY_MAP: &[(&str, &str)] = &[
     ("drag on the mesh", "stroke with the current brush"),
+    (
+        "drag with cut / patch chosen",
+        "trace the layer tool (Esc while dragging drops the trace)",
+    ),
     ("Ctrl + drag", "stroke inverted"),
     ("Shift + drag", "smooth"),
     ("drag on the background, middle drag", "orbit"),

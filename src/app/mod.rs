@@ -31,7 +31,7 @@ pub use pick::{Hit, Picker, Ray};
 pub use replay::{ExitPlan, Metrics};
 pub use upload::{MeshUpdate, Mirror};
 pub use viewport::ViewOptions;
-pub use worker::{Command, Reply, Status, StrokePoint};
+pub use worker::{Command, NewLayer, Reply, Status, StrokePoint};
 
 use eframe::{egui, egui_wgpu};
 
@@ -96,6 +96,11 @@ pub struct Tools {
     pub remesh: bool,
     /// A drag on the mesh traces this layer tool instead of stroking the brush.
     pub trace: Option<Trace>,
+    /// How far a patch or a duplicate is lifted off its surface, in edge lengths (the
+    /// collision distance is one).
+    pub lift_edges: f32,
+    /// A patch or a duplicate this many edge lengths thick, a closed shell; 0: an open sheet.
+    pub thickness_edges: f32,
     pub view: ViewOptions,
     /// The engine's phase times in the status bar (off for pictures that must not change
     /// from run to run).
@@ -219,6 +224,8 @@ impl SlayerApp {
                 symmetry_x: false,
                 remesh: true,
                 trace: None,
+                lift_edges: 2.0,
+                thickness_edges: 0.0,
                 view: ViewOptions {
                     show_mask: true,
                     ..ViewOptions::default()
@@ -454,6 +461,20 @@ impl SlayerApp {
         }
     }
 
+    /// The layer a duplicate or a patch makes, as the panels set it: the brush's material.
+    pub fn new_layer(&self) -> NewLayer {
+        NewLayer {
+            material: self.tools.material,
+            lift_edges: self.tools.lift_edges,
+            thickness_edges: self.tools.thickness_edges,
+        }
+    }
+
+    /// The layer tool's trace drawn so far, in screen points (empty when none is drawn).
+    pub fn trace_outline(&self) -> &[egui::Pos2] {
+        self.pointer.trace_outline()
+    }
+
     /// The stroke the brush panel describes, with the modifiers held at its start.
     fn stroke_settings(
         &self,
@@ -596,6 +617,7 @@ impl SlayerApp {
             ui.painter().image(texture, rect, uv, egui::Color32::WHITE);
         }
         panels::brush_circle(self, ui.painter(), rect);
+        panels::trace_outline(self, ui.painter());
     }
 }
 

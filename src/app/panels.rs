@@ -338,6 +338,33 @@ fn trace_choice(app: &mut SlayerApp, ui: &mut Ui) {
         ui.selectable_value(trace, Some(Trace::Patch), "patch")
             .on_hover_text("draw a closed outline: a new layer in the brush's material fills it");
     });
+    // What a patch, or a duplicate from the Layers panel, makes.
+    ui.add(egui::Slider::new(&mut app.tools.lift_edges, 1.0..=8.0).text("new layer: lift"))
+        .on_hover_text("how far a patch or a duplicate is lifted off its surface, in edge lengths (the layers' collision distance is one)");
+    ui.add(
+        egui::Slider::new(&mut app.tools.thickness_edges, 0.0..=8.0).text("new layer: thickness"),
+    )
+    .on_hover_text("0: an open sheet; more: a closed shell this many edge lengths thick");
+}
+
+/// The layer tool's trace while it is drawn: the cut's line, or the patch's outline with a
+/// dashed segment where the patch will close it.
+pub fn trace_outline(app: &SlayerApp, painter: &Painter) {
+    let outline = app.trace_outline();
+    if outline.len() < 2 {
+        return;
+    }
+    let colour = Color32::from_rgb(255, 225, 90);
+    painter.add(egui::Shape::line(outline.to_vec(), Line::new(2.0, colour)));
+    if app.tools.trace == Some(Trace::Patch) {
+        let ends = [outline[outline.len() - 1], outline[0]];
+        painter.extend(egui::Shape::dashed_line(
+            &ends,
+            Line::new(1.5, colour),
+            6.0,
+            4.0,
+        ));
+    }
 }
 
 /// The layer tools on a layer's name: duplicate (its masked part, or all of it) in the brush's
@@ -371,10 +398,10 @@ fn layer_menu(app: &mut SlayerApp, label: &egui::Response, layer: u32) {
     label.context_menu(|ui| {
         if ui
             .button("duplicate, lifted off it")
-            .on_hover_text("copies the masked part (all of it if nothing is masked) into a new layer 2 edges above, in the brush's material")
+            .on_hover_text("copies the masked part (all of it if nothing is masked) into a new layer in the brush's material, lifted and as thick as the Brush panel's new-layer sliders say")
             .clicked()
         {
-            app.send(Command::DuplicateLayer(layer, app.tools.material));
+            app.send(Command::DuplicateLayer(layer, app.new_layer()));
             ui.close();
         }
         if ui.button("delete layer").clicked() {
@@ -467,7 +494,8 @@ pub fn brush_circle(app: &SlayerApp, painter: &Painter, rect: Rect) {
     let (Some(hit), Some(camera)) = (app.hover, &app.camera) else {
         return;
     };
-    if app.pointer.stroking() {
+    // A stroke shows its effect, a trace its outline (`trace_outline`).
+    if app.pointer.stroking() || !app.trace_outline().is_empty() {
         return;
     }
     let size = glam::Vec2::new(rect.width(), rect.height());

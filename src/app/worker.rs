@@ -49,8 +49,8 @@ pub enum Command {
     SetLayer(LayerId, LayerSettings),
     RenameLayer(LayerId, String),
     /// Copies the layer's masked part (all of it where nothing is masked) into a new layer
-    /// lifted off it, in this material.
-    DuplicateLayer(LayerId, Brdf),
+    /// lifted off it.
+    DuplicateLayer(LayerId, NewLayer),
     DeleteLayer(LayerId),
     /// A layer tool traced on the surface: the pointer's rays over one drag.
     Trace(LayerTool, Vec<Ray>),
@@ -71,8 +71,29 @@ pub enum Command {
 pub enum LayerTool {
     /// Cut the active layers open along the trace.
     Cut,
-    /// A new layer in this material, filling the closed trace.
-    Patch(Brdf),
+    /// A new layer filling the closed trace.
+    Patch(NewLayer),
+}
+
+/// What a duplicate or a patch makes: a layer in `material`, lifted `lift_edges` edge lengths
+/// off the surface it comes from, and `thickness_edges` thick (0: an open sheet; more: a closed
+/// shell).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewLayer {
+    pub material: Brdf,
+    pub lift_edges: f32,
+    pub thickness_edges: f32,
+}
+
+impl NewLayer {
+    /// The library's settings for this layer on `mesh`, in its edge length.
+    fn settings(&self, mesh: &Mesh, name: &str) -> DuplicateSettings {
+        let mut settings = DuplicateSettings::for_mesh(mesh, name, self.material);
+        settings.offset = self.lift_edges * settings.edge;
+        settings.thickness =
+            (self.thickness_edges > 0.0).then_some(self.thickness_edges * settings.edge);
+        settings
+    }
 }
 
 /// The document as the panels show it.
@@ -190,8 +211,8 @@ impl Worker {
                 let result = self.session.rename_layer(layer, &name);
                 self.after_refusable(result.map(|_| ()).map_err(|e| e.to_string()));
             }
-            Command::DuplicateLayer(layer, material) => {
-                let result = self.duplicate(layer, material);
+            Command::DuplicateLayer(layer, new_layer) => {
+                let result = self.duplicate(layer, new_layer);
                 self.after_tool(result);
             }
             Command::Trace(tool, rays) => {
@@ -261,7 +282,7 @@ impl Worker {
         self.send_status();
     }
 
-    fn duplicate(&mut self, layer: LayerId, material: Brdf) -> Result<(), String> {
+    fn duplicate(&mut self, layer: LayerId, new_layer: NewLayer) -> Result<(), String> {
         let mesh = self.session.mesh();
         let masked = selected_faces(mesh, Selection::Masked(layer)).is_ok();
         let selection = if masked {
@@ -274,7 +295,7 @@ impl Worker {
             .get(layer as usize)
             .cloned()
             .unwrap_or_default();
-        let settings = DuplicateSettings::for_mesh(mesh, &format!("{name} copy"), material);
+        let settings = new_layer.settings(mesh, &format!("{name} copy"));
         let result = self.session.duplicate(selection, &settings);
         result.map(|_| ()).map_err(|e| e.to_string())
     }
@@ -297,8 +318,8 @@ impl Worker {
                 let settings = CutSettings::for_mesh(mesh, &self.session.active_layers());
                 self.session.cut(&points, &settings).map(|_| ())
             }
-            LayerTool::Patch(material) => {
-                let settings = DuplicateSettings::for_mesh(mesh, "patch", material);
+            LayerTool::Patch(new_layer) => {
+                let settings = new_layer.settings(mesh, "patch");
                 self.session.patch(&points, layer, &settings).map(|_| ())
             }
         };
