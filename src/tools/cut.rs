@@ -194,6 +194,9 @@ fn cut_layer(
         let (Some(a), Some(b)) = (pair[0], pair[1]) else {
             continue;
         };
+        if a != b && mesh.find_edge(a, b).is_none() {
+            split_between(mesh, a, b, report);
+        }
         if a != b
             && let Some(path) = shortest_path(mesh, a, b, settings.edge)
         {
@@ -251,6 +254,37 @@ fn split_under(
         }
     }
     made
+}
+
+/// Where `a` and `b` are the far corners of two faces sharing an edge (the stroke ran across
+/// that edge with no point near enough to it to split it), splits that edge where the segment
+/// from `a` to `b` passes it: the path then runs along the stroke instead of round it, through
+/// a corner up to 0.87·L off (an equilateral pair's shared edge's end).
+fn split_between(mesh: &mut Mesh, a: u32, b: u32, report: &mut CutReport) {
+    let shared = mesh.adjacency().corners_around(a).find(|&corner| {
+        let twin = mesh.adjacency().opposite[corner as usize];
+        twin != crate::mesh::INVALID && mesh.corner_vertex(twin) == b
+    });
+    let Some(corner) = shared else {
+        return;
+    };
+    let p = |v: u32| mesh.positions()[v as usize];
+    let (w, z) = mesh.edge_vertices(corner);
+    // The point of w–z nearest to the line through a and b (Ericson, "closest points of two
+    // lines"), as a parameter from w.
+    let (along, across, between) = (p(b) - p(a), p(z) - p(w), p(a) - p(w));
+    let (aa, ab, zz) = (along.dot(along), along.dot(across), across.dot(across));
+    let (ac, zc) = (along.dot(between), across.dot(between));
+    let denominator = aa * zz - ab * ab;
+    if denominator <= f32::EPSILON * aa * zz {
+        return;
+    }
+    let s = (ab * zc - ac * zz) / denominator;
+    let t = (ab * s + zc) / zz;
+    if (0.15..=0.85).contains(&t) {
+        mesh.split_edge(corner, t);
+        report.splits += 1;
+    }
 }
 
 /// The edge of `tri` nearest to `q`: its ends and `q`'s parameter along it from the first.

@@ -6,6 +6,7 @@
 //! duplicate: along the normals, clear of everything, remeshed to `L`, checked exactly.
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::ToolError;
 use super::duplicate::{DuplicateReport, DuplicateSettings, check_settings, lift_off};
@@ -55,9 +56,10 @@ pub fn plan_patch(
     let flat = flatten(&ring)?;
     let corners = corners(&flat);
     let grid = coons_grid(&ring, &corners, edge);
+    // Each point on its own: a big patch's projection would otherwise leave cores idle.
     let positions = grid
         .points
-        .iter()
+        .par_iter()
         .map(|&p| on_layer(p).ok_or_else(|| bad("it encloses a hole in the layer")))
         .collect::<Result<Vec<Vec3>, _>>()?;
     let facing = |p: Vec3| nearest(p).map_or(Vec3::ZERO, |(f, _)| mesh.face_normal(f as usize));
