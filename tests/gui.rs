@@ -14,6 +14,15 @@ use slayer::session::Session;
 
 const SIZE: [f32; 2] = [1100.0, 700.0];
 
+/// The unit-diameter sphere at about 5K faces.
+fn sphere() -> slayer::mesh::Mesh {
+    generate(&SceneSpec {
+        triangles: 5_000,
+        ..SceneSpec::new(SceneKind::Sphere)
+    })
+    .unwrap()
+}
+
 fn plaster() -> Session {
     Session::new(
         generate(&SceneSpec {
@@ -562,12 +571,7 @@ fn a_layer_is_duplicated_and_deleted_from_its_menu() {
 /// drag makes a patch layer; each is one undo step.
 #[test]
 fn cut_and_patch_are_traced_on_the_surface() {
-    let sphere = generate(&SceneSpec {
-        triangles: 5_000,
-        ..SceneSpec::new(SceneKind::Sphere)
-    })
-    .unwrap();
-    let mut harness = app(Session::new(sphere));
+    let mut harness = app(Session::new(sphere()));
     let start = digest(&harness);
     harness.get_by_label("cut").click();
     harness.step();
@@ -625,11 +629,7 @@ fn ring(c: Pos2, offset: egui::Vec2, radius: f32, count: usize) -> Vec<Pos2> {
 /// sheet two edges off). The mid-drag picture is left in the temp folder.
 #[test]
 fn a_trace_is_drawn_while_dragged_and_the_patch_follows_the_new_layer_sliders() {
-    let sphere = generate(&SceneSpec {
-        triangles: 5_000,
-        ..SceneSpec::new(SceneKind::Sphere)
-    })
-    .unwrap();
+    let sphere = sphere();
     let edge = sphere.mean_edge_length();
     let mut harness = app(Session::new(sphere));
     let start = digest(&harness);
@@ -660,38 +660,29 @@ fn a_trace_is_drawn_while_dragged_and_the_patch_follows_the_new_layer_sliders() 
     picture.save(&shot).unwrap();
     release(&mut harness, path[path.len() - 1], Modifiers::NONE, 0);
     assert!(harness.state().trace_outline().is_empty());
-    let (open_edges, lowest, highest) = harness
+    let (open_loops, lowest, highest) = harness
         .state()
         .query(|s| {
             let mesh = s.mesh();
-            let patch: Vec<usize> = (0..mesh.face_count())
-                .filter(|&f| mesh.face_layers()[f] == 1)
-                .collect();
-            let heights: Vec<f32> = patch
+            let open_loops: usize = mesh
+                .component_shapes()
                 .iter()
-                .flat_map(|&f| mesh.faces()[f])
+                .filter(|c| c.layer == 1)
+                .map(|c| c.boundary_loops)
+                .sum();
+            let (lo, hi) = (0..mesh.vertex_count() as u32)
+                .filter(|&v| mesh.is_vertex_live(v) && mesh.vertex_layers()[v as usize] == 1)
                 .map(|v| mesh.positions()[v as usize].length() - 0.5)
-                .collect();
-            let mut edges = std::collections::HashMap::new();
-            for &f in &patch {
-                let [a, b, c] = mesh.faces()[f];
-                for (u, v) in [(a, b), (b, c), (c, a)] {
-                    *edges.entry((u.min(v), u.max(v))).or_insert(0) += 1;
-                }
-            }
-            let open = edges.values().filter(|&&n| n == 1).count();
-            let (lo, hi) = heights
-                .iter()
-                .fold((f32::MAX, f32::MIN), |(lo, hi), &h| (lo.min(h), hi.max(h)));
-            (open, lo, hi)
+                .fold((f32::MAX, f32::MIN), |(lo, hi), h| (lo.min(h), hi.max(h)));
+            (open_loops, lo, hi)
         })
         .unwrap();
     eprintln!(
-        "patch: {open_edges} open edges, {:.2}-{:.2} edges off the sphere",
+        "patch: {open_loops} boundary loops, {:.2}-{:.2} edges off the sphere",
         lowest / edge,
         highest / edge
     );
-    assert_eq!(open_edges, 0, "a thick patch is a closed shell");
+    assert_eq!(open_loops, 0, "a thick patch is a closed shell");
     assert!(
         lowest > 2.5 * edge,
         "lifted 3 edges: lowest {:.2} L",

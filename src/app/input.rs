@@ -64,9 +64,10 @@ impl PointerState {
         &self.outline
     }
 
-    fn drop_trace(&mut self) {
-        self.trace.clear();
+    /// The trace's rays, leaving no trace drawn.
+    fn take_trace(&mut self) -> Vec<Ray> {
         self.outline.clear();
+        std::mem::take(&mut self.trace)
     }
 
     /// What this frame did (`samples_pending`: the engine has stroke samples to run, the
@@ -121,7 +122,7 @@ pub fn pointer(app: &mut SlayerApp, ui: &egui::Ui, rect: Rect, response: &egui::
             Event::PointerGone | Event::WindowFocused(false) => {
                 match app.pointer.gesture {
                     Gesture::Stroke => end_stroke(app, &mut points),
-                    Gesture::Trace => app.pointer.drop_trace(),
+                    Gesture::Trace => drop(app.pointer.take_trace()),
                     _ => {}
                 }
                 app.pointer.gesture = Gesture::None;
@@ -225,8 +226,7 @@ fn end_stroke(app: &mut SlayerApp, points: &mut Vec<StrokePoint>) {
 
 /// Hands the traced rays to the engine for the chosen layer tool.
 fn end_trace(app: &mut SlayerApp) {
-    let rays = std::mem::take(&mut app.pointer.trace);
-    app.pointer.drop_trace();
+    let rays = app.pointer.take_trace();
     let tool = match app.tools.trace {
         Some(Trace::Cut) => LayerTool::Cut,
         Some(Trace::Patch) => LayerTool::Patch(app.new_layer()),
@@ -431,7 +431,7 @@ pub fn keys(app: &mut SlayerApp, ctx: &egui::Context) {
             app.pointer.gesture = Gesture::None;
         }
         if app.pointer.gesture == Gesture::Trace {
-            app.pointer.drop_trace();
+            drop(app.pointer.take_trace());
             app.pointer.gesture = Gesture::None;
         }
     }

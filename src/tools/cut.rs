@@ -194,12 +194,13 @@ fn cut_layer(
         let (Some(a), Some(b)) = (pair[0], pair[1]) else {
             continue;
         };
-        if a != b && mesh.find_edge(a, b).is_none() {
+        if a == b {
+            continue;
+        }
+        if mesh.find_edge(a, b).is_none() {
             split_between(mesh, a, b, report);
         }
-        if a != b
-            && let Some(path) = shortest_path(mesh, a, b, settings.edge)
-        {
+        if let Some(path) = shortest_path(mesh, a, b, settings.edge) {
             edges.extend(path.windows(2).map(|w| [w[0], w[1]]));
         }
     }
