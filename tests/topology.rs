@@ -210,30 +210,6 @@ fn two_fuse_layers_touching_never_weld() {
     assert_eq!(closed_and_clean(&mesh).len(), 2);
 }
 
-/// A torus about z: `around` quads the long way, `across` the short way, each split in two.
-fn torus(around: u32, across: u32, (major, minor): (f32, f32)) -> Mesh {
-    use std::f32::consts::TAU;
-    let mut positions = Vec::new();
-    for i in 0..around {
-        let u = TAU * i as f32 / around as f32;
-        for j in 0..across {
-            let v = TAU * j as f32 / across as f32;
-            let ring = major + minor * v.cos();
-            positions.push(Vec3::new(ring * u.cos(), ring * u.sin(), minor * v.sin()));
-        }
-    }
-    let at = |i: u32, j: u32| (i % around) * across + j % across;
-    let mut faces = Vec::new();
-    for i in 0..around {
-        for j in 0..across {
-            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-        }
-    }
-    let layers = vec![0; faces.len()];
-    Mesh::new(positions, faces, layers, vec!["ring".into()]).expect("torus")
-}
-
 /// 300 seeded strokes of the brushes that move a surface into itself, Freestyle's sweeps
 /// among them, over `start` (each from a vertex of the fuse copy, brush radii and reach scaled
 /// by `size`), the same on a fuse and on a collide copy: after each, both are closed, valid
@@ -308,7 +284,7 @@ fn random_strokes_keep_a_fuse_sphere_closed_manifold_and_intersection_free() {
 
 #[test]
 fn random_strokes_keep_a_fuse_torus_closed_manifold_and_intersection_free() {
-    let ring = torus(40, 14, (0.5, 0.2));
+    let ring = common::torus(40, 14, (0.5, 0.2));
     assert_eq!(closed_and_clean(&ring)[0].genus, 1);
     let changes = random_strokes(&ring, 0.6, 28);
     assert!(

@@ -83,7 +83,10 @@ fn sheet_cone(
 ) -> Option<Cone> {
     // The loop first: a layer with a rim in the region (a flake, a peeling patch) is no
     // sheet, found without computing a normal.
-    let boundary = boundary_loop(mesh, region, faces)?;
+    let layers = mesh.face_layers();
+    let layer = layers[faces[0] as usize];
+    let in_set = |g: u32| layers[g as usize] == layer && region.local(g).is_some();
+    let boundary = boundary_loop(mesh, faces, in_set)?;
     let now = |v: u32| mesh.positions()[v as usize];
     let cone = normal_cone(mesh, faces, now, state.parallel)?;
     let d = state.collision_distance as f64 * (1.0 + MARGIN);
@@ -122,17 +125,17 @@ pub(super) fn kept_orientation(
 }
 
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Cone {
-    axis: DVec3,
+pub(crate) struct Cone {
+    pub(crate) axis: DVec3,
     /// The smallest `n·axis` over the faces' unit normals.
-    cos: f64,
-    min_altitude: f64,
+    pub(crate) cos: f64,
+    pub(crate) min_altitude: f64,
 }
 
 /// The faces' normals' cone around their area-weighted mean, and their smallest altitude, with
 /// vertices where `position` puts them; none for a degenerate face or a cone as wide as a
 /// hemisphere.
-fn normal_cone(
+pub(crate) fn normal_cone(
     mesh: &Mesh,
     faces: &[u32],
     position: impl Fn(u32) -> Vec3 + Sync,
@@ -173,11 +176,14 @@ fn normal_cone(
     })
 }
 
-/// The vertices of the one loop that bounds `faces`, in order; none when the faces touch the
-/// mesh's rim, or their boundary is several loops or passes a vertex twice.
-fn boundary_loop(mesh: &Mesh, region: &Region, faces: &[u32]) -> Option<Vec<u32>> {
-    let layers = mesh.face_layers();
-    let layer = layers[faces[0] as usize];
+/// The vertices of the one loop that bounds `faces` (those `in_set` says belong), in order;
+/// none when the faces touch the mesh's rim, or their boundary is several loops or passes a
+/// vertex twice.
+pub(crate) fn boundary_loop(
+    mesh: &Mesh,
+    faces: &[u32],
+    in_set: impl Fn(u32) -> bool,
+) -> Option<Vec<u32>> {
     let opposite = &mesh.adjacency().opposite;
     // Each edge directed as its face runs: next(c) → prev(c) for the corner facing it.
     let mut edges: Vec<(u32, u32)> = Vec::new();
@@ -187,8 +193,7 @@ fn boundary_loop(mesh: &Mesh, region: &Region, faces: &[u32]) -> Option<Vec<u32>
             if o == INVALID {
                 return None;
             }
-            let g = face_of(o);
-            if layers[g as usize] != layer || region.local(g).is_none() {
+            if !in_set(face_of(o)) {
                 edges.push((mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c))));
             }
         }
@@ -223,7 +228,7 @@ fn box_gap(a: &Aabb, b: &Aabb) -> f64 {
 /// Whether the closed polyline through `loop_vertices`, projected along `axis`, is simple:
 /// no two edges closer than a hair (touching counts as crossing), no edge folded back onto
 /// the next. Edges are bucketed in a grid of cells about one edge long.
-fn projected_loop_is_simple(mesh: &Mesh, loop_vertices: &[u32], axis: DVec3) -> bool {
+pub(crate) fn projected_loop_is_simple(mesh: &Mesh, loop_vertices: &[u32], axis: DVec3) -> bool {
     let (u, w) = axis.any_orthonormal_pair();
     let points: Vec<DVec2> = loop_vertices
         .iter()

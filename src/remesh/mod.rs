@@ -16,12 +16,14 @@
 //! [`SHAPE_TOLERANCE`]·L from where it was, nor changes a closed component's volume past
 //! [`VOLUME_TOLERANCE`] or takes it below [`MIN_CLOSED_FACES`] faces.
 
+mod cells;
 mod edits;
 mod quality;
 mod reference;
 mod refine;
 mod safety;
 mod shape;
+mod zone;
 
 use std::time::Instant;
 
@@ -40,6 +42,7 @@ use reference::ReferenceSurface;
 pub use refine::{subdivide, subdivision_levels};
 use shape::ClosedParts;
 pub use shape::{MIN_CLOSED_FACES, SHAPE_TOLERANCE, VOLUME_TOLERANCE};
+use zone::Zone;
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
 pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
@@ -100,6 +103,8 @@ pub struct RemeshReport {
     /// changed a closed component's volume past [`VOLUME_TOLERANCE`], or left it fewer than
     /// [`MIN_CLOSED_FACES`] faces.
     pub shape_refused: usize,
+    /// Edits whose safety checks a sheet zone settled (whole-mesh remeshing, `zone`).
+    pub culled: usize,
     /// Longest edge among the faces around the region afterwards (the pipeline's running
     /// bound on edge lengths).
     pub longest_edge: f32,
@@ -117,6 +122,7 @@ impl RemeshReport {
         self.relaxed += other.relaxed;
         self.refused += other.refused;
         self.shape_refused += other.shape_refused;
+        self.culled += other.culled;
         self.longest_edge = self.longest_edge.max(other.longest_edge);
         self.millis += other.millis;
     }
@@ -144,7 +150,13 @@ pub fn remesh_region_with(
     settings: &RemeshSettings,
     sets: &mut RemeshSets,
 ) -> (RemeshReport, Vec<u32>) {
-    remesh(mesh, grid, seeds, settings, (Start::OutOfBand, sets))
+    let pass = Pass {
+        start: Start::OutOfBand,
+        sets,
+        closed: None,
+        zone: None,
+    };
+    remesh(mesh, grid, seeds, settings, pass)
 }
 
 /// The per-vertex sets of a remeshing pass (which vertices are in its region, which an edit
@@ -176,15 +188,28 @@ enum Start {
     Subdivided,
 }
 
+/// How one remeshing pass runs, besides its region.
+struct Pass<'s> {
+    start: Start,
+    sets: &'s mut RemeshSets,
+    /// The closed components' volumes, kept across the passes of a whole-mesh remesh (one
+    /// pass per cell); `None` finds those of the region.
+    closed: Option<&'s mut ClosedParts>,
+    /// The sheet zone the region lies in, whose edits need no safety checks (`zone`).
+    zone: Option<Zone>,
+}
+
 fn remesh(
     mesh: &mut Mesh,
     grid: &mut SpatialHash,
     seeds: &[u32],
     settings: &RemeshSettings,
-    (start, sets): (Start, &mut RemeshSets),
+    mut pass: Pass<'_>,
 ) -> (RemeshReport, Vec<u32>) {
     let started = Instant::now();
-    let mut remesher = Remesher::new(mesh, grid, seeds, settings, (start, sets));
+    let kept = pass.closed.as_deref_mut().map(std::mem::take);
+    let mut remesher = Remesher::new(mesh, grid, seeds, settings, (pass.start, pass.sets), kept);
+    remesher.zone = pass.zone;
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
         remesher.split_long_edges();
@@ -196,6 +221,9 @@ fn remesh(
             break;
         }
         remesher.relax();
+    }
+    if let Some(closed) = pass.closed {
+        *closed = std::mem::take(&mut remesher.closed);
     }
     let (mut report, changed) = remesher.finish();
     report.passes = 1;
@@ -216,8 +244,29 @@ pub enum RemeshError {
 
 /// Remeshes a whole mesh to edge length `target_edge` (`slayer remesh`). A target several
 /// times shorter than the mean edge is first approached by whole levels of subdivision
-/// ([`subdivision_levels`], [`subdivide`]), then the passes run over every vertex.
+/// ([`subdivision_levels`], [`subdivide`]), then the passes run over every vertex, cell by
+/// cell (`cells`).
 pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshReport, RemeshError> {
+    remesh_all_with(mesh, settings, Culling::On)
+}
+
+/// Whether a whole-mesh remesh lets sheet zones settle the safety checks of their edits
+/// (`zone`). Off only to show that they change nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Culling {
+    On,
+    Off,
+}
+
+/// The vertex grid's cell, in target edge lengths, for a whole-mesh remesh.
+const WHOLE_MESH_GRID_EDGES: f32 = 4.0;
+
+/// [`remesh_all`], with the zones' culling as `culling` says.
+pub fn remesh_all_with(
+    mesh: &mut Mesh,
+    settings: &RemeshSettings,
+    culling: Culling,
+) -> Result<RemeshReport, RemeshError> {
     // Before anything changes: a target the grid refuses leaves the mesh as it was.
     SpatialHash::new(settings.target_edge, 0)?;
     let started = Instant::now();
@@ -226,29 +275,17 @@ pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshRe
         *mesh = subdivide(mesh)?;
     }
     let subdivided_ms = started.elapsed().as_secs_f64() * 1e3;
-    let mut grid = SpatialHash::build(mesh, settings.target_edge)?;
-    let seeds: Vec<u32> = (0..mesh.vertex_count() as u32)
-        .filter(|&v| {
-            !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
-        })
-        .collect();
+    // Coarse cells: each cell's queries span dozens of edges (its reference surface, its zone),
+    // and a grid of edge-sized cells spent most of their time walking empty ones.
+    let mut grid = SpatialHash::build(mesh, WHOLE_MESH_GRID_EDGES * settings.target_edge)?;
     // A subdivided mesh is as even as its input: only where an edge left the band is there
     // work, as after a stroke (most of a million vertices need nothing).
-    let (start, rings) = if levels > 0 {
-        (Start::Subdivided, 1)
+    let start = if levels > 0 {
+        Start::Subdivided
     } else {
-        (Start::Everywhere, 0)
+        Start::Everywhere
     };
-    let (report, _) = remesh(
-        mesh,
-        &mut grid,
-        &seeds,
-        &RemeshSettings {
-            region_rings: rings,
-            ..*settings
-        },
-        (start, &mut RemeshSets::default()),
-    );
+    let report = cells::remesh_by_cells(mesh, &mut grid, settings, start, culling);
     mesh.compact();
     Ok(RemeshReport {
         subdivisions: levels,
@@ -280,6 +317,8 @@ struct Remesher<'a> {
     /// A whole-mesh remesh ([`Start::Everywhere`], [`Start::Subdivided`]): relaxation passes
     /// over vertices whose move is short before projecting them.
     whole: bool,
+    /// The sheet zone the region lies in, while its edits keep it one (`zone`).
+    zone: Option<Zone>,
 }
 
 impl<'a> Remesher<'a> {
@@ -289,6 +328,7 @@ impl<'a> Remesher<'a> {
         seeds: &[u32],
         settings: &RemeshSettings,
         (start, sets): (Start, &'a mut RemeshSets),
+        closed: Option<ClosedParts>,
     ) -> Self {
         let live = |v: u32| (v as usize) < mesh.vertex_count() && !mesh.is_vertex_dead(v);
         let (short, long) = (
@@ -333,7 +373,7 @@ impl<'a> Remesher<'a> {
         }
         region.sort_unstable();
         let surface = ReferenceSurface::capture(mesh, grid, &region, settings);
-        let closed = ClosedParts::find(mesh, &region);
+        let closed = closed.unwrap_or_else(|| ClosedParts::find(mesh, &region));
         let mut remesher = Remesher {
             report: RemeshReport {
                 region_vertices: region.len(),
@@ -351,6 +391,7 @@ impl<'a> Remesher<'a> {
             scratch: Vec::new(),
             near: Vec::new(),
             whole: start != Start::OutOfBand,
+            zone: None,
         };
         for v in starting {
             remesher.mark_dirty(v);

@@ -15,28 +15,12 @@ impl Remesher<'_> {
     /// face outside its neighbourhood gets closer than the collision distance (or than it
     /// already was), and its faces at the new position cross no other layer.
     pub(super) fn move_is_safe(&mut self, v: u32, target: Vec3, merged: Option<u32>) -> bool {
-        let d = self.settings.collision_distance;
-        let from = self.mesh.positions()[v as usize];
-        let mut ring = std::mem::take(&mut self.scratch);
-        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
-        if let Some(m) = merged {
-            let mut more = Vec::new();
-            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
-            ring.extend(more);
-        }
-        let layer = self.mesh.vertex_layers()[v as usize];
         let positions = self.mesh.positions();
         let faces = self.mesh.faces();
         let carrying: Vec<u32> = [Some(v), merged]
             .into_iter()
             .flatten()
             .flat_map(|w| self.mesh.faces_around(w).collect::<Vec<_>>())
-            .collect();
-        // The surface the edit replaces, as it is now (a face around both ends comes twice,
-        // which a nearest distance does not mind).
-        let before: Vec<[Vec3; 3]> = carrying
-            .iter()
-            .map(|&f| faces[f as usize].map(|w| positions[w as usize]))
             .collect();
         // The faces that will carry the vertex, at their new positions.
         let moved: Vec<([u32; 3], [Vec3; 3])> = carrying
@@ -57,10 +41,41 @@ impl Remesher<'_> {
                 Some((ids, at))
             })
             .collect();
+        self.unless_vouched(&moved, |remesher| {
+            remesher.move_checks(v, (target, merged), &carrying, &moved)
+        })
+    }
+
+    /// [`Self::move_is_safe`]'s checks in full, given the faces around the moving vertices
+    /// (`carrying`) and the faces they become (`moved`).
+    fn move_checks(
+        &mut self,
+        v: u32,
+        (target, merged): (Vec3, Option<u32>),
+        carrying: &[u32],
+        moved: &[([u32; 3], [Vec3; 3])],
+    ) -> bool {
+        let d = self.settings.collision_distance;
+        let from = self.mesh.positions()[v as usize];
+        let mut ring = std::mem::take(&mut self.scratch);
+        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
+        if let Some(m) = merged {
+            let mut more = Vec::new();
+            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
+            ring.extend(more);
+        }
+        let layer = self.mesh.vertex_layers()[v as usize];
+        let (positions, faces) = (self.mesh.positions(), self.mesh.faces());
+        // The surface the edit replaces, as it is now (a face around both ends comes twice,
+        // which a nearest distance does not mind).
+        let before: Vec<[Vec3; 3]> = carrying
+            .iter()
+            .map(|&f| faces[f as usize].map(|w| positions[w as usize]))
+            .collect();
         // One gathering serves both tests: faces near the move (for the distance test) and near
         // the moved faces (for the crossing test).
         let reach = Aabb::of_points(&[from, target]).expanded(d);
-        let around = bounds_of(&moved).including_box(&reach);
+        let around = bounds_of(moved).including_box(&reach);
         let near = self.gather_near(&around);
         let mut safe = true;
         for candidate in &near {
@@ -83,10 +98,31 @@ impl Remesher<'_> {
         }
         self.scratch = ring;
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
+
         let clear = safe
-            && self.faces_clear_among(&moved, &involved, &[], &near)
-            && self.keeps_layer_gap(layer, &before, &moved);
+            && self.faces_clear_among(moved, &involved, &[], &near)
+            && self.keeps_layer_gap(layer, &before, moved);
         self.near = near;
+        clear
+    }
+
+    /// `check`'s verdict on an edit that makes `triangles`, unless the cell's sheet zone
+    /// vouches for them (`zone`): then the edit is safe unchecked. An edit checked in full
+    /// that passes ends the zone, since its faces may leave the zone no longer a sheet.
+    fn unless_vouched(
+        &mut self,
+        triangles: &[([u32; 3], [Vec3; 3])],
+        check: impl FnOnce(&mut Self) -> bool,
+    ) -> bool {
+        let zone = self.zone.as_ref();
+        if zone.is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t))) {
+            self.report.culled += 1;
+            return true;
+        }
+        let clear = check(self);
+        if clear {
+            self.zone = None;
+        }
         clear
     }
 
@@ -98,12 +134,14 @@ impl Remesher<'_> {
         replaced: [u32; 2],
         before: &[[Vec3; 3]],
     ) -> bool {
-        let layer = self.mesh.face_layers()[replaced[0] as usize];
-        let near = self.gather_near(&bounds_of(after));
-        let clear = self.faces_clear_among(after, &[], &replaced, &near)
-            && self.keeps_layer_gap(layer, before, after);
-        self.near = near;
-        clear
+        self.unless_vouched(after, |remesher| {
+            let layer = remesher.mesh.face_layers()[replaced[0] as usize];
+            let near = remesher.gather_near(&bounds_of(after));
+            let clear = remesher.faces_clear_among(after, &[], &replaced, &near)
+                && remesher.keeps_layer_gap(layer, before, after);
+            remesher.near = near;
+            clear
+        })
     }
 
     /// The layer gap kept through an edit that replaces the surface `before` (triangles of
@@ -173,17 +211,20 @@ impl Remesher<'_> {
             replaced.push(o / 3);
         }
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
-        // The halves lie on the faces they replace: only the new vertex needs the wider reach.
-        let mut reach = bounds_of(&halves);
-        if self.mesh.layer_count() > 1 {
-            let d = self.settings.collision_distance;
-            reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
-        }
-        let near = self.gather_near(&reach);
-        let clear = self.faces_clear_among(&halves, &[], &replaced, &near)
-            && self.midpoint_keeps_gap(layer, ends, at_m, &near);
-        self.near = near;
-        clear
+        self.unless_vouched(&halves, |remesher| {
+            // The halves lie on the faces they replace: only the new vertex needs the wider
+            // reach.
+            let mut reach = bounds_of(&halves);
+            if remesher.mesh.layer_count() > 1 {
+                let d = remesher.settings.collision_distance;
+                reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
+            }
+            let near = remesher.gather_near(&reach);
+            let clear = remesher.faces_clear_among(&halves, &[], &replaced, &near)
+                && remesher.midpoint_keeps_gap(layer, ends, at_m, &near);
+            remesher.near = near;
+            clear
+        })
     }
 
     /// A split's new vertex `m` on the edge `ends` is no nearer to another layer's face within

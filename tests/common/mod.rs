@@ -135,3 +135,31 @@ pub fn closed_volume(mesh: &slayer::mesh::Mesh) -> f64 {
     assert_eq!(closed.len(), 1, "one closed component");
     closed[0].volume
 }
+
+/// A torus about z: `around` quads the long way, `across` the short way, each split in two.
+pub fn torus(around: u32, across: u32, (major, minor): (f32, f32)) -> slayer::mesh::Mesh {
+    use std::f32::consts::TAU;
+    let mut positions = Vec::new();
+    for i in 0..around {
+        let u = TAU * i as f32 / around as f32;
+        for j in 0..across {
+            let v = TAU * j as f32 / across as f32;
+            let ring = major + minor * v.cos();
+            positions.push(glam::Vec3::new(
+                ring * u.cos(),
+                ring * u.sin(),
+                minor * v.sin(),
+            ));
+        }
+    }
+    let at = |i: u32, j: u32| (i % around) * across + j % across;
+    let mut faces = Vec::new();
+    for i in 0..around {
+        for j in 0..across {
+            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let layers = vec![0; faces.len()];
+    slayer::mesh::Mesh::new(positions, faces, layers, vec!["ring".into()]).expect("torus")
+}
