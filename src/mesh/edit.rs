@@ -10,6 +10,10 @@ use glam::Vec3;
 
 use super::{INVALID, Mesh, VertexFlags, face_of, next, prev};
 
+/// The longest vertex ring [`Mesh::is_collapse_ok`] gathers on the stack; longer ones (rare)
+/// go to the heap.
+const STACK_RING: usize = 32;
+
 impl Mesh {
     /// The two end vertices of the edge opposite `corner`.
     pub fn edge_vertices(&self, corner: u32) -> (u32, u32) {
@@ -226,8 +230,24 @@ impl Mesh {
         if !boundary_edge && self.is_boundary_vertex(b) {
             return false;
         }
-        let ring_a = self.neighbours(a);
-        let ring_b = self.neighbours(b);
+        // Most fans are short: their rings are gathered on the stack, where this test runs
+        // millions of times in a whole-mesh remesh.
+        let (mut stack_a, mut stack_b) = ([0; STACK_RING], [0; STACK_RING]);
+        let (heap_a, heap_b);
+        let ring_a = match self.ring_on_stack(a, &mut stack_a) {
+            Some(n) => &stack_a[..n],
+            None => {
+                heap_a = self.neighbours(a);
+                &heap_a[..]
+            }
+        };
+        let ring_b = match self.ring_on_stack(b, &mut stack_b) {
+            Some(n) => &stack_b[..n],
+            None => {
+                heap_b = self.neighbours(b);
+                &heap_b[..]
+            }
+        };
         let shared = ring_a.iter().filter(|v| ring_b.contains(v)).count();
         let expected = if boundary_edge { 1 } else { 2 };
         if shared != expected || !ring_a.contains(&x) || (!boundary_edge && !ring_a.contains(&y)) {
@@ -243,8 +263,28 @@ impl Mesh {
                 return false;
             }
         }
-        // The survivor must keep a fan: a tiny closed component would fold flat.
-        self.valence(a) + self.valence(b) > 4 + expected
+        // The survivor must keep a fan: a tiny closed component would fold flat. (A ring holds
+        // as many vertices as the valence counts edges.)
+        ring_a.len() + ring_b.len() > 4 + expected
+    }
+
+    /// [`Self::neighbours`] of `vertex` into `ring`, in the same order; how many, or none
+    /// when they do not fit.
+    fn ring_on_stack(&self, vertex: u32, ring: &mut [u32; STACK_RING]) -> Option<usize> {
+        let mut count = 0;
+        let first = self.adjacency.vertex_corner[vertex as usize];
+        let boundary = self
+            .is_boundary_vertex(vertex)
+            .then(|| self.corner_vertex(prev(first)));
+        let around = self.adjacency.corners_around(vertex);
+        for u in boundary
+            .into_iter()
+            .chain(around.map(|c| self.corner_vertex(next(c))))
+        {
+            *ring.get_mut(count)? = u;
+            count += 1;
+        }
+        Some(count)
     }
 
     /// Collapses the edge opposite `corner` (check [`is_collapse_ok`](Self::is_collapse_ok)

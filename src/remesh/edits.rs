@@ -98,11 +98,10 @@ impl Remesher<'_> {
             let positions = self.mesh.positions();
             let middle = 0.5 * (positions[a as usize] + positions[b as usize]);
             // (Meeting in the middle from the other side would test the same faces again.)
-            let first = if c != INVALID && self.mesh.is_collapse_ok(c) {
-                c
-            } else {
-                o
-            };
+            // Each side's link condition is asked once: nothing changes until a collapse.
+            let ok_c = self.mesh.is_collapse_ok(c);
+            let mut ok_o = None;
+            let first = if ok_c { c } else { o };
             let choices = [
                 (first, a, b, Some(middle)),
                 (c, a, b, None),
@@ -111,7 +110,14 @@ impl Remesher<'_> {
             let mut done = false;
             let mut refused = false;
             for (corner, keep, remove, to) in choices {
-                if corner == INVALID || done || !self.mesh.is_collapse_ok(corner) {
+                if corner == INVALID || done {
+                    continue;
+                }
+                let ok = match corner == c {
+                    true => ok_c,
+                    false => *ok_o.get_or_insert_with(|| self.mesh.is_collapse_ok(o)),
+                };
+                if !ok {
                     continue;
                 }
                 let (keep, remove) = if corner == c { (keep, remove) } else { (b, a) };
