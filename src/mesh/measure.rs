@@ -49,6 +49,18 @@ impl Mesh {
         edges
     }
 
+    /// The longest edge of the live faces.
+    pub fn longest_edge(&self) -> f32 {
+        (0..self.face_count())
+            .into_par_iter()
+            .filter(|&f| !self.is_face_dead(f))
+            .map(|f| {
+                let [a, b, c] = self.face_positions(f);
+                a.distance(b).max(b.distance(c)).max(c.distance(a))
+            })
+            .reduce(|| 0.0, f32::max)
+    }
+
     /// Mean, spread and range of edge lengths (f64 sums, so a million edges lose nothing).
     pub fn edge_length_stats(&self) -> EdgeLengthStats {
         let lengths: Vec<f64> = self

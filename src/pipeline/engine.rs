@@ -358,6 +358,9 @@ pub(super) fn fuse_touched(
 
 /// Longest edge of the given faces (all live faces when `faces` is `None`).
 pub(super) fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
+    let Some(list) = faces else {
+        return mesh.longest_edge();
+    };
     let edge_max = |f: usize| {
         if mesh.is_face_dead(f) {
             return 0.0f32;
@@ -365,16 +368,9 @@ pub(super) fn longest_edge(mesh: &Mesh, faces: Option<&[u32]>) -> f32 {
         let [a, b, c] = mesh.face_positions(f);
         a.distance(b).max(b.distance(c)).max(c.distance(a))
     };
-    match faces {
-        Some(list) => list
-            .iter()
-            .map(|&f| edge_max(f as usize))
-            .fold(0.0, f32::max),
-        None => (0..mesh.face_count())
-            .into_par_iter()
-            .map(edge_max)
-            .reduce(|| 0.0, f32::max),
-    }
+    list.iter()
+        .map(|&f| edge_max(f as usize))
+        .fold(0.0, f32::max)
 }
 
 /// The longest edge at `vertices`: after they moved, the only edges whose length changed.

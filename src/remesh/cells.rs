@@ -37,7 +37,7 @@ pub(super) fn remesh_by_cells(
     let mut sets = RemeshSets::default();
     let mut zones = ZoneFinder::default();
     let mut report = RemeshReport::default();
-    let mut longest_edge = longest_edge(mesh);
+    let mut longest_edge = mesh.longest_edge();
     let width = CELL_EDGES * settings.target_edge;
     for (shift, start) in [
         (0.0, start),
@@ -77,17 +77,6 @@ fn live_vertices(mesh: &Mesh) -> Vec<u32> {
             !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
         })
         .collect()
-}
-
-/// The longest edge of the live faces.
-fn longest_edge(mesh: &Mesh) -> f32 {
-    (0..mesh.face_count())
-        .filter(|&f| !mesh.is_face_dead(f))
-        .map(|f| {
-            let [a, b, c] = mesh.face_positions(f);
-            a.distance(b).max(b.distance(c)).max(c.distance(a))
-        })
-        .fold(0.0, f32::max)
 }
 
 /// The live vertices grouped by the cube `width` wide they lie in, the cubes shifted by

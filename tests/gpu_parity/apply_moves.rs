@@ -5,8 +5,8 @@ use glam::Vec3;
 use slayer::grid::SpatialHash;
 
 use crate::common::{
-    PROXIMITY_TOLERANCE, ProximityScene, SIZES, folded_sheet, gathered_region, gpu, longest_edge,
-    packed, pressed_sheets, random_positions, random_u32s, shuffled,
+    PROXIMITY_TOLERANCE, ProximityScene, SIZES, folded_sheet, gathered_region, gpu, packed,
+    pressed_sheets, random_positions, random_u32s, shuffled,
 };
 
 /// Random moving entries over distinct vertices of `vertex_count`, with targets, verdicts (about
@@ -160,7 +160,7 @@ fn check_clamp_loop(scene: ProximityScene) {
             parallel: true,
             collision_distance: 0.5 * scene.edge,
             ring: 2,
-            max_edge: longest_edge(mesh),
+            max_edge: mesh.longest_edge(),
             cull: true,
         };
         let (mut region, target_of) = gathered_region(&state, mesh, &selection, &targets);

@@ -6,9 +6,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::gpu::table_size_for;
 
-use crate::common::{
-    ProximityScene, gpu, longest_edge, mesh_table, packed, pressed_sheets, shuffled,
-};
+use crate::common::{ProximityScene, gpu, mesh_table, packed, pressed_sheets, shuffled};
 
 /// A step for the backstop filter: `scene`'s mesh at the step's start, with `order` moved to
 /// `targets` unclamped, so that faces cross, turn over and fold onto their neighbours.
@@ -95,7 +93,7 @@ fn backstop_filter_matches_cpu_mirror_and_keeps_every_crossing() {
                 mesh: &scene.mesh,
                 current: &current,
                 selection: &selection,
-                max_edge: longest_edge(&scene.mesh),
+                max_edge: scene.mesh.longest_edge(),
                 cell_size: scene.edge,
                 capacity: 1 << 16,
             };

@@ -149,16 +149,6 @@ pub fn selection_under(
 /// closest-point arithmetic's multiply-adds.
 pub const PROXIMITY_TOLERANCE: f32 = 1e-5;
 
-pub fn longest_edge(mesh: &slayer::mesh::Mesh) -> f32 {
-    (0..mesh.face_count())
-        .filter(|&f| !mesh.is_face_dead(f))
-        .map(|f| {
-            let [a, b, c] = mesh.face_positions(f);
-            a.distance(b).max(b.distance(c)).max(c.distance(a))
-        })
-        .fold(0.0, f32::max)
-}
-
 /// A step to test proximity on: the mesh at the step's start, its selection (a seeded shuffle
 /// of the vertices that move) and every vertex's tentative position.
 pub struct ProximityScene {

@@ -8,8 +8,8 @@ use slayer::gpu::{GpuContext, SelectedVertex};
 use slayer::mesh::INVALID;
 
 use crate::common::{
-    Binding, SIZES, bumpy_sheets, gpu, gpu_for_normals, half_moved_list, longest_edge,
-    normal_params, packed, random_positions, shuffled,
+    Binding, SIZES, bumpy_sheets, gpu, gpu_for_normals, half_moved_list, normal_params, packed,
+    random_positions, shuffled,
 };
 
 #[test]
@@ -273,7 +273,7 @@ fn check_moved_edges(binding: Binding) {
     let topology = slayer::gpu::PackedTopology::of(&start);
     let order = shuffled((0..vertex_count as u32).collect(), 931);
     let mut rng = ChaCha8Rng::seed_from_u64(932);
-    let initial = longest_edge(&start);
+    let initial = start.longest_edge();
     let sizes = SIZES.map(|size| size.min(vertex_count));
     for (k, &size) in sizes.iter().enumerate() {
         if k + 1 == sizes.len() {

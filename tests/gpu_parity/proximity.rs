@@ -7,8 +7,8 @@ use slayer::grid::SpatialHash;
 
 use crate::common::{
     Binding, PROXIMITY_TOLERANCE, ProximityScene, binding_limit_paging, folded_sheet,
-    gathered_region, gpu, gpu_with_binding_limit, host_moving_list, longest_edge, mesh_table,
-    packed, pressed_sheets,
+    gathered_region, gpu, gpu_with_binding_limit, host_moving_list, mesh_table, packed,
+    pressed_sheets,
 };
 
 /// The proximity mirror's verdicts for `selection` of `scene`, with `current` positions.
@@ -63,7 +63,7 @@ fn reference_pull_back(
         parallel: false,
         collision_distance: distance,
         ring,
-        max_edge: longest_edge(mesh).max(longest_edge(&current)),
+        max_edge: mesh.longest_edge().max(current.longest_edge()),
         cull: true,
     };
     let pairs: Vec<(u32, f32)> = selection.iter().map(|&v| (v, 1.0)).collect();
@@ -154,7 +154,7 @@ fn check_proximity(scene: ProximityScene, binding: Binding) {
             selection,
             distance,
             ring,
-            max_edge: longest_edge(&scene.mesh),
+            max_edge: scene.mesh.longest_edge(),
             cell_size: scene.edge,
             marks: None,
         };
