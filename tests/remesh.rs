@@ -203,8 +203,8 @@ fn sheet_zones_skip_checks_without_changing_the_remesh() {
         let mut settings = RemeshSettings::new(mesh.mean_edge_length());
         settings.exclusion_ring = exclusion_ring(&mesh, settings.target_edge);
         let (mut culled, mut checked) = (mesh.clone(), mesh);
-        let on = remesh_all_with(&mut culled, &settings, Culling::On).unwrap();
-        let off = remesh_all_with(&mut checked, &settings, Culling::Off).unwrap();
+        let on = remesh_all_with(&mut culled, &settings, Culling::On, &mut |_| {}).unwrap();
+        let off = remesh_all_with(&mut checked, &settings, Culling::Off, &mut |_| {}).unwrap();
         eprintln!("{name}: culled {on:?}\n  checked {off:?}");
         culled.validate().unwrap();
         assert_eq!(find_intersections(&culled).total(), 0, "{name}");

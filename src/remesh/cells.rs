@@ -14,7 +14,7 @@ use glam::{IVec3, Vec3};
 
 use super::shape::ClosedParts;
 use super::zone::ZoneFinder;
-use super::{Culling, Pass, RemeshReport, RemeshSets, RemeshSettings, Start, remesh};
+use super::{Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, remesh};
 use crate::geom::Aabb;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh};
@@ -30,8 +30,8 @@ pub(super) fn remesh_by_cells(
     mesh: &mut Mesh,
     grid: &mut SpatialHash,
     settings: &RemeshSettings,
-    start: Start,
-    culling: Culling,
+    (start, culling): (Start, Culling),
+    progress: &mut dyn FnMut(Progress),
 ) -> RemeshReport {
     let mut closed = ClosedParts::find(mesh, &live_vertices(mesh));
     let mut sets = RemeshSets::default();
@@ -39,18 +39,21 @@ pub(super) fn remesh_by_cells(
     let mut report = RemeshReport::default();
     let mut longest_edge = mesh.longest_edge();
     let width = CELL_EDGES * settings.target_edge;
-    for (shift, start) in [
+    let rounds = [
         (0.0, start),
         (0.5, Start::Subdivided),
         (0.25, Start::Subdivided),
-    ] {
+    ];
+    for (round, (shift, start)) in rounds.into_iter().enumerate() {
         // Every vertex of the first round's cells, where it begins everywhere; around the
         // vertices out of band, in the others.
         let settings = RemeshSettings {
             region_rings: u32::from(start != Start::Everywhere),
             ..*settings
         };
-        for (core, seeds) in cells(mesh, width, shift) {
+        let cells = cells(mesh, width, shift);
+        let count = cells.len();
+        for (cell, (core, seeds)) in cells.into_iter().enumerate() {
             let zone = match culling {
                 Culling::On => zones.find(mesh, grid, &core, (settings.target_edge, longest_edge)),
                 Culling::Off => None,
@@ -64,6 +67,12 @@ pub(super) fn remesh_by_cells(
             let (done, _) = remesh(mesh, grid, &seeds, &settings, pass);
             longest_edge = longest_edge.max(done.longest_edge);
             report.add(&done);
+            progress(Progress {
+                round: round + 1,
+                rounds: rounds.len(),
+                cell: cell + 1,
+                cells: count,
+            });
         }
     }
     report.passes = 1;

@@ -247,7 +247,17 @@ pub enum RemeshError {
 /// ([`subdivision_levels`], [`subdivide`]), then the passes run over every vertex, cell by
 /// cell (`cells`).
 pub fn remesh_all(mesh: &mut Mesh, settings: &RemeshSettings) -> Result<RemeshReport, RemeshError> {
-    remesh_all_with(mesh, settings, Culling::On)
+    remesh_all_with(mesh, settings, Culling::On, &mut |_| {})
+}
+
+/// How far a whole-mesh remesh has come: `cell` of `cells` in round `round` (from 1) of
+/// `rounds` (`cells`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    pub round: usize,
+    pub rounds: usize,
+    pub cell: usize,
+    pub cells: usize,
 }
 
 /// Whether a whole-mesh remesh lets sheet zones settle the safety checks of their edits
@@ -261,11 +271,13 @@ pub enum Culling {
 /// The vertex grid's cell, in target edge lengths, for a whole-mesh remesh.
 const WHOLE_MESH_GRID_EDGES: f32 = 4.0;
 
-/// [`remesh_all`], with the zones' culling as `culling` says.
+/// [`remesh_all`], with the zones' culling as `culling` says, telling `progress` after each
+/// cell.
 pub fn remesh_all_with(
     mesh: &mut Mesh,
     settings: &RemeshSettings,
     culling: Culling,
+    progress: &mut dyn FnMut(Progress),
 ) -> Result<RemeshReport, RemeshError> {
     // Before anything changes: a target the grid refuses leaves the mesh as it was.
     SpatialHash::new(settings.target_edge, 0)?;
@@ -285,7 +297,7 @@ pub fn remesh_all_with(
     } else {
         Start::Everywhere
     };
-    let report = cells::remesh_by_cells(mesh, &mut grid, settings, start, culling);
+    let report = cells::remesh_by_cells(mesh, &mut grid, settings, (start, culling), progress);
     mesh.compact();
     Ok(RemeshReport {
         subdivisions: levels,
