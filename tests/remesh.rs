@@ -223,7 +223,8 @@ fn sheet_zones_skip_checks_without_changing_the_remesh() {
 /// one order, whatever the pool.
 #[test]
 fn a_whole_mesh_remesh_is_the_same_on_one_and_two_threads() {
-    let torus = common::torus(160, 60, (1.0, 0.35));
+    // 30,000 vertices: remeshed by cells.
+    let torus = common::torus(300, 100, (1.0, 0.35));
     let settings = RemeshSettings::new(torus.mean_edge_length());
     let remeshed = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()

@@ -16,17 +16,64 @@ use super::shape::ClosedParts;
 use super::zone::ZoneFinder;
 use super::{Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, remesh};
 use crate::geom::Aabb;
-use crate::grid::SpatialHash;
+use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{INVALID, Mesh};
 
 /// A cell's width, in target edge lengths: wide enough that the zone's margin around it is a
 /// small share of its faces, narrow enough that a sheet's normals stay in a cone across it.
 const CELL_EDGES: f32 = 16.0;
 
-/// Remeshes every vertex of `mesh`, cell by cell (the module's rounds). `start` says which of
-/// a cell's vertices the first round begins at; the later ones begin where edges are out of
-/// band.
-pub(super) fn remesh_by_cells(
+/// Below this many vertices a mesh is remeshed as one region: cells pay for themselves where
+/// one region's index grows large, and a small mesh has no seams to pay for.
+const CELLS_FROM_VERTICES: usize = 20_000;
+/// The vertex grid's cell, in target edge lengths, when remeshing by cells: each cell's
+/// queries span dozens of edges (its reference surface, its zone), and a grid of edge-sized
+/// cells spent most of their time walking empty ones.
+const GRID_EDGES: f32 = 4.0;
+
+/// Remeshes every vertex of `mesh`: a small mesh as one region, a larger one cell by cell (the
+/// module's rounds). `start` says which vertices the (first round's) regions begin at; the
+/// later rounds begin where edges are out of band.
+pub(super) fn remesh_whole(
+    mesh: &mut Mesh,
+    settings: &RemeshSettings,
+    (start, culling): (Start, Culling),
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RemeshReport, GridError> {
+    let live = live_vertices(mesh);
+    if live.len() < CELLS_FROM_VERTICES {
+        let mut grid = SpatialHash::build(mesh, settings.target_edge)?;
+        let settings = RemeshSettings {
+            region_rings: rings(start),
+            ..*settings
+        };
+        let pass = Pass {
+            start,
+            sets: &mut RemeshSets::default(),
+            closed: None,
+            zone: None,
+        };
+        let (report, _) = remesh(mesh, &mut grid, &live, &settings, pass);
+        progress(Progress {
+            round: 1,
+            rounds: 1,
+            cell: 1,
+            cells: 1,
+        });
+        return Ok(report);
+    }
+    let mut grid = SpatialHash::build(mesh, GRID_EDGES * settings.target_edge)?;
+    let report = remesh_by_cells(mesh, &mut grid, settings, (start, culling), progress);
+    Ok(report)
+}
+
+/// Every vertex of the regions `start` begins at, where it begins everywhere; around them, by
+/// one ring, where it begins out of band.
+fn rings(start: Start) -> u32 {
+    u32::from(start != Start::Everywhere)
+}
+
+fn remesh_by_cells(
     mesh: &mut Mesh,
     grid: &mut SpatialHash,
     settings: &RemeshSettings,
@@ -45,10 +92,8 @@ pub(super) fn remesh_by_cells(
         (0.25, Start::Subdivided),
     ];
     for (round, (shift, start)) in rounds.into_iter().enumerate() {
-        // Every vertex of the first round's cells, where it begins everywhere; around the
-        // vertices out of band, in the others.
         let settings = RemeshSettings {
-            region_rings: u32::from(start != Start::Everywhere),
+            region_rings: rings(start),
             ..*settings
         };
         let cells = cells(mesh, width, shift);

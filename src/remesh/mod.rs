@@ -268,9 +268,6 @@ pub enum Culling {
     Off,
 }
 
-/// The vertex grid's cell, in target edge lengths, for a whole-mesh remesh.
-const WHOLE_MESH_GRID_EDGES: f32 = 4.0;
-
 /// [`remesh_all`], with the zones' culling as `culling` says, telling `progress` after each
 /// cell.
 pub fn remesh_all_with(
@@ -287,9 +284,6 @@ pub fn remesh_all_with(
         *mesh = subdivide(mesh)?;
     }
     let subdivided_ms = started.elapsed().as_secs_f64() * 1e3;
-    // Coarse cells: each cell's queries span dozens of edges (its reference surface, its zone),
-    // and a grid of edge-sized cells spent most of their time walking empty ones.
-    let mut grid = SpatialHash::build(mesh, WHOLE_MESH_GRID_EDGES * settings.target_edge)?;
     // A subdivided mesh is as even as its input: only where an edge left the band is there
     // work, as after a stroke (most of a million vertices need nothing).
     let start = if levels > 0 {
@@ -297,7 +291,7 @@ pub fn remesh_all_with(
     } else {
         Start::Everywhere
     };
-    let report = cells::remesh_by_cells(mesh, &mut grid, settings, (start, culling), progress);
+    let report = cells::remesh_whole(mesh, settings, (start, culling), progress)?;
     mesh.compact();
     Ok(RemeshReport {
         subdivisions: levels,
