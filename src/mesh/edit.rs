@@ -232,22 +232,8 @@ impl Mesh {
         }
         // Most fans are short: their rings are gathered on the stack, where this test runs
         // millions of times in a whole-mesh remesh.
-        let (mut stack_a, mut stack_b) = ([0; STACK_RING], [0; STACK_RING]);
-        let (heap_a, heap_b);
-        let ring_a = match self.ring_on_stack(a, &mut stack_a) {
-            Some(n) => &stack_a[..n],
-            None => {
-                heap_a = self.neighbours(a);
-                &heap_a[..]
-            }
-        };
-        let ring_b = match self.ring_on_stack(b, &mut stack_b) {
-            Some(n) => &stack_b[..n],
-            None => {
-                heap_b = self.neighbours(b);
-                &heap_b[..]
-            }
-        };
+        let (ring_a, ring_b) = (Ring::of(self, a), Ring::of(self, b));
+        let (ring_a, ring_b) = (ring_a.as_slice(), ring_b.as_slice());
         let shared = ring_a.iter().filter(|v| ring_b.contains(v)).count();
         let expected = if boundary_edge { 1 } else { 2 };
         if shared != expected || !ring_a.contains(&x) || (!boundary_edge && !ring_a.contains(&y)) {
@@ -266,25 +252,6 @@ impl Mesh {
         // The survivor must keep a fan: a tiny closed component would fold flat. (A ring holds
         // as many vertices as the valence counts edges.)
         ring_a.len() + ring_b.len() > 4 + expected
-    }
-
-    /// [`Self::neighbours`] of `vertex` into `ring`, in the same order; how many, or none
-    /// when they do not fit.
-    fn ring_on_stack(&self, vertex: u32, ring: &mut [u32; STACK_RING]) -> Option<usize> {
-        let mut count = 0;
-        let first = self.adjacency.vertex_corner[vertex as usize];
-        let boundary = self
-            .is_boundary_vertex(vertex)
-            .then(|| self.corner_vertex(prev(first)));
-        let around = self.adjacency.corners_around(vertex);
-        for u in boundary
-            .into_iter()
-            .chain(around.map(|c| self.corner_vertex(next(c))))
-        {
-            *ring.get_mut(count)? = u;
-            count += 1;
-        }
-        Some(count)
     }
 
     /// Collapses the edge opposite `corner` (check [`is_collapse_ok`](Self::is_collapse_ok)
@@ -370,5 +337,33 @@ impl Mesh {
         }
         self.version.topology += 1;
         a
+    }
+}
+
+/// A vertex's ring ([`Mesh::ring`]), on the stack when it fits in [`STACK_RING`].
+enum Ring {
+    Stack([u32; STACK_RING], usize),
+    Heap(Vec<u32>),
+}
+
+impl Ring {
+    fn of(mesh: &Mesh, vertex: u32) -> Ring {
+        let mut stack = [0; STACK_RING];
+        let mut count = 0;
+        for u in mesh.ring(vertex) {
+            let Some(slot) = stack.get_mut(count) else {
+                return Ring::Heap(mesh.neighbours(vertex));
+            };
+            *slot = u;
+            count += 1;
+        }
+        Ring::Stack(stack, count)
+    }
+
+    fn as_slice(&self) -> &[u32] {
+        match self {
+            Ring::Stack(stack, count) => &stack[..*count],
+            Ring::Heap(ring) => ring,
+        }
     }
 }

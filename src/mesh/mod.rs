@@ -323,15 +323,21 @@ impl Mesh {
     /// neighbour to the other.
     pub fn neighbours(&self, vertex: u32) -> Vec<u32> {
         let mut ring = Vec::with_capacity(8);
-        if self.is_boundary_vertex(vertex) {
-            // The first corner's other edge is the boundary edge the fan starts from.
-            let first = self.adjacency.vertex_corner[vertex as usize];
-            ring.push(self.corner_vertex(prev(first)));
-        }
-        for c in self.adjacency.corners_around(vertex) {
-            ring.push(self.corner_vertex(next(c)));
-        }
+        ring.extend(self.ring(vertex));
         ring
+    }
+
+    /// [`Self::neighbours`] without gathering them.
+    pub fn ring(&self, vertex: u32) -> impl Iterator<Item = u32> + '_ {
+        // The first corner's other edge is the boundary edge the fan starts from.
+        let first = self.adjacency.vertex_corner[vertex as usize];
+        let boundary = self
+            .is_boundary_vertex(vertex)
+            .then(|| self.corner_vertex(prev(first)));
+        let around = self.adjacency.corners_around(vertex);
+        boundary
+            .into_iter()
+            .chain(around.map(|c| self.corner_vertex(next(c))))
     }
 
     /// True when the vertex lies on the boundary of an open sheet.

@@ -17,7 +17,7 @@ use super::zone::ZoneFinder;
 use super::{Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, remesh};
 use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
-use crate::mesh::{INVALID, Mesh};
+use crate::mesh::Mesh;
 
 /// A cell's width, in target edge lengths: wide enough that the zone's margin around it is a
 /// small share of its faces, narrow enough that a sheet's normals stay in a cone across it.
@@ -127,9 +127,7 @@ fn remesh_by_cells(
 /// The vertices with faces.
 fn live_vertices(mesh: &Mesh) -> Vec<u32> {
     (0..mesh.vertex_count() as u32)
-        .filter(|&v| {
-            !mesh.is_vertex_dead(v) && mesh.adjacency().vertex_corner[v as usize] != INVALID
-        })
+        .filter(|&v| mesh.is_vertex_live(v))
         .collect()
 }
 

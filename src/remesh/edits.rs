@@ -293,7 +293,7 @@ impl Remesher<'_> {
         movable.start(self.mesh.vertex_count());
         let mut live: Vec<u32> = Vec::new();
         for &v in &self.dirty_list {
-            if !self.live(v) {
+            if !self.mesh.is_vertex_live(v) {
                 continue;
             }
             for u in std::iter::once(v).chain(self.mesh.neighbours(v)) {

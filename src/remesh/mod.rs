@@ -34,7 +34,7 @@ use crate::collide::Stamps;
 
 use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
-use crate::mesh::{INVALID, Mesh, next, prev};
+use crate::mesh::{Mesh, next, prev};
 pub use quality::{
     AngleSummary, Distance, Quality, Surface, VALENCE_BUCKETS, smallest_angle_degrees,
 };
@@ -477,16 +477,12 @@ impl<'a> Remesher<'a> {
         (report, changed)
     }
 
-    fn live(&self, v: u32) -> bool {
-        !self.mesh.is_vertex_dead(v) && self.mesh.adjacency().vertex_corner[v as usize] != INVALID
-    }
-
     /// Edges with both ends in the region, each once, as corners. (Edges leaving the region
     /// are left alone: the ring around the touched vertices is the margin.)
     fn region_edges(&self) -> Vec<u32> {
         let mut edges = Vec::new();
         for &v in &self.region {
-            if self.live(v) {
+            if self.mesh.is_vertex_live(v) {
                 self.push_edges_at(v, &mut edges);
             }
         }

@@ -28,6 +28,7 @@
 
 use glam::Vec3;
 
+use super::normal;
 use crate::collide::{Stamps, boundary_loop, normal_cone, projected_loop_is_simple};
 use crate::geom::Aabb;
 use crate::grid::SpatialHash;
@@ -115,7 +116,7 @@ impl Zone {
     pub(super) fn holds<'t>(&self, triangles: impl IntoIterator<Item = &'t [Vec3; 3]>) -> bool {
         triangles.into_iter().all(|t| {
             let inside = t.iter().all(|&p| self.inner.distance_squared_to(p) == 0.0);
-            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            let n = normal(*t);
             let length = n.length();
             inside && length > self.min_double_area && n.dot(self.axis) >= MIN_COS * length
         })
