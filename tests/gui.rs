@@ -53,6 +53,7 @@ fn app(session: Session) -> Harness<'static, SlayerApp> {
                     replay: Vec::new(),
                     plan: Default::default(),
                     antialias: true,
+                    shares_engine_device: false,
                 },
             )
         });
@@ -362,7 +363,8 @@ fn run_in(dir: &std::path::Path, command: &str) {
 /// A real window under Xvfb (installed by `tools/test.sh`): the replay drives the pointer's
 /// path, the screenshot is the window's own pixels, and the saved session is the mesh
 /// `slayer sculpt` makes of the same strokes on the same backend, bit for bit; on the GPU
-/// backend the window draws with the engine's device.
+/// backend the window draws with the engine's device, positions and normals straight from the
+/// backend's buffers, so its strokes upload a fraction of what the CPU backend's do.
 #[test]
 fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
     let xvfb = std::process::Command::new("xvfb-run")
@@ -379,6 +381,8 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
         &dir,
         "slayer strokes --scene plaster --triangles 4000 --count 3 -o s.json",
     );
+    // Bytes uploaded to the viewport over the strokes, per backend.
+    let mut uploaded = Vec::new();
     // The virtual screen is larger than the window, which keeps the size it asked for.
     for backend in ["cpu", "gpu"] {
         let window = std::process::Command::new("xvfb-run")
@@ -398,6 +402,7 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             ])
             .args(["--save", &format!("gui-{backend}.slayer")])
             .args(["--screenshot", &format!("shot-{backend}.png")])
+            .args(["--metrics", &format!("metrics-{backend}.json")])
             .args(["--window", "900x600", "--backend", backend])
             // On lavapipe the window would otherwise open its own device.
             .args(["--device", "shared"])
@@ -434,6 +439,17 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             (900, 600),
             "the screenshot is the window"
         );
+        let metrics = std::fs::read_to_string(dir.join(format!("metrics-{backend}.json"))).unwrap();
+        let metrics: serde_json::Value = serde_json::from_str(&metrics).unwrap();
+        let figure = |name: &str| metrics[name].as_f64().unwrap();
+        let frames = figure("frames_stroking");
+        let from_engine = figure("stroking_frames_drawn_from_engine_buffers");
+        let expected = if backend == "gpu" { frames } else { 0.0 };
+        assert!(
+            frames > 0.0 && from_engine == expected,
+            "{backend}: {metrics}"
+        );
+        uploaded.push(frames * figure("bytes_uploaded_per_stroking_frame"));
         let mut colours: Vec<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
         colours.sort_unstable();
         colours.dedup();
@@ -443,6 +459,10 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             colours.len()
         );
     }
+    assert!(
+        uploaded[1] < uploaded[0] / 4.0,
+        "bytes uploaded while stroking, cpu then gpu: {uploaded:?}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

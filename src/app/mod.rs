@@ -78,6 +78,9 @@ pub struct AppSetup {
     pub plan: ExitPlan,
     /// Draw the viewport with 4× multisampling.
     pub antialias: bool,
+    /// The window draws with the GPU backend's device ([`run`] sets it when given one): the
+    /// viewport then reads positions and normals from the backend's own buffers.
+    pub shares_engine_device: bool,
 }
 
 /// The brush and what it paints, as the panels set them.
@@ -189,6 +192,7 @@ impl SlayerApp {
             worker_commands,
             worker_replies,
             wake,
+            setup.shares_engine_device,
         );
         let handle = std::thread::Builder::new()
             .name("slayer engine".into())
@@ -550,9 +554,11 @@ impl eframe::App for SlayerApp {
         panels::overlays(self, ui.ctx());
         replay::step(self, ui.ctx());
         let uploaded = self.viewport.as_mut().map_or(0, |v| v.take_uploaded());
+        let from_engine = self.viewport.as_ref().is_ok_and(|v| v.draws_from_engine());
         let pending = self.progress.done < self.progress.sent;
         let activity = self.pointer.activity(pending);
-        self.metrics.frame_done(frame_start, activity, uploaded);
+        self.metrics
+            .frame_done(frame_start, activity, (uploaded, from_engine));
         if !self.idle() {
             ui.ctx().request_repaint();
         }
@@ -634,6 +640,10 @@ pub fn save_path_for(path: &std::path::Path) -> PathBuf {
 /// Runs the app in a window until it is closed; on `shared`, the engine's device, when the
 /// engine runs on the GPU.
 pub fn run(setup: AppSetup, window: [f32; 2], shared: Option<SharedDevice>) -> Result<(), String> {
+    let setup = AppSetup {
+        shares_engine_device: shared.is_some(),
+        ..setup
+    };
     let mut wgpu_options = egui_wgpu::WgpuConfiguration::default();
     if let Some(shared) = shared {
         wgpu_options.wgpu_setup = egui_wgpu::WgpuSetup::Existing(egui_wgpu::WgpuSetupExisting {

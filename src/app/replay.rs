@@ -214,6 +214,8 @@ pub struct Metrics {
     /// The oldest pointer event whose effect arrived this frame.
     arrived: Option<Instant>,
     uploads: Vec<u64>,
+    /// Stroking frames drawn from the GPU backend's own vertex buffers.
+    stroking_from_engine: usize,
     /// The longest time one frame's code ran on the UI thread, ms, and the bytes that frame
     /// uploaded (what made it long, when it was the uploads).
     longest_frame_work: f64,
@@ -231,6 +233,9 @@ struct Summary {
     latency_ms_p95: f64,
     latency_samples: usize,
     bytes_uploaded_per_stroking_frame: f64,
+    /// Stroking frames whose positions and normals came from the GPU backend's buffers (the
+    /// window shares its device), not from rows uploaded for the viewport.
+    stroking_frames_drawn_from_engine_buffers: usize,
     longest_frame_work_ms: f64,
     longest_frame_bytes_uploaded: u64,
     peak_memory_mib: Option<f64>,
@@ -242,7 +247,14 @@ impl Metrics {
         self.arrived = Some(self.arrived.map_or(sent, |a| a.min(sent)));
     }
 
-    pub(crate) fn frame_done(&mut self, start: Instant, activity: Activity, uploaded: u64) {
+    /// `uploaded`: bytes the frame wrote to the viewport's buffers, and whether it drew
+    /// positions and normals from the GPU backend's own buffers.
+    pub(crate) fn frame_done(
+        &mut self,
+        start: Instant,
+        activity: Activity,
+        (uploaded, from_engine): (u64, bool),
+    ) {
         let now = Instant::now();
         self.longest_frame_work = self.longest_frame_work.max(ms(now.duration_since(start)));
         if let Some(last) = self.last_frame {
@@ -251,6 +263,7 @@ impl Metrics {
                 Activity::Stroking => {
                     self.stroking.push(interval);
                     self.uploads.push(uploaded);
+                    self.stroking_from_engine += usize::from(from_engine);
                 }
                 Activity::Orbiting => self.orbiting.push(interval),
                 Activity::Idle => {}
@@ -294,6 +307,7 @@ impl Metrics {
             latency_ms_p95: p95,
             latency_samples: latencies.len(),
             bytes_uploaded_per_stroking_frame: mean(&uploads),
+            stroking_frames_drawn_from_engine_buffers: self.stroking_from_engine,
             longest_frame_work_ms: self.longest_frame_work,
             longest_frame_bytes_uploaded: self.longest_frame_uploaded,
             peak_memory_mib: peak_memory_mib(),

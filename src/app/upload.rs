@@ -4,11 +4,16 @@
 //! changed, so only those are compared; after remeshing, an undo or an open, the whole mesh
 //! is compared (a few milliseconds at a million faces, on the engine's thread) and still only
 //! what differs is sent.
+//!
+//! Where the viewport shares the GPU backend's device, it draws positions and normals from the
+//! backend's own buffers ([`EngineVertices`]): the rows it is sent then carry only what the
+//! backend does not keep (layer, material, mask), so a sculpting stroke sends none.
 
 use bytemuck::Zeroable;
 use glam::Vec3;
 
 use crate::mesh::{INVALID, Mesh};
+use crate::pipeline::EngineVertices;
 use crate::render::{RenderVertex, render_vertex};
 
 /// Items closer than this are sent as one run with those between them: one buffer write
@@ -29,6 +34,12 @@ pub struct MeshUpdate {
     pub corners: Vec<(u32, Vec<[u32; 3]>)>,
     /// The mesh's box, when the whole mesh was compared.
     pub bounds: Option<Option<(Vec3, Vec3)>>,
+    /// Where positions and normals are drawn from: the GPU backend's buffers, or (`None`) the
+    /// rows.
+    pub engine: Option<EngineVertices>,
+    /// Positions or normals changed in the backend's buffers, which the rows do not show:
+    /// the viewport must draw again.
+    pub redraw: bool,
 }
 
 impl MeshUpdate {
@@ -40,7 +51,7 @@ impl MeshUpdate {
     }
 
     pub fn is_empty(&self) -> bool {
-        self.rows.is_empty() && self.corners.is_empty() && self.bounds.is_none()
+        self.rows.is_empty() && self.corners.is_empty() && self.bounds.is_none() && !self.redraw
     }
 }
 
@@ -49,24 +60,35 @@ impl MeshUpdate {
 pub struct Mirror {
     rows: Vec<RenderVertex>,
     corners: Vec<[u32; 3]>,
+    engine: Option<EngineVertices>,
 }
 
 impl Mirror {
     /// What differs between the mirror and `mesh`, looking only at the vertices `changed`
     /// (and any the mesh gained) when given, at every vertex otherwise; `faces_changed`: the
-    /// faces may differ too. The mirror then matches the mesh.
+    /// faces may differ too. `engine`: the GPU backend's buffers to draw positions and normals
+    /// from, current with `mesh`, or `None` to send them in the rows. The mirror then matches
+    /// the mesh.
     pub fn update(
         &mut self,
         mesh: &Mesh,
         changed: Option<&[u32]>,
         faces_changed: bool,
+        engine: Option<EngineVertices>,
     ) -> MeshUpdate {
+        // Rows switch between carrying geometry and not: every row is compared again.
+        let switched = self.engine.is_some() != engine.is_some();
+        // New buffers (the backend uploaded its copy afresh) must be bound before drawing.
+        let rebound = self.engine != engine;
+        let changed = changed.filter(|_| !switched);
+        let geometry = engine.is_none();
+        self.engine = engine;
         let old_vertices = self.rows.len();
         let vertex_count = mesh.vertex_count();
         self.rows.resize(vertex_count, RenderVertex::zeroed());
         let mut differing: Vec<u32> = Vec::new();
         let mut compare = |v: usize, rows: &mut Vec<RenderVertex>| {
-            let row = render_vertex(mesh, v);
+            let row = drawn_row(mesh, v, geometry);
             if rows[v] != row || v >= old_vertices {
                 rows[v] = row;
                 differing.push(v as u32);
@@ -94,6 +116,8 @@ impl Mirror {
             rows: runs(&differing, &self.rows),
             corners: runs(&corners, &self.corners),
             bounds: changed.is_none().then(|| mesh.bounds()),
+            redraw: rebound || (!geometry && changed.is_none_or(|c| !c.is_empty())),
+            engine: self.engine.clone(),
         }
     }
 
@@ -114,6 +138,21 @@ impl Mirror {
             }
         }
         differing
+    }
+}
+
+/// Vertex `v`'s row as the viewport draws it: without position and normal where those come
+/// from the GPU backend's buffers (`geometry` false).
+fn drawn_row(mesh: &Mesh, v: usize, geometry: bool) -> RenderVertex {
+    let row = render_vertex(mesh, v);
+    if geometry {
+        row
+    } else {
+        RenderVertex {
+            position: [0.0; 3],
+            normal: [0.0; 3],
+            ..row
+        }
     }
 }
 
@@ -164,7 +203,7 @@ mod tests {
         let mut mesh = plaster();
         let mut mirror = Mirror::default();
         let (mut rows, mut corners) = (Vec::new(), Vec::new());
-        let first = mirror.update(&mesh, None, true);
+        let first = mirror.update(&mesh, None, true, None);
         assert_eq!(first.rows.len(), 1, "everything, in one run");
         apply(&mut rows, &mut corners, &first);
 
@@ -172,7 +211,7 @@ mod tests {
         for v in [3u32, 5, 200] {
             mesh.positions_mut()[v as usize].z += 0.01;
         }
-        let update = mirror.update(&mesh, Some(&[3, 5, 200, 7]), false);
+        let update = mirror.update(&mesh, Some(&[3, 5, 200, 7]), false, None);
         assert_eq!(update.rows.len(), 2, "3..=5 and 200 (7 did not change)");
         assert!(update.corners.is_empty());
         assert!(update.bytes() < 5 * std::mem::size_of::<RenderVertex>());
@@ -181,7 +220,7 @@ mod tests {
         // Remeshing: an edge split, with nothing said about what it changed.
         let faces_before = mesh.face_count();
         mesh.split_edge(30, 0.5);
-        let update = mirror.update(&mesh, None, true);
+        let update = mirror.update(&mesh, None, true, None);
         let rewritten: usize = update.corners.iter().map(|(_, c)| c.len()).sum();
         assert!(
             rewritten >= 2 && rewritten < 2 * RUN_GAP as usize + 4,
@@ -205,6 +244,6 @@ mod tests {
             })
             .collect();
         assert_eq!(corners, drawn);
-        assert!(mirror.update(&mesh, None, true).rows.is_empty());
+        assert!(mirror.update(&mesh, None, true, None).rows.is_empty());
     }
 }

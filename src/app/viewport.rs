@@ -3,13 +3,20 @@
 //! another, drawn with the preview renderer's shader (`wgsl/render/preview.wgsl`) into a
 //! texture the app owns and egui shows. It renders only when the camera, the options or the
 //! mesh changed.
+//!
+//! On the GPU backend's own device the vertex stage reads positions and normals from the
+//! backend's buffers ([`EngineVertices`], `vs_engine`), which the engine keeps current as it
+//! sculpts, and the rows carry only layer, material and mask. The viewport then draws what
+//! the engine has submitted by the time it draws: mid-batch, a step whose exact check is still
+//! to come can show for a frame before the next update.
 
 use eframe::{egui, egui_wgpu};
 
 use super::upload::MeshUpdate;
 use crate::gpu::GpuError;
+use crate::pipeline::EngineVertices;
 use crate::render::{
-    Camera, MSAA_SAMPLES, PreviewTargets, PreviewUniforms, RenderOptions, RenderVertex,
+    Camera, MSAA_SAMPLES, PreviewTargets, PreviewUniforms, RenderOptions, RenderVertex, VertexPull,
     preview_bind_group, preview_pipeline, preview_uniforms, record_preview_draws,
 };
 
@@ -27,6 +34,10 @@ pub struct Viewport {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::RenderPipeline,
+    /// Where positions and normals come from the GPU backend's buffers: those, and the
+    /// pipeline that reads them (`vs_engine`), made when first needed.
+    engine: Option<EngineVertices>,
+    engine_pipeline: Option<wgpu::RenderPipeline>,
     uniform: wgpu::Buffer,
     vertices: wgpu::Buffer,
     corners: wgpu::Buffer,
@@ -53,7 +64,7 @@ impl Viewport {
         antialias: bool,
     ) -> Result<Viewport, GpuError> {
         let samples = if antialias { MSAA_SAMPLES } else { 1 };
-        let pipeline = preview_pipeline(device, samples)?;
+        let pipeline = preview_pipeline(device, samples, VertexPull::Rows)?;
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("viewport uniforms"),
             size: std::mem::size_of::<PreviewUniforms>() as u64,
@@ -62,11 +73,13 @@ impl Viewport {
         });
         let vertices = storage(device, "viewport vertices", 64);
         let corners = storage(device, "viewport corners", 64);
-        let bind_group = bind(device, &pipeline, &uniform, &vertices, &corners);
+        let bind_group = bind(device, &pipeline, &uniform, (&vertices, &corners), None);
         Ok(Viewport {
             device: device.clone(),
             queue: queue.clone(),
             pipeline,
+            engine: None,
+            engine_pipeline: None,
             uniform,
             vertices,
             corners,
@@ -102,17 +115,38 @@ impl Viewport {
                 limit >> 20
             ));
         }
+        if let Some(engine) = &update.engine
+            && engine.count < update.vertex_count as usize
+        {
+            return Err(format!(
+                "the engine's vertex buffers hold {} vertices, the mesh {}",
+                engine.count, update.vertex_count
+            ));
+        }
         let grown_vertices = self.grown(&self.vertices, "viewport vertices", vertex_bytes);
         let grown_corners = self.grown(&self.corners, "viewport corners", corner_bytes);
-        if grown_vertices.is_some() || grown_corners.is_some() {
-            self.vertices = grown_vertices.unwrap_or_else(|| self.vertices.clone());
-            self.corners = grown_corners.unwrap_or_else(|| self.corners.clone());
+        let rebind =
+            grown_vertices.is_some() || grown_corners.is_some() || self.engine != update.engine;
+        if let Some(grown) = grown_vertices {
+            self.vertices = grown;
+        }
+        if let Some(grown) = grown_corners {
+            self.corners = grown;
+        }
+        if update.engine.is_some() && self.engine_pipeline.is_none() {
+            let pipeline = preview_pipeline(&self.device, self.samples, VertexPull::Engine);
+            self.engine_pipeline = Some(pipeline.map_err(|e| e.to_string())?);
+        }
+        self.engine = update.engine.clone();
+        if rebind {
+            let engine = (self.engine.as_ref()).map(|e| (&e.positions, &e.normals));
+            let buffers = (&self.vertices, &self.corners);
             self.bind_group = bind(
                 &self.device,
-                &self.pipeline,
+                self.pipeline(),
                 &self.uniform,
-                &self.vertices,
-                &self.corners,
+                buffers,
+                engine,
             );
         }
         for (first, rows) in &update.rows {
@@ -130,6 +164,14 @@ impl Viewport {
         self.corner_count = update.face_count * 3;
         self.dirty = true;
         Ok(())
+    }
+
+    /// The pipeline for where positions and normals come from now.
+    fn pipeline(&self) -> &wgpu::RenderPipeline {
+        match (&self.engine, &self.engine_pipeline) {
+            (Some(_), Some(engine)) => engine,
+            _ => &self.pipeline,
+        }
     }
 
     /// The largest buffer one binding may hold on this device.
@@ -158,6 +200,11 @@ impl Viewport {
         Some(new)
     }
 
+    /// Whether positions and normals come from the GPU backend's own buffers.
+    pub fn draws_from_engine(&self) -> bool {
+        self.engine.is_some()
+    }
+
     /// Bytes uploaded since the last call.
     pub fn take_uploaded(&mut self) -> u64 {
         std::mem::take(&mut self.uploaded)
@@ -171,28 +218,37 @@ impl Viewport {
         camera: &Camera,
         view: &ViewOptions,
     ) {
-        let size = (size.0.max(1), size.1.max(1));
-        if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
-            let targets = PreviewTargets::new(&self.device, size, self.samples, sampled);
+        if self.fit_targets(size) {
+            let view = &self.targets.as_ref().expect("fitted").resolved_view;
+            let filter = wgpu::FilterMode::Linear;
             match self.texture {
-                Some(id) => renderer.update_egui_texture_from_wgpu_texture(
-                    &self.device,
-                    &targets.resolved_view,
-                    wgpu::FilterMode::Linear,
-                    id,
-                ),
+                Some(id) => {
+                    renderer.update_egui_texture_from_wgpu_texture(&self.device, view, filter, id)
+                }
                 None => {
-                    self.texture = Some(renderer.register_native_texture(
-                        &self.device,
-                        &targets.resolved_view,
-                        wgpu::FilterMode::Linear,
-                    ))
+                    let id = renderer.register_native_texture(&self.device, view, filter);
+                    self.texture = Some(id);
                 }
             }
-            self.targets = Some(targets);
-            self.dirty = true;
         }
+        self.draw(camera, view);
+    }
+
+    /// Makes the targets when there are none of `size` yet (then `true`).
+    fn fit_targets(&mut self, size: (u32, u32)) -> bool {
+        let size = (size.0.max(1), size.1.max(1));
+        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+            return false;
+        }
+        // Sampled by egui; copied out by the tests.
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        self.dirty = true;
+        self.targets = Some(PreviewTargets::new(&self.device, size, self.samples, usage));
+        true
+    }
+
+    /// Draws into the targets when dirty or the camera or view changed.
+    fn draw(&mut self, camera: &Camera, view: &ViewOptions) {
         let options = RenderOptions {
             wireframe: view.wireframe,
             false_colour: view.false_colour,
@@ -208,7 +264,7 @@ impl Viewport {
         self.drawn_with = Some(uniforms);
         self.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniforms));
-        let targets = self.targets.as_ref().expect("made above");
+        let targets = self.targets.as_ref().expect("made by fit_targets");
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -220,7 +276,7 @@ impl Viewport {
         } else {
             &[]
         };
-        record_preview_draws(&mut encoder, &self.pipeline, draws, targets);
+        record_preview_draws(&mut encoder, self.pipeline(), draws, targets);
         self.queue.submit([encoder.finish()]);
     }
 }
@@ -240,9 +296,143 @@ fn bind(
     device: &wgpu::Device,
     pipeline: &wgpu::RenderPipeline,
     uniform: &wgpu::Buffer,
-    vertices: &wgpu::Buffer,
-    corners: &wgpu::Buffer,
+    rows: (&wgpu::Buffer, &wgpu::Buffer),
+    engine: Option<(&wgpu::Buffer, &wgpu::Buffer)>,
 ) -> wgpu::BindGroup {
     let layout = pipeline.get_bind_group_layout(0);
-    preview_bind_group(device, &layout, uniform, vertices, corners)
+    preview_bind_group(device, &layout, uniform, rows, engine)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::SharedDevice;
+    use crate::app::upload::Mirror;
+    use crate::bench::{ScriptSpec, generate_script};
+    use crate::gpu::{AdapterChoice, GpuContext, GpuKernels};
+    use crate::mesh::Mesh;
+    use crate::pipeline::{Pipeline, PipelineSettings};
+    use crate::render::CameraSpec;
+    use crate::scene::{SceneKind, SceneSpec, generate};
+
+    fn gpu() -> GpuContext {
+        GpuContext::new(AdapterChoice {
+            allow_software: true,
+        })
+        .expect("GPU tests need an adapter (run tools/test.sh)")
+    }
+
+    /// A viewport on `device`, fed by its own mirror: from the rows, or from the engine's
+    /// buffers.
+    struct Fed {
+        viewport: Viewport,
+        mirror: Mirror,
+        engine: bool,
+    }
+
+    impl Fed {
+        fn new(device: &SharedDevice, engine: bool) -> Fed {
+            let viewport = Viewport::new(&device.device, &device.queue, false).unwrap();
+            let mirror = Mirror::default();
+            Fed {
+                viewport,
+                mirror,
+                engine,
+            }
+        }
+
+        /// Sends what changed; returns the update.
+        fn update(
+            &mut self,
+            mesh: &Mesh,
+            changed: Option<&[u32]>,
+            buffers: Option<EngineVertices>,
+        ) -> MeshUpdate {
+            let buffers = buffers.filter(|_| self.engine);
+            let update = self
+                .mirror
+                .update(mesh, changed, changed.is_none(), buffers);
+            self.viewport.apply(&update).unwrap();
+            assert_eq!(self.viewport.draws_from_engine(), self.engine);
+            update
+        }
+
+        fn picture(&mut self, device: &SharedDevice, mesh: &Mesh) -> Vec<u8> {
+            let camera = Camera::fit(&CameraSpec::default(), mesh.bounds(), 4.0 / 3.0);
+            self.viewport.fit_targets((320, 240));
+            self.viewport.draw(&camera, &ViewOptions::default());
+            let targets = self.viewport.targets.as_ref().expect("fitted");
+            targets.read_image(&device.device, &device.queue).unwrap()
+        }
+    }
+
+    fn same_pictures(device: &SharedDevice, mesh: &Mesh, fed: [&mut Fed; 2]) {
+        let [a, b] = fed.map(|f| f.picture(device, mesh));
+        let background = a.chunks(4).filter(|p| p[..3] == a[..3]).count();
+        assert!(
+            background < a.len() / 4 * 9 / 10,
+            "the mesh is in the picture"
+        );
+        assert!(a == b, "the two pictures differ");
+    }
+
+    /// On the GPU backend's device (lavapipe here) the viewport draws positions and normals
+    /// from the backend's own buffers: a sculpting stroke sends it no rows, only a redraw, and
+    /// the picture is the one rows uploaded from the mesh give, pixel for pixel.
+    #[test]
+    fn the_engines_buffers_draw_the_rows_picture_and_a_stroke_uploads_no_rows() {
+        let mut mesh = generate(&SceneSpec {
+            kind: SceneKind::Plaster,
+            triangles: 2000,
+            seed: 3,
+        })
+        .unwrap();
+        let spec = ScriptSpec {
+            strokes: 8,
+            samples: 12,
+            ..ScriptSpec::default()
+        };
+        let strokes = generate_script(&mesh, &spec)
+            .resolve(&mesh, "test")
+            .unwrap();
+        // A grab also remeshes between samples; this one only moves vertices until it ends.
+        let plain = (strokes.iter())
+            .find(|s| !s.settings().brush.kind.drags())
+            .unwrap();
+        let context = gpu();
+        let shared = SharedDevice::of(&context);
+        let kernels = Box::new(GpuKernels::new(context));
+        let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), kernels);
+        let (mut rows, mut engine) = (Fed::new(&shared, false), Fed::new(&shared, true));
+        let buffers = pipeline.vertex_buffers(&mesh);
+        assert!(rows.update(&mesh, None, None).bytes() > 0);
+        assert!(
+            engine.update(&mesh, None, buffers).bytes() > 0,
+            "layers and materials"
+        );
+        same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
+
+        let mut stroke = (pipeline.begin_stroke(&mut mesh, plain.settings())).unwrap();
+        let report = stroke.add_samples(&plain.samples).unwrap();
+        assert!(!report.changed.is_empty() && !report.topology_changed);
+        let buffers = stroke.vertex_buffers();
+        let changed = Some(&report.changed[..]);
+        let sculpted = engine.update(stroke.mesh(), changed, buffers);
+        assert_eq!(
+            sculpted.bytes(),
+            0,
+            "positions and normals are the engine's"
+        );
+        assert!(sculpted.redraw && !sculpted.is_empty());
+        let uploaded = rows.update(stroke.mesh(), changed, None);
+        assert!(uploaded.bytes() > 0 && !uploaded.redraw);
+        same_pictures(&shared, stroke.mesh(), [&mut rows, &mut engine]);
+        stroke.finish().unwrap();
+
+        // Remeshed: the whole mesh compared, as the app does after a stroke.
+        let buffers = pipeline.vertex_buffers(&mesh);
+        engine.update(&mesh, None, buffers);
+        rows.update(&mesh, None, None);
+        same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
+    }
 }

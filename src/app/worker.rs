@@ -144,6 +144,9 @@ pub struct Worker {
     picker: Picker,
     /// What the viewport holds.
     mirror: Mirror,
+    /// The viewport draws with the GPU backend's device: it draws positions and normals
+    /// from the backend's own buffers.
+    viewport_on_engine_device: bool,
     link: Link,
 }
 
@@ -154,10 +157,12 @@ impl Worker {
         commands: Receiver<Command>,
         replies: Sender<Reply>,
         wake: Box<dyn Fn() + Send>,
+        viewport_on_engine_device: bool,
     ) -> Worker {
         Worker {
             picker: Picker::default(),
             mirror: Mirror::default(),
+            viewport_on_engine_device,
             revision: 0,
             saved_revision: 0,
             gpu_failure_said: false,
@@ -352,6 +357,7 @@ impl Worker {
             pipeline,
             picker,
             mirror,
+            viewport_on_engine_device,
             link,
             ..
         } = self;
@@ -372,6 +378,7 @@ impl Worker {
                 stroke,
                 picker,
                 mirror,
+                viewport_on_engine_device: *viewport_on_engine_device,
                 projector: &mut projector,
                 visible: &visible,
                 grab,
@@ -435,7 +442,11 @@ impl Worker {
 
     /// Compares the whole mesh with what the viewport holds and sends the difference.
     fn send_changes(&mut self) {
-        let update = self.mirror.update(self.session.mesh(), None, true);
+        let mesh = self.session.mesh();
+        let engine = (self.viewport_on_engine_device)
+            .then(|| self.pipeline.vertex_buffers(mesh))
+            .flatten();
+        let update = self.mirror.update(mesh, None, true, engine);
         self.link.reply(Reply::Mesh(update));
     }
 
@@ -559,6 +570,7 @@ struct Batch<'s, 'm> {
     stroke: Option<&'s mut StrokeInProgress<'m>>,
     picker: &'s mut Picker,
     mirror: &'s mut Mirror,
+    viewport_on_engine_device: bool,
     projector: &'s mut Projector,
     visible: &'s [bool],
     grab: bool,
@@ -630,11 +642,15 @@ impl Batch<'_, '_> {
     }
 
     fn flush(&mut self, unsent: Unsent, link: &Link) {
-        if let Some(stroke) = &self.stroke {
+        if let Some(stroke) = &mut self.stroke {
+            let engine = (self.viewport_on_engine_device)
+                .then(|| stroke.vertex_buffers())
+                .flatten();
             let update = self.mirror.update(
                 stroke.mesh(),
                 Some(&unsent.changed),
                 unsent.topology_changed,
+                engine,
             );
             if !update.is_empty() {
                 link.reply(Reply::Mesh(update));

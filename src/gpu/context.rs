@@ -435,24 +435,7 @@ impl GpuContext {
     pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         self.read_backs
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let (sender, receiver) = mpsc::channel();
-        buffer.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = sender.send(result);
-        });
-        let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| failed(&e))?;
-        receiver
-            .recv()
-            .map_err(|e| failed(&e))?
-            .map_err(|e| failed(&e))?;
-        let bytes = buffer
-            .get_mapped_range(..)
-            .map_err(|e| failed(&e))?
-            .to_vec();
-        buffer.unmap();
-        Ok(bytes)
+        map_read(&self.device, buffer)
     }
 
     /// Blocking read-backs so far ([`GpuContext::map_read`] calls).
@@ -588,4 +571,26 @@ impl GpuContext {
             (max_x as u32, groups.div_ceil(max_x) as u32)
         }
     }
+}
+
+/// [`GpuContext::map_read`] on any device (a window's), uncounted.
+pub(crate) fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let (sender, receiver) = mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |result| {
+        let _ = sender.send(result);
+    });
+    let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| failed(&e))?;
+    receiver
+        .recv()
+        .map_err(|e| failed(&e))?
+        .map_err(|e| failed(&e))?;
+    let bytes = buffer
+        .get_mapped_range(..)
+        .map_err(|e| failed(&e))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
 }

@@ -46,6 +46,8 @@ pub use backstop_filter::{
 };
 pub use brush_frame::{frame_sums_buffer, record_brush_frame, run_brush_frame};
 pub use cell_keys::{record_cell_keys, run_cell_keys};
+#[cfg(test)]
+pub(crate) use context::map_read;
 pub use context::{AdapterChoice, AdapterSummary, GpuContext, GpuError, Workgroups, list_adapters};
 pub use deform::{
     DeformBuffers, SmoothingNeighbours, deform_params, record_deform, run_deform,

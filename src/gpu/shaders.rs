@@ -92,6 +92,9 @@ pub const RENDER_SHADERS: &[(&str, &str)] =
 /// Entry points every render shader has.
 pub const VERTEX_ENTRY: &str = "vs_main";
 pub const FRAGMENT_ENTRY: &str = "fs_main";
+/// The preview shader's second vertex stage: positions and normals from the GPU backend's own
+/// buffers (`wgsl/render/preview.wgsl`).
+pub const ENGINE_VERTEX_ENTRY: &str = "vs_engine";
 
 #[derive(Debug, Error)]
 pub enum ShaderError {

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::kernels::{CpuKernels, StepKernels};
+use super::kernels::{CpuKernels, EngineVertices, StepKernels};
 use super::stroke::StrokeInProgress;
 use super::{
     BackstopFilter, GpuMemory, PhaseTimes, PipelineError, PipelineSettings, Remeshing,
@@ -221,6 +221,13 @@ impl Pipeline {
     /// Kernels that filter the backstop's pairs elsewhere (the GPU's): what they left the CPU.
     pub fn backstop_filter(&self) -> Option<BackstopFilter> {
         self.kernels.backstop_filter()
+    }
+
+    /// Kernels that keep a copy of the mesh on a GPU: their position and normal buffers,
+    /// current with `mesh` (what differs is sent first), for a viewport on the same device
+    /// (the caller's to know: the app's window shares the backend's device or not).
+    pub fn vertex_buffers(&mut self, mesh: &Mesh) -> Option<EngineVertices> {
+        self.kernels.vertex_buffers(mesh)
     }
 
     /// Kernels that keep `mesh` in GPU memory: how much they hold now.

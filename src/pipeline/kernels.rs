@@ -135,6 +135,23 @@ pub trait StepKernels: Send {
     fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
         Ok(())
     }
+    /// The kernels' own position and normal buffers, brought up to date with `mesh` first,
+    /// for a renderer on their device to draw from; `None` for kernels that keep no copy on a
+    /// GPU, or gave theirs up.
+    fn vertex_buffers(&mut self, _mesh: &Mesh) -> Option<EngineVertices> {
+        None
+    }
+}
+
+/// The GPU backend's per-vertex positions and normals (x, y, z each, packed, `count` rows of
+/// them current): what the app's viewport draws from when it shares the backend's device.
+/// Until the next call says otherwise they follow the engine's work as it is submitted, so a
+/// renderer on the same queue sees every step the engine recorded before its own draw.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EngineVertices {
+    pub positions: wgpu::Buffer,
+    pub normals: wgpu::Buffer,
+    pub count: usize,
 }
 
 /// Which call of a stroke the pipeline makes, by the number of its sample in the stroke

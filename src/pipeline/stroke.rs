@@ -14,7 +14,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::engine::{Pipeline, Prepared, Scratch, longest_edge_at, millis};
-use super::kernels::{CallAt, Deformed, FrameSource, SampleProbe, StepKernels};
+use super::kernels::{CallAt, Deformed, EngineVertices, FrameSource, SampleProbe, StepKernels};
 use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
 use super::{PhaseTimes, PipelineError, Remeshing, StrokeReport};
 use crate::brush::{BrushKind, Dab, DabFrame, Resampler, Sample, StrokeSettings};
@@ -165,6 +165,11 @@ impl<'a> StrokeInProgress<'a> {
     /// The mesh as the stroke has left it so far.
     pub fn mesh(&self) -> &Mesh {
         self.mesh
+    }
+
+    /// [`Pipeline::vertex_buffers`] for the mesh as the samples so far left it.
+    pub fn vertex_buffers(&mut self) -> Option<EngineVertices> {
+        self.pipeline.vertex_buffers(self.mesh)
     }
 
     /// Runs every sample `samples` completes at the stroke's spacing (the last one given is

@@ -16,7 +16,7 @@ pub use preview::{
     Rendered, render,
 };
 pub(crate) use preview::{
-    MSAA_SAMPLES, Targets as PreviewTargets, bind_group as preview_bind_group,
+    MSAA_SAMPLES, Targets as PreviewTargets, VertexPull, bind_group as preview_bind_group,
     pipeline as preview_pipeline, record_draws as record_preview_draws, render_vertex,
     uniforms as preview_uniforms,
 };

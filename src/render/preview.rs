@@ -9,7 +9,9 @@ use thiserror::Error;
 use super::brdf::Lighting;
 use super::camera::{Camera, CameraSpec};
 use super::image::Image;
-use crate::gpu::shaders::{FRAGMENT_ENTRY, VERTEX_ENTRY, render_source, validate};
+use crate::gpu::shaders::{
+    ENGINE_VERTEX_ENTRY, FRAGMENT_ENTRY, VERTEX_ENTRY, render_source, validate,
+};
 use crate::gpu::{GpuContext, GpuError};
 use crate::mesh::{INVALID, LayerId, Mesh};
 
@@ -262,9 +264,20 @@ pub(crate) fn uniforms(camera: &Camera, options: &RenderOptions) -> PreviewUnifo
     }
 }
 
+/// Where the vertex stage reads each vertex's position and normal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum VertexPull {
+    /// From the vertex rows, with everything else (`vs_main`).
+    Rows,
+    /// From the GPU backend's own position and normal buffers, the rest from the rows
+    /// (`vs_engine`).
+    Engine,
+}
+
 pub(crate) fn pipeline(
     device: &wgpu::Device,
     samples: u32,
+    pull: VertexPull,
 ) -> Result<wgpu::RenderPipeline, GpuError> {
     let source = render_source("preview")?;
     // naga's messages carry source locations; wgpu's would not.
@@ -279,7 +292,10 @@ pub(crate) fn pipeline(
         layout: None,
         vertex: wgpu::VertexState {
             module: &module,
-            entry_point: Some(VERTEX_ENTRY),
+            entry_point: Some(match pull {
+                VertexPull::Rows => VERTEX_ENTRY,
+                VertexPull::Engine => ENGINE_VERTEX_ENTRY,
+            }),
             compilation_options: Default::default(),
             buffers: &[],
         },
@@ -360,14 +376,14 @@ pub fn render(
     } else {
         1
     };
-    let pipeline = pipeline(&gpu.device, samples)?;
+    let pipeline = pipeline(&gpu.device, samples, VertexPull::Rows)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let uniform = gpu.uniform_buffer("preview uniforms", &uniforms(&camera, options));
     let draws = bind_chunks(gpu, &pipeline, &uniform, &chunks);
     drop(chunks);
     let copied = wgpu::TextureUsages::COPY_SRC;
     let targets = Targets::new(&gpu.device, (width, height), samples, copied);
-    let readback = Readback::new(gpu, width, height);
+    let readback = Readback::new(&gpu.device, width, height);
     let mut encoder = gpu
         .device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -425,16 +441,18 @@ fn chunk_limits(gpu: &GpuContext, options: &RenderOptions) -> (usize, usize) {
 }
 
 /// The shader's bindings: the uniforms, the vertex rows and the corners (three vertex numbers
-/// per face).
+/// per face), and for [`VertexPull::Engine`] the GPU backend's positions and normals.
 pub(crate) fn bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     uniform: &wgpu::Buffer,
-    vertices: &wgpu::Buffer,
-    corners: &wgpu::Buffer,
+    (vertices, corners): (&wgpu::Buffer, &wgpu::Buffer),
+    engine: Option<(&wgpu::Buffer, &wgpu::Buffer)>,
 ) -> wgpu::BindGroup {
+    let engine = engine.map(|(positions, normals)| [positions, normals]);
     let entries: Vec<wgpu::BindGroupEntry> = [uniform, vertices, corners]
         .into_iter()
+        .chain(engine.into_iter().flatten())
         .enumerate()
         .map(|(binding, buffer)| wgpu::BindGroupEntry {
             binding: binding as u32,
@@ -461,7 +479,7 @@ fn bind_chunks(
         .map(|chunk| {
             let vertices = gpu.storage_buffer("preview vertices", &chunk.vertices, false);
             let corners = gpu.storage_buffer("preview corners", &chunk.corners, false);
-            let group = bind_group(&gpu.device, &layout, uniform, &vertices, &corners);
+            let group = bind_group(&gpu.device, &layout, uniform, (&vertices, &corners), None);
             (group, chunk.corners.len() as u32)
         })
         .collect()
@@ -479,6 +497,22 @@ pub(crate) struct Targets {
 }
 
 impl Targets {
+    /// The image's RGBA bytes, copied out on `device` (the app's viewport, in its tests; the
+    /// image must have been made with `COPY_SRC`).
+    #[cfg(test)]
+    pub(crate) fn read_image(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<u8>, GpuError> {
+        let readback = Readback::new(device, self.size.0, self.size.1);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        readback.record_copy(&mut encoder, &self.resolved);
+        queue.submit([encoder.finish()]);
+        let padded = crate::gpu::map_read(device, &readback.buffer)?;
+        Ok(readback.unpadded(&padded))
+    }
+
     /// Colour and depth targets of `size` at `samples` per pixel; the image also gets
     /// `image_usage` (copied out by `render`, sampled by the app's viewport).
     pub(crate) fn new(
@@ -575,10 +609,10 @@ struct Readback {
 }
 
 impl Readback {
-    fn new(gpu: &GpuContext, width: u32, height: u32) -> Readback {
+    fn new(device: &wgpu::Device, width: u32, height: u32) -> Readback {
         let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let padded_row_bytes = (4 * width).div_ceil(align) * align;
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("preview readback"),
             size: padded_row_bytes as u64 * height as u64,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -618,12 +652,15 @@ impl Readback {
 
     /// The image's RGBA bytes, the padding dropped.
     fn read(&self, gpu: &GpuContext) -> Result<Vec<u8>, GpuError> {
-        let padded = gpu.map_read(&self.buffer)?;
+        Ok(self.unpadded(&gpu.map_read(&self.buffer)?))
+    }
+
+    fn unpadded(&self, padded: &[u8]) -> Vec<u8> {
         let row_bytes = 4 * self.width as usize;
         let mut rgba = Vec::with_capacity(row_bytes * self.height as usize);
         for row in padded.chunks_exact(self.padded_row_bytes as usize) {
             rgba.extend_from_slice(&row[..row_bytes]);
         }
-        Ok(rgba)
+        rgba
     }
 }

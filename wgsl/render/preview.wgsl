@@ -5,6 +5,10 @@
 // Vertices are pulled from storage buffers by `vertex_index` (three per face, no index buffer),
 // so each corner knows which corner of its triangle it is: that gives the barycentric
 // coordinates the wireframe needs without duplicating the mesh's vertices.
+//
+// `vs_main` reads whole rows from `vertices`. `vs_engine` (the app, when it shares the GPU
+// backend's device) reads positions and normals from the backend's own per-vertex buffers and
+// only the rest of each row from `vertices`, so a sculpting stroke uploads nothing to draw.
 
 #import shared/brdf
 
@@ -64,9 +68,12 @@ struct Varyings {
     @location(7) mask: f32,
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) index: u32) -> Varyings {
-    let vertex = vertices[corners[index]];
+// The GPU backend's positions and normals: x, y, z per vertex, packed (`src/gpu/vertices.rs`).
+// Bound only by the pipeline whose vertex stage is `vs_engine`.
+@group(0) @binding(3) var<storage, read> engine_positions: array<f32>;
+@group(0) @binding(4) var<storage, read> engine_normals: array<f32>;
+
+fn corner_varyings(index: u32, vertex: RenderVertex) -> Varyings {
     var out: Varyings;
     out.clip = view.view_proj * vec4<f32>(vertex.position, 1.0);
     out.world = vertex.position;
@@ -83,6 +90,28 @@ fn vs_main(@builtin(vertex_index) index: u32) -> Varyings {
         out.clip = vec4<f32>(0.0, 0.0, -1.0, 1.0);
     }
     return out;
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> Varyings {
+    return corner_varyings(index, vertices[corners[index]]);
+}
+
+@vertex
+fn vs_engine(@builtin(vertex_index) index: u32) -> Varyings {
+    let v = corners[index];
+    var vertex = vertices[v];
+    vertex.position = vec3<f32>(
+        engine_positions[3u * v], engine_positions[3u * v + 1u], engine_positions[3u * v + 2u]
+    );
+    let normal = vec3<f32>(
+        engine_normals[3u * v], engine_normals[3u * v + 1u], engine_normals[3u * v + 2u]
+    );
+    // As `render_vertex` does on the CPU: a normal that is not finite is drawn as none (the
+    // fragment stage then takes the face's); NaN fails every comparison.
+    let finite = all(abs(normal) <= vec3<f32>(3.0e38));
+    vertex.normal = select(vec3<f32>(0.0), normal, finite);
+    return corner_varyings(index, vertex);
 }
 
 @fragment

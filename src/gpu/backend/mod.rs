@@ -51,8 +51,8 @@ use crate::gpu::reusable::ReusableBuffer;
 use crate::gpu::{AdapterSummary, GpuContext, GpuError, GpuOptions};
 use crate::mesh::{Mesh, MeshVersion};
 use crate::pipeline::{
-    BackstopFilter, CallAt, CpuKernels, Deformed, FrameSource, GpuMemory, SampleProbe, StepKernels,
-    Uploads,
+    BackstopFilter, CallAt, CpuKernels, Deformed, EngineVertices, FrameSource, GpuMemory,
+    SampleProbe, StepKernels, Uploads,
 };
 
 /// Selection, deformation and the proximity passes on a GPU, falling back to the CPU
@@ -491,6 +491,17 @@ impl StepKernels for GpuKernels {
             reserved_bytes: report.as_ref().map(|r| r.total_reserved_bytes),
             budget_bytes: resident_bytes(mesh),
             budget_limit_bytes: self.gpu.budget_bytes,
+        })
+    }
+
+    fn vertex_buffers(&mut self, mesh: &Mesh) -> Option<EngineVertices> {
+        self.on_gpu(|k| {
+            let r = GpuKernels::sync(&k.gpu, (&mut k.resident, &mut k.uploads), mesh)?;
+            Ok(EngineVertices {
+                positions: r.vertices.positions.clone(),
+                normals: r.normals.clone(),
+                count: r.vertices.count,
+            })
         })
     }
 

@@ -287,7 +287,7 @@ impl GpuKernels {
     }
 
     /// Brings the GPU copy up to date with `mesh`.
-    fn sync<'a>(
+    pub(super) fn sync<'a>(
         gpu: &GpuContext,
         (resident, uploads): (&'a mut Option<Resident>, &mut Uploads),
         mesh: &Mesh,
