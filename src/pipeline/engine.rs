@@ -202,6 +202,16 @@ impl Pipeline {
         Ok(())
     }
 
+    /// Forgets the mesh it worked on — its edge length, grid and the kernels' copy — for a
+    /// pipeline that goes on with another mesh (the app opening a file). The pipeline knows a
+    /// mesh by its edit counts ([`MeshVersion`]), which a mesh from another file can share, and
+    /// keeps the edge length it first measured.
+    pub fn forget_mesh(&mut self) {
+        self.edge_length = None;
+        self.prepared = None;
+        self.kernels.forget_mesh();
+    }
+
     /// Why the GPU kernels gave up and the pipeline went on with the CPU's, if they did.
     pub fn kernel_failure(&self) -> Option<String> {
         self.kernels.failure()

@@ -135,6 +135,8 @@ pub trait StepKernels: Send {
     fn check_copy(&self, _mesh: &Mesh) -> Result<(), String> {
         Ok(())
     }
+    /// Drops any copy of the mesh the kernels keep ([`super::Pipeline::forget_mesh`]).
+    fn forget_mesh(&mut self) {}
     /// The kernels' own position and normal buffers, brought up to date with `mesh` first,
     /// for a renderer on their device to draw from; `None` for kernels that keep no copy on a
     /// GPU, or gave theirs up.

@@ -494,6 +494,10 @@ impl StepKernels for GpuKernels {
         })
     }
 
+    fn forget_mesh(&mut self) {
+        self.resident = None;
+    }
+
     fn vertex_buffers(&mut self, mesh: &Mesh) -> Option<EngineVertices> {
         self.on_gpu(|k| {
             let r = GpuKernels::sync(&k.gpu, (&mut k.resident, &mut k.uploads), mesh)?;
