@@ -315,7 +315,11 @@ fn a_pipeline_that_forgets_its_mesh_sculpts_the_next_as_a_fresh_one() {
     )
     .resolve(&large, "script")
     .unwrap();
-    assert_eq!(small.version(), large.version(), "the two meshes' edit counts");
+    assert_eq!(
+        small.version(),
+        large.version(),
+        "the two meshes' edit counts"
+    );
     let sculpt = |pipeline: &mut Pipeline| {
         let mut mesh = large.clone();
         for stroke in &strokes {
