@@ -363,8 +363,8 @@ fn run_in(dir: &std::path::Path, command: &str) {
 /// A real window under Xvfb (installed by `tools/test.sh`): the replay drives the pointer's
 /// path, the screenshot is the window's own pixels, and the saved session is the mesh
 /// `slayer sculpt` makes of the same strokes on the same backend, bit for bit; on the GPU
-/// backend the window draws with the engine's device, positions and normals straight from the
-/// backend's buffers, so its strokes upload a fraction of what the CPU backend's do.
+/// backend the window draws with the engine's device, every stroking frame's positions and
+/// normals straight from the backend's buffers.
 #[test]
 fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
     let xvfb = std::process::Command::new("xvfb-run")
@@ -381,8 +381,6 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
         &dir,
         "slayer strokes --scene plaster --triangles 4000 --count 3 -o s.json",
     );
-    // Bytes uploaded to the viewport over the strokes, per backend.
-    let mut uploaded = Vec::new();
     // The virtual screen is larger than the window, which keeps the size it asked for.
     for backend in ["cpu", "gpu"] {
         let window = std::process::Command::new("xvfb-run")
@@ -449,7 +447,6 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             frames > 0.0 && from_engine == expected,
             "{backend}: {metrics}"
         );
-        uploaded.push(frames * figure("bytes_uploaded_per_stroking_frame"));
         let mut colours: Vec<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
         colours.sort_unstable();
         colours.dedup();
@@ -459,10 +456,6 @@ fn a_window_under_xvfb_replays_a_stroke_file_like_sculpt() {
             colours.len()
         );
     }
-    assert!(
-        uploaded[1] < uploaded[0] / 4.0,
-        "bytes uploaded while stroking, cpu then gpu: {uploaded:?}"
-    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
