@@ -53,7 +53,6 @@ fn app(session: Session) -> Harness<'static, SlayerApp> {
                     replay: Vec::new(),
                     plan: Default::default(),
                     antialias: true,
-                    shares_engine_device: false,
                 },
             )
         });

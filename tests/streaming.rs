@@ -297,43 +297,47 @@ fn gpu_runs_of_the_samples_given_agree_with_one_sample_per_call() {
 
 /// The app keeps one pipeline and opens one file after another. A mesh is known to the
 /// pipeline by its edit counts, which a mesh from another file can share, and its edge length
-/// is fixed once known: after `forget_mesh`, a pipeline that prepared for a small plaster
-/// sculpts a ten-times larger one exactly as a fresh pipeline does.
+/// is fixed once known: after `forget_mesh`, a pipeline that prepared for a plaster sculpts the
+/// same plaster ten times larger (the same edit counts) exactly as a fresh pipeline does, on
+/// the CPU and on the GPU (whose copy of the first would otherwise pass for current).
 #[test]
 fn a_pipeline_that_forgets_its_mesh_sculpts_the_next_as_a_fresh_one() {
-    let (mut small, _) = plaster_and_strokes(2000, 0, 1);
-    let (mut large, strokes) = plaster_and_strokes(2000, 3, 1);
-    small.positions_mut().iter_mut().for_each(|p| *p *= 1.0);
-    large.positions_mut().iter_mut().for_each(|p| *p *= 10.0);
-    let strokes = generate_script(
-        &large,
-        &ScriptSpec {
-            strokes: strokes.len(),
+    let cpu = || Pipeline::new(PipelineSettings::default());
+    let gpu = || gpu_pipeline(PipelineSettings::default(), &GpuOptions::default());
+    for (backend, make) in [("cpu", &cpu as &dyn Fn() -> Pipeline), ("gpu", &gpu)] {
+        let (mut first, _) = plaster_and_strokes(2000, 0, 1);
+        let (mut next, _) = plaster_and_strokes(2000, 0, 1);
+        // One edit each, so that both have the same edit counts.
+        first.positions_mut();
+        next.positions_mut().iter_mut().for_each(|p| *p *= 10.0);
+        assert_eq!(
+            first.version(),
+            next.version(),
+            "the two meshes' edit counts"
+        );
+        let spec = ScriptSpec {
+            strokes: 3,
             seed: 1,
             ..ScriptSpec::default()
-        },
-    )
-    .resolve(&large, "script")
-    .unwrap();
-    assert_eq!(
-        small.version(),
-        large.version(),
-        "the two meshes' edit counts"
-    );
-    let sculpt = |pipeline: &mut Pipeline| {
-        let mut mesh = large.clone();
-        for stroke in &strokes {
-            pipeline.apply_stroke(&mut mesh, stroke).unwrap();
-        }
-        mesh
-    };
-    let mut fresh = Pipeline::new(PipelineSettings::default());
-    let expected = sculpt(&mut fresh);
-    let mut reused = Pipeline::new(PipelineSettings::default());
-    reused.prepare(&small).unwrap();
-    let small_edge = reused.edge_length();
-    reused.forget_mesh();
-    assert_identical(&sculpt(&mut reused), &expected, "after forget_mesh");
-    assert_eq!(reused.edge_length(), fresh.edge_length());
-    assert_ne!(reused.edge_length(), small_edge);
+        };
+        let strokes = generate_script(&next, &spec)
+            .resolve(&next, "script")
+            .unwrap();
+        let sculpt = |pipeline: &mut Pipeline| {
+            let mut mesh = next.clone();
+            for stroke in &strokes {
+                pipeline.apply_stroke(&mut mesh, stroke).unwrap();
+            }
+            mesh
+        };
+        let mut fresh = make();
+        let expected = sculpt(&mut fresh);
+        let mut reused = make();
+        reused.prepare(&first).unwrap();
+        let first_edge = reused.edge_length();
+        reused.forget_mesh();
+        assert_identical(&sculpt(&mut reused), &expected, backend);
+        assert_eq!(reused.edge_length(), fresh.edge_length(), "{backend}");
+        assert_ne!(reused.edge_length(), first_edge, "{backend}");
+    }
 }

@@ -78,9 +78,6 @@ pub struct AppSetup {
     pub plan: ExitPlan,
     /// Draw the viewport with 4× multisampling.
     pub antialias: bool,
-    /// The window draws with the GPU backend's device ([`run`] sets it when given one): the
-    /// viewport then reads positions and normals from the backend's own buffers.
-    pub shares_engine_device: bool,
 }
 
 /// The brush and what it paints, as the panels set them.
@@ -180,6 +177,16 @@ pub struct SlayerApp {
 impl SlayerApp {
     /// The app on eframe's wgpu device; the engine thread starts here.
     pub fn new(cc: &eframe::CreationContext<'_>, setup: AppSetup) -> SlayerApp {
+        SlayerApp::on_device(cc, setup, false)
+    }
+
+    /// [`SlayerApp::new`]; `shares_engine_device`: eframe's device is the GPU backend's (only
+    /// [`run`] knows), so the viewport reads positions and normals from the backend's buffers.
+    fn on_device(
+        cc: &eframe::CreationContext<'_>,
+        setup: AppSetup,
+        shares_engine_device: bool,
+    ) -> SlayerApp {
         let (commands, worker_commands) = mpsc::channel();
         let (worker_replies, replies) = mpsc::channel();
         let ctx = cc.egui_ctx.clone();
@@ -192,7 +199,7 @@ impl SlayerApp {
             worker_commands,
             worker_replies,
             wake,
-            setup.shares_engine_device,
+            shares_engine_device,
         );
         let handle = std::thread::Builder::new()
             .name("slayer engine".into())
@@ -640,10 +647,7 @@ pub fn save_path_for(path: &std::path::Path) -> PathBuf {
 /// Runs the app in a window until it is closed; on `shared`, the engine's device, when the
 /// engine runs on the GPU.
 pub fn run(setup: AppSetup, window: [f32; 2], shared: Option<SharedDevice>) -> Result<(), String> {
-    let setup = AppSetup {
-        shares_engine_device: shared.is_some(),
-        ..setup
-    };
+    let shares_engine_device = shared.is_some();
     let mut wgpu_options = egui_wgpu::WgpuConfiguration::default();
     if let Some(shared) = shared {
         wgpu_options.wgpu_setup = egui_wgpu::WgpuSetup::Existing(egui_wgpu::WgpuSetupExisting {
@@ -664,7 +668,10 @@ pub fn run(setup: AppSetup, window: [f32; 2], shared: Option<SharedDevice>) -> R
     eframe::run_native(
         "slayer",
         options,
-        Box::new(move |cc| Ok(Box::new(SlayerApp::new(cc, setup)))),
+        Box::new(move |cc| {
+            let app = SlayerApp::on_device(cc, setup, shares_engine_device);
+            Ok(Box::new(app))
+        }),
     )
     .map_err(|e| format!("the window could not open: {e}"))
 }

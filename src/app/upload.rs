@@ -78,7 +78,8 @@ impl Mirror {
     ) -> MeshUpdate {
         // Rows switch between carrying geometry and not: every row is compared again.
         let switched = self.engine.is_some() != engine.is_some();
-        // New buffers (the backend uploaded its copy afresh) must be bound before drawing.
+        // Other buffers (the backend uploaded its copy afresh), or as many vertices in them
+        // (remeshing added some), or a switch of mode: the viewport binds them again.
         let rebound = self.engine != engine;
         let changed = changed.filter(|_| !switched);
         let geometry = engine.is_none();

@@ -8,7 +8,8 @@
 //! backend's buffers ([`EngineVertices`], `vs_engine`), which the engine keeps current as it
 //! sculpts, and the rows carry only layer, material and mask. The viewport then draws what
 //! the engine has submitted by the time it draws: mid-batch, a step whose exact check is still
-//! to come can show for a frame before the next update.
+//! to come can show for a frame before the next update, and at a stroke's end its remesh (new
+//! positions under the old faces) until the update with the new faces arrives.
 
 use eframe::{egui, egui_wgpu};
 
@@ -106,8 +107,7 @@ impl Viewport {
         );
         let limit = self.binding_limit();
         if vertex_bytes.max(corner_bytes) > limit {
-            self.corner_count = 0;
-            self.dirty = true;
+            self.draw_nothing();
             return Err(format!(
                 "the viewport cannot draw {} vertices: {} MiB of vertex rows, over this adapter's storage binding limit of {} MiB",
                 update.vertex_count,
@@ -115,13 +115,25 @@ impl Viewport {
                 limit >> 20
             ));
         }
+        // What can fail comes before anything changes.
         if let Some(engine) = &update.engine
-            && engine.count < update.vertex_count as usize
+            && engine.count != update.vertex_count as usize
         {
+            self.draw_nothing();
             return Err(format!(
                 "the engine's vertex buffers hold {} vertices, the mesh {}",
                 engine.count, update.vertex_count
             ));
+        }
+        if update.engine.is_some() && self.engine_pipeline.is_none() {
+            let pipeline = preview_pipeline(&self.device, self.samples, VertexPull::Engine);
+            match pipeline {
+                Ok(pipeline) => self.engine_pipeline = Some(pipeline),
+                Err(e) => {
+                    self.draw_nothing();
+                    return Err(format!("the viewport cannot draw from the engine: {e}"));
+                }
+            }
         }
         let grown_vertices = self.grown(&self.vertices, "viewport vertices", vertex_bytes);
         let grown_corners = self.grown(&self.corners, "viewport corners", corner_bytes);
@@ -132,10 +144,6 @@ impl Viewport {
         }
         if let Some(grown) = grown_corners {
             self.corners = grown;
-        }
-        if update.engine.is_some() && self.engine_pipeline.is_none() {
-            let pipeline = preview_pipeline(&self.device, self.samples, VertexPull::Engine);
-            self.engine_pipeline = Some(pipeline.map_err(|e| e.to_string())?);
         }
         self.engine = update.engine.clone();
         if rebind {
@@ -164,6 +172,13 @@ impl Viewport {
         self.corner_count = update.face_count * 3;
         self.dirty = true;
         Ok(())
+    }
+
+    /// After an update that could not be applied: nothing is drawn (rather than rows that no
+    /// longer match what the engine sent).
+    fn draw_nothing(&mut self) {
+        self.corner_count = 0;
+        self.dirty = true;
     }
 
     /// The pipeline for where positions and normals come from now.
@@ -219,14 +234,14 @@ impl Viewport {
         view: &ViewOptions,
     ) {
         if self.fit_targets(size) {
-            let view = &self.targets.as_ref().expect("fitted").resolved_view;
+            let image = &self.targets.as_ref().expect("fitted").resolved_view;
             let filter = wgpu::FilterMode::Linear;
             match self.texture {
                 Some(id) => {
-                    renderer.update_egui_texture_from_wgpu_texture(&self.device, view, filter, id)
+                    renderer.update_egui_texture_from_wgpu_texture(&self.device, image, filter, id)
                 }
                 None => {
-                    let id = renderer.register_native_texture(&self.device, view, filter);
+                    let id = renderer.register_native_texture(&self.device, image, filter);
                     self.texture = Some(id);
                 }
             }
@@ -427,12 +442,20 @@ mod tests {
         let uploaded = rows.update(stroke.mesh(), changed, None);
         assert!(uploaded.bytes() > 0 && !uploaded.redraw);
         same_pictures(&shared, stroke.mesh(), [&mut rows, &mut engine]);
-        stroke.finish().unwrap();
+        let remesh = stroke.finish().unwrap().remesh;
+        assert!(remesh.splits + remesh.collapses > 0, "{remesh:?}");
 
         // Remeshed: the whole mesh compared, as the app does after a stroke.
         let buffers = pipeline.vertex_buffers(&mesh);
         engine.update(&mesh, None, buffers);
         rows.update(&mesh, None, None);
+        same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
+
+        // The backend's copy uploaded afresh (as after an open): new buffers, bound again.
+        pipeline.forget_mesh();
+        let buffers = pipeline.vertex_buffers(&mesh);
+        let rebound = engine.update(&mesh, None, buffers);
+        assert!(rebound.redraw && rebound.bytes() == 0);
         same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
     }
 }

@@ -450,6 +450,8 @@ impl Worker {
             .flatten();
         let update = self.mirror.update(mesh, None, true, engine);
         self.link.reply(Reply::Mesh(update));
+        // Bringing the GPU's copy up to date can be what fails.
+        self.say_if_the_gpu_failed();
     }
 
     fn send_status(&self) {

@@ -68,7 +68,8 @@ struct Varyings {
     @location(7) mask: f32,
 }
 
-// The GPU backend's positions and normals: x, y, z per vertex, packed (`src/gpu/vertices.rs`).
+// The GPU backend's positions and normals: x, y, z per vertex, packed (`src/gpu/vertices.rs`,
+// `src/gpu/backend/resident.rs`).
 // Bound only by the pipeline whose vertex stage is `vs_engine`.
 @group(0) @binding(3) var<storage, read> engine_positions: array<f32>;
 @group(0) @binding(4) var<storage, read> engine_normals: array<f32>;
@@ -108,8 +109,10 @@ fn vs_engine(@builtin(vertex_index) index: u32) -> Varyings {
         engine_normals[3u * v], engine_normals[3u * v + 1u], engine_normals[3u * v + 2u]
     );
     // As `render_vertex` does on the CPU: a normal that is not finite is drawn as none (the
-    // fragment stage then takes the face's); NaN fails every comparison.
-    let finite = all(abs(normal) <= vec3<f32>(3.0e38));
+    // fragment stage then takes the face's). Told by the exponent bits: a shader compiler may
+    // assume that no float is NaN and fold a comparison away.
+    let exponent = vec3<u32>(0x7f800000u);
+    let finite = all((bitcast<vec3<u32>>(normal) & exponent) != exponent);
     vertex.normal = select(vec3<f32>(0.0), normal, finite);
     return corner_varyings(index, vertex);
 }

@@ -63,8 +63,6 @@ pub fn run(args: Args<'_>) -> anyhow::Result<ExitCode> {
         replay,
         plan: args.plan,
         antialias: args.antialias,
-        // Set by `run`, which knows whether the window shares the engine's device.
-        shares_engine_device: false,
     };
     let (width, height) = args.window;
     let shared = shared.filter(|shared| match args.device {

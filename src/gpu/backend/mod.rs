@@ -42,7 +42,7 @@ pub use resident::{face_capacity, resident_bytes, vertex_capacity};
 
 use clamp::{ClampedAhead, tally};
 use hashed::TableUse;
-use resident::Resident;
+use resident::{CopyScope, Resident};
 use step_buffers::StepBuffers;
 
 use crate::brush::Dab;
@@ -496,11 +496,15 @@ impl StepKernels for GpuKernels {
 
     fn forget_mesh(&mut self) {
         self.resident = None;
+        // Sized for the last mesh's brushes.
+        self.last_selection = 0;
+        self.last_move = 0.0;
     }
 
     fn vertex_buffers(&mut self, mesh: &Mesh) -> Option<EngineVertices> {
         self.on_gpu(|k| {
-            let r = GpuKernels::sync(&k.gpu, (&mut k.resident, &mut k.uploads), mesh)?;
+            let tables = (&mut k.resident, &mut k.uploads);
+            let r = GpuKernels::sync(&k.gpu, tables, mesh, CopyScope::Geometry)?;
             Ok(EngineVertices {
                 positions: r.vertices.positions.clone(),
                 normals: r.normals.clone(),

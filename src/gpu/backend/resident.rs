@@ -254,6 +254,15 @@ impl Resident {
     }
 }
 
+/// What [`GpuKernels::sync`] brings up to date.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum CopyScope {
+    Everything,
+    /// All but the flags: what a viewport drawing from the copy reads. A mask stroke changes
+    /// flags every sample, and the whole flag buffer need not follow each of its updates.
+    Geometry,
+}
+
 /// What a mesh keeps resident on the GPU, in bytes, with the room it is allocated with
 /// ([`vertex_capacity`], [`face_capacity`], the slotted rows' spare words): per vertex of room
 /// positions, hashed positions and normals (12 bytes each), layer, flags, marks, overlay marks,
@@ -280,17 +289,18 @@ impl GpuKernels {
         cell: f32,
         table_use: TableUse,
     ) -> Result<&'a mut Resident, GpuError> {
-        let r = GpuKernels::sync(gpu, (resident, uploads), mesh)?;
+        let r = GpuKernels::sync(gpu, (resident, uploads), mesh, CopyScope::Everything)?;
         let vertices = (&r.vertices, r.capacity);
         Hashed::refresh(&mut r.hashed, gpu, uploads, mesh, vertices, cell, table_use)?;
         Ok(r)
     }
 
-    /// Brings the GPU copy up to date with `mesh`.
+    /// Brings the GPU copy up to date with `mesh`, within `scope`.
     pub(super) fn sync<'a>(
         gpu: &GpuContext,
         (resident, uploads): (&'a mut Option<Resident>, &mut Uploads),
         mesh: &Mesh,
+        scope: CopyScope,
     ) -> Result<&'a mut Resident, GpuError> {
         let version = mesh.version();
         let fits = resident.as_ref().is_some_and(|r| {
@@ -315,11 +325,17 @@ impl GpuKernels {
                 .write_buffer(&r.normals, 0, bytemuck::cast_slice(mesh.normals()));
             r.hashed = None;
         }
-        if r.version.flags != version.flags {
-            gpu.queue
-                .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(flag_bits(mesh)));
-        }
-        r.version = version;
+        let flags = match scope {
+            CopyScope::Everything if r.version.flags != version.flags => {
+                gpu.queue
+                    .write_buffer(&r.vertices.flags, 0, bytemuck::cast_slice(flag_bits(mesh)));
+                version.flags
+            }
+            CopyScope::Everything => version.flags,
+            // Left for the next stroke's own sync, as the version says.
+            CopyScope::Geometry => r.version.flags,
+        };
+        r.version = MeshVersion { flags, ..version };
         Ok(r)
     }
 
