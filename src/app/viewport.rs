@@ -324,6 +324,7 @@ mod tests {
     use crate::app::SharedDevice;
     use crate::app::upload::Mirror;
     use crate::bench::{ScriptSpec, generate_script};
+    use crate::brush::Stroke;
     use crate::gpu::{AdapterChoice, GpuContext, GpuKernels};
     use crate::mesh::Mesh;
     use crate::pipeline::{Pipeline, PipelineSettings};
@@ -364,11 +365,12 @@ mod tests {
             buffers: Option<EngineVertices>,
         ) -> MeshUpdate {
             let buffers = buffers.filter(|_| self.engine);
+            let from_engine = buffers.is_some();
             let update = self
                 .mirror
                 .update(mesh, changed, changed.is_none(), buffers);
             self.viewport.apply(&update).unwrap();
-            assert_eq!(self.viewport.draws_from_engine(), self.engine);
+            assert_eq!(self.viewport.draws_from_engine(), from_engine);
             update
         }
 
@@ -391,12 +393,10 @@ mod tests {
         assert!(a == b, "the two pictures differ");
     }
 
-    /// On the GPU backend's device (lavapipe here) the viewport draws positions and normals
-    /// from the backend's own buffers: a sculpting stroke sends it no rows, only a redraw, and
-    /// the picture is the one rows uploaded from the mesh give, pixel for pixel.
-    #[test]
-    fn the_engines_buffers_draw_the_rows_picture_and_a_stroke_uploads_no_rows() {
-        let mut mesh = generate(&SceneSpec {
+    /// A 2K-face plaster, and a stroke of the bench's script that only moves vertices until
+    /// it ends (a grab also remeshes between samples).
+    fn plaster_and_plain_stroke() -> (Mesh, Stroke) {
+        let mesh = generate(&SceneSpec {
             kind: SceneKind::Plaster,
             triangles: 2000,
             seed: 3,
@@ -410,10 +410,18 @@ mod tests {
         let strokes = generate_script(&mesh, &spec)
             .resolve(&mesh, "test")
             .unwrap();
-        // A grab also remeshes between samples; this one only moves vertices until it ends.
-        let plain = (strokes.iter())
+        let plain = (strokes.into_iter())
             .find(|s| !s.settings().brush.kind.drags())
             .unwrap();
+        (mesh, plain)
+    }
+
+    /// On the GPU backend's device (lavapipe here) the viewport draws positions and normals
+    /// from the backend's own buffers: a sculpting stroke sends it no rows, only a redraw, and
+    /// the picture is the one rows uploaded from the mesh give, pixel for pixel.
+    #[test]
+    fn the_engines_buffers_draw_the_rows_picture_and_a_stroke_uploads_no_rows() {
+        let (mut mesh, plain) = plaster_and_plain_stroke();
         let context = gpu();
         let shared = SharedDevice::of(&context);
         let kernels = Box::new(GpuKernels::new(context));
@@ -456,6 +464,39 @@ mod tests {
         let buffers = pipeline.vertex_buffers(&mesh);
         let rebound = engine.update(&mesh, None, buffers);
         assert!(rebound.redraw && rebound.bytes() == 0);
+        same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
+    }
+
+    /// A GPU that gives up (a lost device) sends the viewport back to rows: every row again,
+    /// and the rows' picture.
+    #[test]
+    fn a_gpu_that_gives_up_sends_the_viewport_back_to_rows() {
+        let (mut mesh, plain) = plaster_and_plain_stroke();
+        let context = gpu();
+        let shared = SharedDevice::of(&context);
+        let mut kernels = GpuKernels::new(context);
+        kernels.fail_after(0);
+        let mut pipeline = Pipeline::with_kernels(PipelineSettings::default(), Box::new(kernels));
+        let (mut rows, mut engine) = (Fed::new(&shared, false), Fed::new(&shared, true));
+        rows.update(&mesh, None, None);
+        let buffers = pipeline.vertex_buffers(&mesh);
+        assert!(
+            buffers.is_some(),
+            "a copy is uploaded before the first stroke"
+        );
+        engine.update(&mesh, None, buffers);
+
+        pipeline.apply_stroke(&mut mesh, &plain).unwrap();
+        assert!(
+            pipeline.kernel_failure().is_some(),
+            "the stroke ran on the CPU"
+        );
+        let buffers = pipeline.vertex_buffers(&mesh);
+        assert!(buffers.is_none());
+        let back = engine.update(&mesh, None, buffers);
+        let row = std::mem::size_of::<RenderVertex>();
+        assert!(back.bytes() >= mesh.vertex_count() * row && back.engine.is_none());
+        rows.update(&mesh, None, None);
         same_pictures(&shared, &mesh, [&mut rows, &mut engine]);
     }
 }
