@@ -2,7 +2,7 @@
 //! high valence; each construction error names its element.
 
 use glam::Vec3;
-use slayer::mesh::{INVALID, Mesh, MeshError, VertexFlags};
+use slayer::mesh::{INVALID, Mesh, MeshError, MeshVersion, VertexFlags};
 use slayer::scene::shapes;
 
 fn kinds() -> Vec<(&'static str, Mesh)> {
@@ -105,24 +105,47 @@ fn mean_edge_length_and_normals() {
     );
 }
 
+/// Each kind of change gives its part of the version a new stamp and leaves the others;
+/// another mesh never shows the same version (a pipeline or GPU copy keyed by it cannot take
+/// one mesh for another).
 #[test]
-fn versions_count_changes() {
+fn versions_stamp_changes() {
     let mut mesh = shapes::fan(5);
+    assert_ne!(
+        mesh.version(),
+        shapes::fan(5).version(),
+        "two meshes, two versions"
+    );
     let before = mesh.version();
     mesh.positions_mut()[0].z = 0.5;
     mesh.recompute_normals_at(&[0, 1, 2]);
-    assert_eq!(mesh.version().positions, before.positions + 1);
-    mesh.brdfs_mut()[0].roughness = 0.1;
-    assert_eq!(mesh.version().attributes, before.attributes + 1);
-    mesh.flags_mut()[0] = VertexFlags::MASKED;
-    assert_eq!(mesh.version().flags, before.flags + 1);
+    let moved = mesh.version();
+    assert!(moved.positions > before.positions);
+    let positions = before.positions;
     assert_eq!(
-        mesh.version().attributes,
-        before.attributes + 1,
-        "flags are apart"
+        MeshVersion { positions, ..moved },
+        before,
+        "only the positions"
     );
+    mesh.brdfs_mut()[0].roughness = 0.1;
+    let painted = mesh.version();
+    assert!(painted.attributes > moved.attributes);
+    let attributes = moved.attributes;
+    assert_eq!(
+        MeshVersion {
+            attributes,
+            ..painted
+        },
+        moved,
+        "only the BRDFs"
+    );
+    mesh.flags_mut()[0] = VertexFlags::MASKED;
+    let masked = mesh.version();
+    assert!(masked.flags > painted.flags);
+    let flags = painted.flags;
+    assert_eq!(MeshVersion { flags, ..masked }, painted, "flags are apart");
     mesh.kill_face(0);
-    assert_eq!(mesh.version().topology, before.topology + 1);
+    assert!(mesh.version().topology > masked.topology);
     assert!(mesh.version().total() > before.total());
 }
 

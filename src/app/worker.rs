@@ -262,7 +262,7 @@ impl Worker {
         match crate::session::open_with(&path, &Default::default()) {
             Ok((session, report)) => {
                 self.session = session;
-                // Another mesh, whose edit counts may match the last one's.
+                // Another mesh, with its own edge length.
                 self.pipeline.forget_mesh();
                 self.session.prepare_history();
                 // The file as opened is saved: `after_edit` counts the change of document.

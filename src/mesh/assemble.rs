@@ -73,10 +73,10 @@ impl Mesh {
                 .map(|&c| shift_corner(c)),
         );
         self.layer_names.extend(piece.layer_names.iter().cloned());
-        self.version.topology += 1;
-        self.version.positions += 1;
-        self.version.attributes += 1;
-        self.version.flags += 1;
+        self.version.topology = super::next_stamp();
+        self.version.positions = super::next_stamp();
+        self.version.attributes = super::next_stamp();
+        self.version.flags = super::next_stamp();
         first_layer
     }
 
@@ -127,6 +127,6 @@ impl Mesh {
         self.face_layers.iter_mut().for_each(renumber);
         self.vertex_layers.iter_mut().for_each(renumber);
         self.layer_names.remove(layer as usize);
-        self.version.attributes += 1;
+        self.version.attributes = super::next_stamp();
     }
 }

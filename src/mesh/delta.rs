@@ -270,16 +270,16 @@ impl MeshDelta {
         // mesh (the pipeline's grid, the GPU's buffers) sees that it changed.
         let version = &mut mesh.version;
         if !self.topology_is_empty() || !self.vertex_layers.is_empty() {
-            version.topology += 1;
+            version.topology = super::next_stamp();
         }
         if !self.positions.is_empty() || !self.normals.is_empty() {
-            version.positions += 1;
+            version.positions = super::next_stamp();
         }
         if !self.brdfs.is_empty() || self.layer_names.is_some() {
-            version.attributes += 1;
+            version.attributes = super::next_stamp();
         }
         if !self.flags.is_empty() {
-            version.flags += 1;
+            version.flags = super::next_stamp();
         }
     }
 

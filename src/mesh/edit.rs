@@ -168,7 +168,7 @@ impl Mesh {
         self.repair_vertex_corner(m, c2);
         self.repair_vertex_corner(x, c0);
         self.repair_vertex_corner(b, d2);
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
         m
     }
 
@@ -206,7 +206,7 @@ impl Mesh {
         for (v, known) in [(x, c0), (y, e0), (a, c1), (b, e1)] {
             self.repair_vertex_corner(v, known);
         }
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
     }
 
     /// Whether collapsing the edge opposite `corner` (removing `prev(corner)`'s vertex into
@@ -335,7 +335,7 @@ impl Mesh {
                 }
             }
         }
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
         a
     }
 }

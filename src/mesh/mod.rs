@@ -40,7 +40,8 @@ use glam::Vec3;
 /// overflow `f32`.
 pub const MAX_COORDINATE: f32 = 1.0e18;
 
-/// How many times each kind of data has changed; the GPU backend re-uploads what moved on.
+/// When each kind of data last changed, as a stamp ([`next_stamp`]): whoever keeps a copy of
+/// the mesh (the pipeline's grid, the GPU backend's buffers) re-sends what moved on.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MeshVersion {
     /// Faces, adjacency or vertex count changed.
@@ -55,10 +56,29 @@ pub struct MeshVersion {
 }
 
 impl MeshVersion {
-    /// One counter covering every kind of change.
+    /// A new mesh's version: stamps no other mesh has.
+    fn fresh() -> MeshVersion {
+        let stamp = next_stamp();
+        MeshVersion {
+            topology: stamp,
+            positions: stamp,
+            attributes: stamp,
+            flags: stamp,
+        }
+    }
+
+    /// One figure that grows with every kind of change.
     pub fn total(&self) -> u64 {
         self.topology + self.positions + self.attributes + self.flags
     }
+}
+
+/// Version stamps come from one counter for the whole process, so a change gives a value no
+/// mesh had before: two meshes (a file opened in place of another, a clone edited apart from
+/// its original) never show a copy-keeper the same version for different content.
+fn next_stamp() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Where each old element went after [`Mesh::compact`]: `INVALID` for removed ones.
@@ -165,7 +185,7 @@ impl Mesh {
             face_layers,
             adjacency,
             layer_names,
-            version: MeshVersion::default(),
+            version: MeshVersion::fresh(),
         };
         mesh.recompute_normals();
         mesh.reserve_for_edits();
@@ -202,7 +222,7 @@ impl Mesh {
     /// Mutable positions; counts as a geometry change. Call [`recompute_normals`](Self::recompute_normals)
     /// or [`recompute_normals_at`](Self::recompute_normals_at) afterwards.
     pub fn positions_mut(&mut self) -> &mut [Vec3] {
-        self.version.positions += 1;
+        self.version.positions = next_stamp();
         &mut self.positions
     }
 
@@ -215,7 +235,7 @@ impl Mesh {
     }
 
     pub fn brdfs_mut(&mut self) -> &mut [Brdf] {
-        self.version.attributes += 1;
+        self.version.attributes = next_stamp();
         &mut self.brdfs
     }
 
@@ -228,7 +248,7 @@ impl Mesh {
     }
 
     pub fn flags_mut(&mut self) -> &mut [VertexFlags] {
-        self.version.flags += 1;
+        self.version.flags = next_stamp();
         &mut self.flags
     }
 
@@ -259,7 +279,7 @@ impl Mesh {
 
     /// Sets every vertex of `layer` to `brdf`.
     pub fn set_layer_brdf(&mut self, layer: LayerId, brdf: Brdf) {
-        self.version.attributes += 1;
+        self.version.attributes = next_stamp();
         for (b, &l) in self.brdfs.iter_mut().zip(&self.vertex_layers) {
             if l == layer {
                 *b = brdf;
@@ -271,7 +291,7 @@ impl Mesh {
     pub fn set_layer_name(&mut self, layer: LayerId, name: &str) {
         if let Some(slot) = self.layer_names.get_mut(layer as usize) {
             *slot = name.to_string();
-            self.version.attributes += 1;
+            self.version.attributes = next_stamp();
         }
     }
 
@@ -284,7 +304,7 @@ impl Mesh {
                 expected: self.vertex_count(),
             });
         }
-        self.version.attributes += 1;
+        self.version.attributes = next_stamp();
         // Copied into the array already there, which keeps the room made for edits.
         self.brdfs.clear();
         self.brdfs.extend_from_slice(&brdfs);
@@ -401,7 +421,7 @@ impl Mesh {
                 self.flags[v as usize].insert(VertexFlags::DEAD);
             }
         }
-        self.version.topology += 1;
+        self.version.topology = next_stamp();
     }
 
     /// Removes dead faces and dead or unused vertices, keeping the order of the rest.
@@ -461,7 +481,7 @@ impl Mesh {
             .filter(|(c, _)| face_map[c / 3] != INVALID)
             .map(|(_, &o)| remap_corner(o))
             .collect();
-        self.version.topology += 1;
+        self.version.topology = next_stamp();
         Compaction {
             vertex_map,
             face_map,

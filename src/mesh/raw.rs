@@ -47,7 +47,7 @@ impl Mesh {
                 vertex_corner: input.array("vertex corners")?,
             },
             layer_names: input.strings("layer names")?,
-            version: MeshVersion::default(),
+            version: MeshVersion::fresh(),
         };
         mesh.validate()?;
         mesh.reserve_for_edits();

@@ -52,7 +52,7 @@ impl Mesh {
         for (v, wedges) in &plans {
             self.adjacency.vertex_corner[*v as usize] = wedges[0][0];
         }
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
         copies
     }
 

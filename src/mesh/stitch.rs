@@ -87,7 +87,7 @@ impl Mesh {
                 self.repair_vertex_corner(v, (3 * (first + i) + k) as u32);
             }
         }
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
         Ok(())
     }
 
@@ -130,7 +130,7 @@ impl Mesh {
                 }
             }
         }
-        self.version.topology += 1;
+        self.version.topology = super::next_stamp();
     }
 
     fn is_vertex_live_or_new(&self, v: u32, layer: LayerId) -> bool {

@@ -203,9 +203,9 @@ impl Pipeline {
     }
 
     /// Forgets the mesh it worked on — its edge length, grid and the kernels' copy — for a
-    /// pipeline that goes on with another mesh (the app opening a file). The pipeline knows a
-    /// mesh by its edit counts ([`MeshVersion`]), which a mesh from another file can share, and
-    /// keeps the edge length it first measured.
+    /// pipeline that goes on with another mesh (the app opening a file): the pipeline keeps the
+    /// edge length it first measured. (The grid and the copy would be rebuilt anyway: another
+    /// mesh's [`MeshVersion`] differs.)
     pub fn forget_mesh(&mut self) {
         self.edge_length = None;
         self.prepared = None;
