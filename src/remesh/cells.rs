@@ -63,7 +63,14 @@ pub(super) fn remesh_whole(
         return Ok(report);
     }
     let mut grid = SpatialHash::build(mesh, GRID_EDGES * settings.target_edge)?;
-    let report = remesh_by_cells(mesh, &mut grid, settings, (start, culling), progress);
+    let closed = ClosedParts::find(mesh, &live);
+    let report = remesh_by_cells(
+        mesh,
+        (&mut grid, closed),
+        settings,
+        (start, culling),
+        progress,
+    );
     Ok(report)
 }
 
@@ -73,14 +80,14 @@ fn rings(start: Start) -> u32 {
     u32::from(start != Start::Everywhere)
 }
 
+/// `closed`: the mesh's closed components, found once for every cell.
 fn remesh_by_cells(
     mesh: &mut Mesh,
-    grid: &mut SpatialHash,
+    (grid, mut closed): (&mut SpatialHash, ClosedParts),
     settings: &RemeshSettings,
     (start, culling): (Start, Culling),
     progress: &mut dyn FnMut(Progress),
 ) -> RemeshReport {
-    let mut closed = ClosedParts::find(mesh, &live_vertices(mesh));
     let mut sets = RemeshSets::default();
     let mut zones = ZoneFinder::default();
     let mut report = RemeshReport::default();
