@@ -29,6 +29,6 @@ pub use region::{Region, Scratch, StepMoves};
 pub use response::{
     CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, collide, collide_with, pull_back,
 };
-pub(crate) use sheet::{boundary_loop, normal_cone, projected_loop_is_simple};
+pub(crate) use sheet::{boundary_loop, normal_cone, projected_loop_is_simple, rim_loop};
 pub use stamps::Stamps;
 pub use state::StrokeState;

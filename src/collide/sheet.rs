@@ -198,6 +198,25 @@ pub(crate) fn boundary_loop(
             }
         }
     }
+    one_loop(edges)
+}
+
+/// The vertices of the mesh's rim, in order, when `faces` (every live face) are bounded by one
+/// loop of rim edges that passes no vertex twice; none otherwise (a closed mesh, several loops).
+pub(crate) fn rim_loop(mesh: &Mesh, faces: &[u32]) -> Option<Vec<u32>> {
+    let opposite = &mesh.adjacency().opposite;
+    let edges = faces
+        .iter()
+        .flat_map(|&f| 3 * f..3 * f + 3)
+        .filter(|&c| opposite[c as usize] == INVALID)
+        .map(|c| (mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c))))
+        .collect();
+    one_loop(edges)
+}
+
+/// The directed `edges` chained into one loop of vertices, in order; none when they make
+/// several loops, pass a vertex twice, or are fewer than three.
+fn one_loop(mut edges: Vec<(u32, u32)>) -> Option<Vec<u32>> {
     if edges.len() < 3 {
         return None;
     }

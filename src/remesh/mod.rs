@@ -159,6 +159,27 @@ pub fn remesh_region_with(
     remesh(mesh, grid, seeds, settings, pass)
 }
 
+/// Remeshes `piece`, a mesh a layer tool made to add to another (which checks it exactly
+/// against that mesh afterwards), where its edges are out of band. Where the piece is one sheet
+/// (`zone`'s lone sheet) the zone vouches for the edits that keep it one: the piece has nothing
+/// else to come near, and a million-face layer's new patch need not pay for the checks a
+/// stack of layers needs.
+pub fn remesh_piece(
+    piece: &mut Mesh,
+    settings: &RemeshSettings,
+) -> Result<RemeshReport, GridError> {
+    let mut grid = SpatialHash::build(piece, settings.target_edge)?;
+    let every: Vec<u32> = (0..piece.vertex_count() as u32).collect();
+    let pass = Pass {
+        start: Start::OutOfBand,
+        sets: &mut RemeshSets::default(),
+        closed: None,
+        zone: Zone::of_lone_sheet(piece, settings.target_edge),
+    };
+    let (report, _) = remesh(piece, &mut grid, &every, settings, pass);
+    Ok(report)
+}
+
 /// The per-vertex sets of a remeshing pass (which vertices are in its region, which an edit
 /// changed, which relaxation may move), emptied in O(1) between passes.
 #[derive(Debug, Clone, Default)]

@@ -41,7 +41,11 @@ impl Remesher<'_> {
                 Some((ids, at))
             })
             .collect();
-        self.unless_vouched(&moved, |remesher| {
+        // The rim stays as it is unless a rim vertex moves or is merged away.
+        let rim = |w: u32| self.mesh.is_boundary_vertex(w);
+        let keeps_rim =
+            merged.is_none_or(|m| !rim(m)) && (!rim(v) || positions[v as usize] == target);
+        self.unless_vouched(&moved, keeps_rim, |remesher| {
             remesher.move_checks(v, (target, merged), &carrying, &moved)
         })
     }
@@ -106,16 +110,18 @@ impl Remesher<'_> {
         clear
     }
 
-    /// `check`'s verdict on an edit that makes `triangles`, unless the cell's sheet zone
-    /// vouches for them (`zone`): then the edit is safe unchecked. An edit checked in full
-    /// that passes ends the zone, since its faces may leave the zone no longer a sheet.
+    /// `check`'s verdict on an edit that makes `triangles` (and leaves the mesh's rim as it
+    /// was, when `keeps_rim`), unless the sheet zone vouches for them (`zone`): then the edit
+    /// is safe unchecked. An edit checked in full that passes ends the zone, since its faces
+    /// may leave the zone no longer a sheet.
     fn unless_vouched(
         &mut self,
         triangles: &[([u32; 3], [Vec3; 3])],
+        keeps_rim: bool,
         check: impl FnOnce(&mut Self) -> bool,
     ) -> bool {
         let zone = self.zone.as_ref();
-        if zone.is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t))) {
+        if keeps_rim && zone.is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t))) {
             self.report.culled += 1;
             return true;
         }
@@ -134,7 +140,8 @@ impl Remesher<'_> {
         replaced: [u32; 2],
         before: &[[Vec3; 3]],
     ) -> bool {
-        self.unless_vouched(after, |remesher| {
+        // A flip's edge is never on the rim (a rim edge has one face).
+        self.unless_vouched(after, true, |remesher| {
             let layer = remesher.mesh.face_layers()[replaced[0] as usize];
             let near = remesher.gather_near(&bounds_of(after));
             let clear = remesher.faces_clear_among(after, &[], &replaced, &near)
@@ -211,7 +218,7 @@ impl Remesher<'_> {
             replaced.push(o / 3);
         }
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
-        self.unless_vouched(&halves, |remesher| {
+        self.unless_vouched(&halves, o != INVALID, |remesher| {
             // The halves lie on the faces they replace: only the new vertex needs the wider
             // reach.
             let mut reach = bounds_of(&halves);

@@ -25,11 +25,19 @@
 //!
 //! An edit the zone cannot vouch for is checked in full, and the zone is dropped for the rest
 //! of the cell's pass: its faces may leave the set no longer a sheet.
+//!
+//! A *lone sheet* is a zone too: a whole mesh of one layer whose rim is one loop, simple in
+//! projection, every normal in the cone (a layer tool's new piece, remeshed on its own before
+//! it joins the mesh and is checked exactly against it). The same argument holds with the rim
+//! as the loop and no box: nothing else exists for an edit to come near, and an edit keeps the
+//! loop as it is when it moves no rim vertex and rewires no rim edge, which the remesher tells
+//! the zone with each edit (a cell's inner box is farther than an edit's reach from any rim,
+//! so there the answer is always yes).
 
 use glam::Vec3;
 
 use super::normal;
-use crate::collide::{Stamps, boundary_loop, normal_cone, projected_loop_is_simple};
+use crate::collide::{Stamps, boundary_loop, normal_cone, projected_loop_is_simple, rim_loop};
 use crate::geom::Aabb;
 use crate::grid::SpatialHash;
 use crate::mesh::Mesh;
@@ -52,7 +60,8 @@ const MIN_DOUBLE_AREA: f32 = 1e-3;
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Zone {
     axis: Vec3,
-    inner: Aabb,
+    /// Where an edit's faces must lie: a cell's inner box, or anywhere in a lone sheet.
+    inner: Option<Aabb>,
     min_double_area: f32,
 }
 
@@ -92,30 +101,63 @@ impl ZoneFinder {
                 }
             }
         });
-        let layers = mesh.face_layers();
-        let layer = layers[*faces.first()? as usize];
-        if faces.iter().any(|&f| layers[f as usize] != layer) {
+        if !one_layer(mesh, faces) {
             return None;
         }
         let boundary = boundary_loop(mesh, faces, |g| members.contains(g as usize))?;
-        let cone = normal_cone(mesh, faces, |v| mesh.positions()[v as usize], false)?;
-        // The axis in f32 differs from the f64 one by far less than the margin asked here.
-        let sheet = cone.cos >= f64::from(MIN_COS) + 0.01
-            && projected_loop_is_simple(mesh, &boundary, cone.axis);
-        sheet.then(|| Zone {
-            axis: cone.axis.as_vec3(),
-            inner: core.expanded(INNER_EDGES * target_edge),
-            min_double_area: MIN_DOUBLE_AREA * target_edge * target_edge,
-        })
+        let inner = core.expanded(INNER_EDGES * target_edge);
+        Zone::of_sheet(mesh, faces, &boundary, (Some(inner), target_edge))
     }
 }
 
+fn one_layer(mesh: &Mesh, faces: &[u32]) -> bool {
+    let layers = mesh.face_layers();
+    faces.first().is_some_and(|&first| {
+        let layer = layers[first as usize];
+        faces.iter().all(|&f| layers[f as usize] == layer)
+    })
+}
+
 impl Zone {
+    /// The zone of the whole of `mesh` when it is a lone sheet (the module's conditions, with
+    /// its rim as the loop).
+    pub(super) fn of_lone_sheet(mesh: &Mesh, target_edge: f32) -> Option<Zone> {
+        let faces: Vec<u32> = (0..mesh.face_count() as u32)
+            .filter(|&f| !mesh.is_face_dead(f as usize))
+            .collect();
+        if !one_layer(mesh, &faces) {
+            return None;
+        }
+        let rim = rim_loop(mesh, &faces)?;
+        Zone::of_sheet(mesh, &faces, &rim, (None, target_edge))
+    }
+
+    /// The zone of `faces` bounded by `boundary`, if their normals lie in the cone and the
+    /// loop projects simple along its axis.
+    fn of_sheet(
+        mesh: &Mesh,
+        faces: &[u32],
+        boundary: &[u32],
+        (inner, target_edge): (Option<Aabb>, f32),
+    ) -> Option<Zone> {
+        let cone = normal_cone(mesh, faces, |v| mesh.positions()[v as usize], false)?;
+        // The axis in f32 differs from the f64 one by far less than the margin asked here.
+        let sheet = cone.cos >= f64::from(MIN_COS) + 0.01
+            && projected_loop_is_simple(mesh, boundary, cone.axis);
+        sheet.then(|| Zone {
+            axis: cone.axis.as_vec3(),
+            inner,
+            min_double_area: MIN_DOUBLE_AREA * target_edge * target_edge,
+        })
+    }
+
     /// Whether faces an edit makes (at their new positions) keep the zone a sheet: inside the
     /// inner box, and each facing along the axis.
     pub(super) fn holds<'t>(&self, triangles: impl IntoIterator<Item = &'t [Vec3; 3]>) -> bool {
         triangles.into_iter().all(|t| {
-            let inside = t.iter().all(|&p| self.inner.distance_squared_to(p) == 0.0);
+            let inside = self
+                .inner
+                .is_none_or(|inner| t.iter().all(|&p| inner.distance_squared_to(p) == 0.0));
             let n = normal(*t);
             let length = n.length();
             inside && length > self.min_double_area && n.dot(self.axis) >= MIN_COS * length

@@ -22,9 +22,8 @@ use super::shell::thicken;
 use super::{ToolError, check_length};
 use crate::collide::find_intersections;
 use crate::geom::Aabb;
-use crate::grid::{GridError, SpatialHash};
 use crate::mesh::{Brdf, LayerId, Mesh};
-use crate::remesh::{RemeshSettings, remesh_region};
+use crate::remesh::{RemeshSettings, remesh_piece};
 
 /// The final check's allowance on `d` for rounding.
 const CLEARANCE_SLACK: f32 = 1e-3;
@@ -224,7 +223,9 @@ fn finish(
         let mut remeshed = piece.clone();
         let mut remesh = RemeshSettings::new(settings.edge);
         remesh.collision_distance = settings.collision_distance;
-        if remesh_out_of_band(&mut remeshed, &remesh).is_ok() {
+        // Where lifting (or thickening) left edges out of band: the rest of the copy is its
+        // source's, already at `L`.
+        if remesh_piece(&mut remeshed, &remesh).is_ok() {
             remeshed.compact();
             if check_clear(&remeshed, obstacles, settings.collision_distance).is_ok() {
                 return Ok((remeshed, true));
@@ -233,15 +234,6 @@ fn finish(
     }
     check_clear(&piece, obstacles, settings.collision_distance)?;
     Ok((piece, false))
-}
-
-/// Remeshes where lifting (or thickening) left edges the remesher would change: the rest of
-/// the copy is its source's, already at `L`, and is left as it is.
-fn remesh_out_of_band(piece: &mut Mesh, settings: &RemeshSettings) -> Result<(), GridError> {
-    let mut grid = SpatialHash::build(piece, settings.target_edge)?;
-    let every: Vec<u32> = (0..piece.vertex_count() as u32).collect();
-    remesh_region(piece, &mut grid, &every, settings);
-    Ok(())
 }
 
 /// Every vertex of `piece` at least `d` (less rounding) from the obstacles, and no face of it
