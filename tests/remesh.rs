@@ -8,8 +8,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use slayer::collide::find_intersections;
 use slayer::collide::neighbourhood::exclusion_ring;
+use slayer::grid::SpatialHash;
 use slayer::mesh::Mesh;
-use slayer::remesh::{Culling, RemeshReport, RemeshSettings, remesh_all, remesh_all_with};
+use slayer::remesh::{
+    Culling, RemeshReport, RemeshSettings, remesh_all, remesh_all_with, remesh_piece, remesh_region,
+};
 use slayer::scene::{SceneKind, SceneSpec, generate, shapes};
 
 fn kinds() -> Vec<(&'static str, Mesh)> {
@@ -217,6 +220,45 @@ fn sheet_zones_skip_checks_without_changing_the_remesh() {
             assert!(on.culled > edits / 2, "{name}: {} of {edits}", on.culled);
         }
     }
+}
+
+/// A layer tool's new piece is remeshed on its own before it joins the mesh (and is checked
+/// exactly against it). Where it is one sheet, its zone vouches for the edits that keep the
+/// rim: the same remesh as with every check made, most of the checks skipped.
+#[test]
+fn a_lone_sheet_is_remeshed_as_with_every_check_made() {
+    let plane = SceneSpec {
+        kind: SceneKind::Plane,
+        triangles: 8_000,
+        seed: 1,
+    };
+    let mut sheet = generate(&plane).unwrap();
+    let edge = sheet.mean_edge_length();
+    // Stretched along x and waved, so that remeshing has edges to split, collapse and flip.
+    for p in sheet.positions_mut() {
+        *p = Vec3::new(1.6 * p.x, p.y * (1.0 + 0.3 * p.x), 0.1 * (6.0 * p.x).sin());
+    }
+    sheet.recompute_normals();
+    let mut settings = RemeshSettings::new(edge);
+    settings.exclusion_ring = 2;
+    let (mut vouched, mut checked) = (sheet.clone(), sheet);
+    let on = remesh_piece(&mut vouched, &settings).unwrap();
+    let mut grid = SpatialHash::build(&checked, edge).unwrap();
+    let every: Vec<u32> = (0..checked.vertex_count() as u32).collect();
+    let (off, _) = remesh_region(&mut checked, &mut grid, &every, &settings);
+    eprintln!("vouched {on:?}\n  checked {off:?}");
+    vouched.validate().unwrap();
+    assert_eq!(find_intersections(&vouched).total(), 0);
+    assert_eq!(edit_counts(&on), edit_counts(&off));
+    assert_eq!(vouched.positions(), checked.positions());
+    assert_eq!(vouched.faces(), checked.faces());
+    let edits = on.splits + on.collapses + on.flips + on.relaxed;
+    assert!(edits > 1_000, "{edits} edits");
+    assert!(
+        on.culled > edits / 2,
+        "{} of {edits} vouched for",
+        on.culled
+    );
 }
 
 /// The issue asks that a whole-mesh remesh not depend on the thread count: the cells run in

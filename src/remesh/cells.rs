@@ -14,7 +14,9 @@ use glam::{IVec3, Vec3};
 
 use super::shape::ClosedParts;
 use super::zone::ZoneFinder;
-use super::{Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, remesh};
+use super::{
+    Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, remesh,
+};
 use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
 use crate::mesh::Mesh;
@@ -51,7 +53,7 @@ pub(super) fn remesh_whole(
             start,
             sets: &mut RemeshSets::default(),
             closed: None,
-            zone: None,
+            zone: Zoning::Off,
         };
         let (report, _) = remesh(mesh, &mut grid, &live, &settings, pass);
         progress(Progress {
@@ -114,7 +116,7 @@ fn remesh_by_cells(
                 start,
                 sets: &mut sets,
                 closed: Some(&mut closed),
-                zone,
+                zone: Zoning::Cell(zone),
             };
             let (done, _) = remesh(mesh, grid, &seeds, &settings, pass);
             longest_edge = longest_edge.max(done.longest_edge);

@@ -154,7 +154,7 @@ pub fn remesh_region_with(
         start: Start::OutOfBand,
         sets,
         closed: None,
-        zone: None,
+        zone: Zoning::Off,
     };
     remesh(mesh, grid, seeds, settings, pass)
 }
@@ -174,7 +174,7 @@ pub fn remesh_piece(
         start: Start::OutOfBand,
         sets: &mut RemeshSets::default(),
         closed: None,
-        zone: Zone::of_lone_sheet(piece, settings.target_edge),
+        zone: Zoning::LoneSheet,
     };
     let (report, _) = remesh(piece, &mut grid, &every, settings, pass);
     Ok(report)
@@ -216,8 +216,21 @@ struct Pass<'s> {
     /// The closed components' volumes, kept across the passes of a whole-mesh remesh (one
     /// pass per cell); `None` finds those of the region.
     closed: Option<&'s mut ClosedParts>,
-    /// The sheet zone the region lies in, whose edits need no safety checks (`zone`).
-    zone: Option<Zone>,
+    /// Which sheet zone vouches for the pass's edits.
+    zone: Zoning,
+}
+
+/// Which sheet zone vouches for a pass's edits, sparing them their safety checks (`zone`).
+enum Zoning {
+    /// None: every edit is checked (a stroke's remesh).
+    Off,
+    /// The zone of a whole-mesh remesh's cell, found before the pass: once an edit it cannot
+    /// vouch for has passed its checks, the rest of the cell's pass is checked.
+    Cell(Option<Zone>),
+    /// The whole mesh, when it is a lone sheet (`zone`): found again before each stage of
+    /// the pass (splits, collapses, flips, relaxation) where an edit it could not vouch for
+    /// ended it. A piece's rim edits come early in a stage, and its interior is most of it.
+    LoneSheet,
 }
 
 fn remesh(
@@ -230,17 +243,24 @@ fn remesh(
     let started = Instant::now();
     let kept = pass.closed.as_deref_mut().map(std::mem::take);
     let mut remesher = Remesher::new(mesh, grid, seeds, settings, (pass.start, pass.sets), kept);
-    remesher.zone = pass.zone;
+    remesher.lone_sheet = matches!(pass.zone, Zoning::LoneSheet);
+    if let Zoning::Cell(zone) = pass.zone {
+        remesher.zone = zone;
+    }
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
+        remesher.renew_zone();
         remesher.split_long_edges();
+        remesher.renew_zone();
         remesher.collapse_short_edges();
+        remesher.renew_zone();
         remesher.flip_toward_regular_valence();
         // Relaxation follows edits: a round that changed nothing (after the first, which
         // relaxes what the stroke left out of band) has converged.
         if round > 0 && remesher.edit_count() == edits {
             break;
         }
+        remesher.renew_zone();
         remesher.relax();
     }
     if let Some(closed) = pass.closed {
@@ -346,6 +366,9 @@ struct Remesher<'a> {
     whole: bool,
     /// The sheet zone the region lies in, while its edits keep it one (`zone`).
     zone: Option<Zone>,
+    /// The whole mesh is a lone sheet's: its zone is found again before each stage
+    /// ([`Zoning::LoneSheet`]).
+    lone_sheet: bool,
 }
 
 impl<'a> Remesher<'a> {
@@ -419,11 +442,19 @@ impl<'a> Remesher<'a> {
             near: Vec::new(),
             whole: start != Start::OutOfBand,
             zone: None,
+            lone_sheet: false,
         };
         for v in starting {
             remesher.mark_dirty(v);
         }
         remesher
+    }
+
+    /// Finds a lone sheet's zone again where an edit it could not vouch for ended it.
+    fn renew_zone(&mut self) {
+        if self.lone_sheet && self.zone.is_none() {
+            self.zone = Zone::of_lone_sheet(self.mesh, self.settings.target_edge);
+        }
     }
 
     fn edit_count(&self) -> usize {

@@ -217,6 +217,45 @@ mod tests {
     }
 
     #[test]
+    fn a_lone_sheet_is_a_zone_with_its_rim_as_its_loop() {
+        let wavy = sheet(|p| p + Vec3::Z * (0.1 * p.x).sin(), &[0.0]);
+        let zone = Zone::of_lone_sheet(&wavy, EDGE).expect("a lone sheet");
+        assert!(zone.inner.is_none(), "no box: nothing else exists");
+        let far = [
+            Vec3::new(90.0, 90.0, 0.0),
+            Vec3::new(91.0, 90.0, 0.0),
+            Vec3::new(90.0, 91.0, 0.0),
+        ];
+        assert!(zone.holds(&[far]), "anywhere, facing along the axis");
+        assert!(
+            !zone.holds(&[[far[0], far[2], far[1]]]),
+            "a face turned over"
+        );
+        // Two sheets: two rims. A sheet folded over itself: normals past the cone.
+        assert!(Zone::of_lone_sheet(&sheet(|p| p, &[0.0, 2.0]), EDGE).is_none());
+        let folded = sheet(
+            |p| {
+                let t = (p.x - 20.0).clamp(0.0, std::f32::consts::PI);
+                Vec3::new(
+                    p.x.min(20.0) + t.sin() - (p.x - 20.0 - t).max(0.0),
+                    p.y,
+                    1.0 - t.cos(),
+                )
+            },
+            &[0.0],
+        );
+        assert!(Zone::of_lone_sheet(&folded, EDGE).is_none());
+        // A closed surface has no rim.
+        let sphere = crate::scene::generate(&crate::scene::SceneSpec {
+            kind: crate::scene::SceneKind::Sphere,
+            triangles: 500,
+            seed: 1,
+        })
+        .unwrap();
+        assert!(Zone::of_lone_sheet(&sphere, EDGE).is_none());
+    }
+
+    #[test]
     fn no_zone_where_more_than_one_sheet_is_near() {
         // Two sheets of one layer, 2 edges apart: their loops are two.
         assert!(zone_of(&sheet(|p| p, &[0.0, 2.0])).is_none());
