@@ -34,52 +34,34 @@ pub fn plan_patch(
     if outline.len() < 4 || outline.iter().any(|p| !p.is_finite()) {
         return Err(bad("it needs at least four finite points"));
     }
-    let bounds = Aabb::of_points(outline);
-    let reach = (4.0 * edge).max(0.5 * (bounds.max - bounds.min).length());
-    let surface = Obstacles::near(mesh, bounds.expanded(reach + edge), 1.5 * edge);
-    // Most points lie on or near the surface: short looks first, the long one only where they
-    // find nothing. A face found within a look is the nearest of all (any nearer one lies
-    // within that look too), so the answer is the one the long look alone would give.
-    let looks = [0.5 * edge, 4.0 * edge, reach];
-    let nearest = |p: Vec3| {
-        looks
-            .iter()
-            .find_map(|&look| surface.nearest_face(p, look, layer))
-    };
-    let on_layer = |p: Vec3| nearest(p).map(|(_, q)| q);
+    let on_layer = OnLayer::near(mesh, outline, layer, edge);
     let projected: Vec<Vec3> = outline
         .iter()
         .enumerate()
         .map(|(i, &p)| {
-            on_layer(p).ok_or_else(|| bad(&format!("point {i} is not over layer {layer}")))
+            let point = on_layer.point(p);
+            point.ok_or_else(|| bad(&format!("point {i} is not over layer {layer}")))
         })
         .collect::<Result<_, _>>()?;
-    let facing = |p: Vec3| nearest(p).map_or(Vec3::ZERO, |(f, _)| mesh.face_normal(f as usize));
-    // Lifting off a curved surface stretches (or shrinks) the patch: laid out at `L` over the
-    // outline, a patch lifted 2·L off a sphere 13·L round comes out 15 % long, just below
-    // the remesher's split length, and remeshing splits a scatter of its edges in two. Laid
-    // out shorter by the stretch its rim takes, it is lifted to `L`.
-    let lifted = |ring: &[Vec3]| -> Vec<Vec3> {
-        ring.iter()
-            .map(|&p| p + facing(p) * settings.offset)
-            .collect()
-    };
-    let ring = closed_ring(&projected, edge)?;
-    let stretch = (perimeter(&lifted(&ring)) / perimeter(&ring)).clamp(0.5, 2.0);
+    let facing = |p: Vec3| on_layer.normal(mesh, p);
+    let stretch = rim_stretch(&closed_ring(&projected, edge)?, &facing, settings.offset);
     let lay_out = |layout: Layout| {
         let spacing = match layout {
             Layout::Lattice => edge / stretch,
             Layout::Quads => edge,
         };
         let ring = closed_ring(&projected, spacing)?;
-        let flat = flatten(&ring)?;
-        let corners = corners(&flat);
+        let corners = corners(&flatten(&ring)?);
         let grid = coons_grid(&ring, &corners, spacing, layout);
         // Each point on its own: a big patch's projection would otherwise leave cores idle.
         let positions = grid
             .points
             .par_iter()
-            .map(|&p| on_layer(p).ok_or_else(|| bad("it encloses a hole in the layer")))
+            .map(|&p| {
+                on_layer
+                    .point(p)
+                    .ok_or_else(|| bad("it encloses a hole in the layer"))
+            })
             .collect::<Result<Vec<Vec3>, _>>()?;
         let piece = triangulate(positions, &grid, settings, facing)?;
         lift_off(mesh, piece, layer, settings)
@@ -91,9 +73,68 @@ pub fn plan_patch(
     {
         return lattice;
     }
+    the_more_even(lattice, lay_out(Layout::Quads))
+}
+
+/// The faces of the layer a patch is drawn on, near its outline, for points to be put on.
+struct OnLayer {
+    surface: Obstacles,
+    layer: LayerId,
+    /// How far to look, shortest first: most points lie on or near the surface, and the long
+    /// look is paid only where the short ones find nothing. A face found within a look is the
+    /// nearest of all (any nearer one lies within that look too), so the answer is the one
+    /// the long look alone would give.
+    looks: [f32; 3],
+}
+
+impl OnLayer {
+    fn near(mesh: &Mesh, outline: &[Vec3], layer: LayerId, edge: f32) -> OnLayer {
+        let bounds = Aabb::of_points(outline);
+        let reach = (4.0 * edge).max(0.5 * (bounds.max - bounds.min).length());
+        OnLayer {
+            surface: Obstacles::near(mesh, bounds.expanded(reach + edge), 1.5 * edge),
+            layer,
+            looks: [0.5 * edge, 4.0 * edge, reach],
+        }
+    }
+
+    fn nearest(&self, p: Vec3) -> Option<(u32, Vec3)> {
+        let layer = self.layer;
+        self.looks
+            .iter()
+            .find_map(|&look| self.surface.nearest_face(p, look, layer))
+    }
+
+    /// The layer's point nearest to `p`.
+    fn point(&self, p: Vec3) -> Option<Vec3> {
+        self.nearest(p).map(|(_, q)| q)
+    }
+
+    /// The normal of the layer's face nearest to `p` (zero where none is in reach).
+    fn normal(&self, mesh: &Mesh, p: Vec3) -> Vec3 {
+        self.nearest(p)
+            .map_or(Vec3::ZERO, |(f, _)| mesh.face_normal(f as usize))
+    }
+}
+
+/// How much longer `ring` comes out lifted by `offset` along the surface's normals (`facing`).
+/// Lifting off a curved surface stretches (or shrinks) a patch: laid out at `L`, a patch lifted
+/// 2·L off a sphere 13·L round comes out 15 % long, just below the remesher's split length,
+/// and remeshing splits a scatter of its edges in two. Laid out shorter by the stretch its rim
+/// takes, it is lifted to `L`.
+fn rim_stretch(ring: &[Vec3], facing: impl Fn(Vec3) -> Vec3, offset: f32) -> f32 {
+    let lifted: Vec<Vec3> = ring.iter().map(|&p| p + facing(p) * offset).collect();
+    (perimeter(&lifted) / perimeter(ring)).clamp(0.5, 2.0)
+}
+
+type Planned = Result<(Mesh, DuplicateReport), ToolError>;
+
+/// Of two layouts' patches, the one with the more even edges; the one that could be placed
+/// where the other could not; the lattice's error where neither could.
+fn the_more_even(lattice: Planned, quads: Planned) -> Planned {
     let evenness =
         |(piece, _): &(Mesh, DuplicateReport)| piece.edge_length_stats().coefficient_of_variation();
-    match (lattice, lay_out(Layout::Quads)) {
+    match (lattice, quads) {
         (Ok(a), Ok(b)) => Ok(if evenness(&b) < evenness(&a) { b } else { a }),
         (Ok(a), Err(_)) | (Err(_), Ok(a)) => Ok(a),
         (Err(e), Err(_)) => Err(e),
