@@ -450,10 +450,13 @@ impl<'a> Remesher<'a> {
         remesher
     }
 
-    /// Finds a lone sheet's zone again where an edit it could not vouch for ended it.
+    /// Finds a lone sheet's zone again where an edit it could not vouch for ended it. A mesh
+    /// that is not one (several rims, normals past the cone) is not asked again: the search
+    /// walks every face.
     fn renew_zone(&mut self) {
         if self.lone_sheet && self.zone.is_none() {
             self.zone = Zone::of_lone_sheet(self.mesh, self.settings.target_edge);
+            self.lone_sheet = self.zone.is_some();
         }
     }
 
