@@ -243,10 +243,12 @@ fn remesh(
     let started = Instant::now();
     let kept = pass.closed.as_deref_mut().map(std::mem::take);
     let mut remesher = Remesher::new(mesh, grid, seeds, settings, (pass.start, pass.sets), kept);
-    remesher.lone_sheet = matches!(pass.zone, Zoning::LoneSheet);
-    if let Zoning::Cell(zone) = pass.zone {
-        remesher.zone = zone;
-    }
+    remesher.zone = match pass.zone {
+        Zoning::Off => None,
+        Zoning::Cell(zone) => zone,
+        Zoning::LoneSheet => Zone::of_lone_sheet(remesher.mesh, settings.target_edge),
+    };
+    remesher.lone_sheet = matches!(pass.zone, Zoning::LoneSheet) && remesher.zone.is_some();
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
         remesher.renew_zone();
@@ -366,8 +368,8 @@ struct Remesher<'a> {
     whole: bool,
     /// The sheet zone the region lies in, while its edits keep it one (`zone`).
     zone: Option<Zone>,
-    /// The whole mesh is a lone sheet's: its zone is found again before each stage
-    /// ([`Zoning::LoneSheet`]).
+    /// The whole mesh was a lone sheet when the pass began: its zone is found again before
+    /// each stage ([`Zoning::LoneSheet`]). A mesh that was not one is not searched again.
     lone_sheet: bool,
 }
 
@@ -450,13 +452,10 @@ impl<'a> Remesher<'a> {
         remesher
     }
 
-    /// Finds a lone sheet's zone again where an edit it could not vouch for ended it. A mesh
-    /// that is not one (several rims, normals past the cone) is not asked again: the search
-    /// walks every face.
+    /// Finds a lone sheet's zone again where an edit it could not vouch for ended it.
     fn renew_zone(&mut self) {
         if self.lone_sheet && self.zone.is_none() {
             self.zone = Zone::of_lone_sheet(self.mesh, self.settings.target_edge);
-            self.lone_sheet = self.zone.is_some();
         }
     }
 
