@@ -1,9 +1,10 @@
 //! A new layer from a closed stroke (sLayer, "Editing Tools": "draw a closed stroke onto a
 //! surface and create a new layer from it using discrete coons patches"): the outline is
 //! projected onto the layer it is drawn on and resampled at `L`, split into four sides at its
-//! sharpest corners (or evenly, where it has none), filled with a discrete Coons patch,
-//! the patch's points projected onto the surface, and the whole lifted off it like a
-//! duplicate: along the normals, clear of everything, remeshed to `L`, checked exactly.
+//! sharpest corners (or evenly, where it has none), filled with a discrete Coons patch laid out
+//! as a triangular lattice (`Layout`), the patch's points projected onto the surface, and the
+//! whole lifted off it like a duplicate: along the normals, clear of everything, remeshed to
+//! `L`, checked exactly.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -417,8 +418,8 @@ fn along(samples: &[Vec3], t: f32) -> Vec3 {
 }
 
 /// The grid's rows stitched into strips of triangles (each step along the shorter of the two
-/// diagonals it could take: in the lattice's middle, the row whose next point comes first), as a one-layer mesh facing the way the surface under
-/// it faces (`surface_normal` at a point).
+/// diagonals it could take: in the lattice's middle, the row whose next point comes first), as
+/// a one-layer mesh facing the way the surface under it faces (`surface_normal` at a point).
 fn triangulate(
     positions: Vec<Vec3>,
     grid: &Grid,
