@@ -41,10 +41,12 @@ impl Remesher<'_> {
                 Some((ids, at))
             })
             .collect();
-        // The rim stays as it is unless a rim vertex moves or is merged away.
+        // The rim stays as it is unless a rim vertex moves or is merged away (asked only
+        // where a zone could vouch: a stroke's remesh has none).
         let rim = |w: u32| self.mesh.is_boundary_vertex(w);
-        let keeps_rim =
-            merged.is_none_or(|m| !rim(m)) && (!rim(v) || positions[v as usize] == target);
+        let keeps_rim = self.zone.is_some()
+            && merged.is_none_or(|m| !rim(m))
+            && (!rim(v) || positions[v as usize] == target);
         self.unless_vouched(&moved, keeps_rim, |remesher| {
             remesher.move_checks(v, (target, merged), &carrying, &moved)
         })

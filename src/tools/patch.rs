@@ -179,9 +179,8 @@ fn bad(why: &str) -> ToolError {
 
 /// The outline closed and resampled at about `edge`, without repeating its first point.
 fn closed_ring(points: &[Vec3], edge: f32) -> Result<Vec<Vec3>, ToolError> {
-    let perimeter: f32 = points.windows(2).map(|w| w[0].distance(w[1])).sum();
     let gap = points[0].distance(points[points.len() - 1]);
-    if gap > (CLOSING_SHARE * perimeter).max(2.0 * edge) {
+    if gap > (CLOSING_SHARE * length(points)).max(2.0 * edge) {
         return Err(bad(&format!(
             "it is not closed (its ends are {:.1} edges apart)",
             gap / edge
@@ -189,14 +188,14 @@ fn closed_ring(points: &[Vec3], edge: f32) -> Result<Vec<Vec3>, ToolError> {
     }
     let mut closed = points.to_vec();
     closed.push(points[0]);
-    let length = perimeter + gap;
-    if length < 8.0 * edge {
+    let around = perimeter(points);
+    if around < 8.0 * edge {
         return Err(bad(&format!(
             "it is too short ({:.1} edges around; a patch needs at least 8 for four sides)",
-            length / edge
+            around / edge
         )));
     }
-    let count = (length / edge).round() as usize;
+    let count = (around / edge).round() as usize;
     let mut ring = resample(&closed, count);
     ring.pop();
     Ok(ring)
@@ -427,11 +426,11 @@ fn triangulate(
     surface_normal: impl Fn(Vec3) -> Vec3,
 ) -> Result<Mesh, ToolError> {
     let mut faces = Vec::with_capacity(2 * positions.len());
+    let d2 = |i: usize, j: usize| positions[i].distance_squared(positions[j]);
     for rows in grid.row_starts.windows(3) {
         let (lower, upper) = (rows[0]..rows[1], rows[1]..rows[2]);
         let (mut a, mut b) = (lower.start, upper.start);
         while a + 1 < lower.end || b + 1 < upper.end {
-            let d2 = |i: usize, j: usize| positions[i].distance_squared(positions[j]);
             let lower_first =
                 b + 1 == upper.end || (a + 1 < lower.end && d2(a + 1, b) <= d2(a, b + 1));
             if lower_first {
