@@ -45,7 +45,7 @@ pub fn plan_patch(
         })
         .collect::<Result<_, _>>()?;
     let facing = |p: Vec3| on_layer.normal(mesh, p);
-    let stretch = rim_stretch(&closed_ring(&projected, edge)?, &facing, settings.offset);
+    let stretch = rim_stretch(&closed_ring(&projected, edge)?, facing, settings.offset);
     let lay_out = |layout: Layout| {
         let spacing = match layout {
             Layout::Lattice => edge / stretch,
