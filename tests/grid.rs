@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3};
 use proptest::prelude::*;
-use slayer::geom::{Ray, point_triangle_distance_squared, ray_triangle};
+use slayer::collide::LocalFaceGrid;
+use slayer::geom::{Aabb, Ray, point_triangle_distance_squared, ray_triangle};
 use slayer::grid::SpatialHash;
 use slayer::mesh::Mesh;
 use slayer::scene::shapes;
@@ -218,4 +219,37 @@ fn picking_from_above_hits_the_top_layer() {
         grid.first_hit(mesh.positions(), mesh.faces(), &csr, &miss, 1.5)
             .is_none()
     );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The dense grid's one-visit walk meets each face filed near a query once: the faces
+    /// every cell the query covers holds, less repeats.
+    #[test]
+    fn each_face_near_a_query_is_met_once(
+        boxes in prop::collection::vec((vec3(4.0), vec3(1.0)), 1..60),
+        query in (vec3(5.0), vec3(2.0)),
+        cell in 0.2f32..2.0,
+    ) {
+        let boxes: Vec<Aabb> = boxes
+            .iter()
+            .map(|&(at, size)| Aabb::of_points(&[at, at + size.abs()]))
+            .collect();
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.including_box(b));
+        let mut grid = LocalFaceGrid::default();
+        grid.build(&boxes, bounds, cell);
+        let query = Aabb::of_points(&[query.0, query.0 + query.1.abs()]);
+        let mut every = Vec::new();
+        grid.for_each_candidate(&query, |f| every.push(f));
+        every.sort_unstable();
+        every.dedup();
+        let mut once = Vec::new();
+        grid.for_each_face_once(&query, &boxes, |f| once.push(f));
+        let met = once.len();
+        once.sort_unstable();
+        once.dedup();
+        prop_assert_eq!(met, once.len(), "a face met twice");
+        prop_assert_eq!(once, every);
+    }
 }

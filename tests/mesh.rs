@@ -191,6 +191,60 @@ fn killing_faces_that_pinch_a_vertex_is_reported() {
     );
 }
 
+/// Faces copied out of a mesh take their table from it: the table (or the error) must be the
+/// one built afresh from the copy's faces, for selections that leave whole fans, cut fans and
+/// pinched vertices (two fans of the selection meeting at one vertex).
+#[test]
+fn faces_copied_out_have_the_table_a_fresh_build_gives() {
+    let (mut tables, mut refusals) = (0, 0);
+    for (name, mesh) in kinds() {
+        let faces = mesh.face_count() as u32;
+        let selections: [Vec<u32>; 4] = [
+            (0..faces).collect(),
+            (0..faces).filter(|f| f % 2 == 0).collect(),
+            (0..faces).filter(|f| f % 3 != 1).rev().collect(),
+            (0..faces / 2).collect(),
+        ];
+        for selection in selections.iter().filter(|s| !s.is_empty()) {
+            let copied = mesh.extract_faces(selection, "piece");
+            let tris: Vec<[u32; 3]> = {
+                let mut order = Vec::new();
+                let mut new = vec![INVALID; mesh.vertex_count()];
+                selection
+                    .iter()
+                    .map(|&f| {
+                        mesh.faces()[f as usize].map(|v| {
+                            if new[v as usize] == INVALID {
+                                new[v as usize] = order.len() as u32;
+                                order.push(v);
+                            }
+                            new[v as usize]
+                        })
+                    })
+                    .collect()
+            };
+            let count = tris.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+            let built = one_layer(points(count), tris);
+            match (&copied, &built) {
+                (Ok((piece, _)), Ok(fresh)) => {
+                    assert_eq!(piece.adjacency(), fresh.adjacency(), "{name}");
+                    piece.validate().unwrap();
+                    tables += 1;
+                }
+                (Err(a), Err(b)) => {
+                    assert_eq!(a, b, "{name}");
+                    refusals += 1;
+                }
+                _ => panic!("{name}: copied {copied:?}, built {built:?}"),
+            }
+        }
+    }
+    assert!(
+        tables > 20 && refusals > 0,
+        "{tables} tables, {refusals} refusals"
+    );
+}
+
 fn one_layer(positions: Vec<Vec3>, faces: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
     let layers = vec![0; faces.len()];
     Mesh::new(positions, faces, layers, vec!["l".into()])

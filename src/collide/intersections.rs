@@ -15,7 +15,7 @@ use glam::{I64Vec3, Vec3};
 use rayon::prelude::*;
 
 use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
-use crate::mesh::{INVALID, Mesh};
+use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// A face spanning more cells than this is tested against every face instead of being filed
 /// (only absurd input has such faces; it keeps the broad phase bounded).
@@ -80,10 +80,15 @@ fn find_intersections_within(mesh: &Mesh, region: Option<&Aabb>) -> Intersection
     let cells = Cells {
         size: broad_phase_cell_size(&boxes, &usable),
     };
-    let (entries, oversized) = file_in_cells(&boxes, &usable, &cells);
+    let filing = file_in_cells(&boxes, &usable, &cells);
     let pairs = PairTest { mesh };
-    let mut found = pairs_in_cells(&entries, &boxes, &cells, &pairs);
-    found.extend(pairs_with_oversized(&oversized, &boxes, &usable, &pairs));
+    let mut found = pairs_in_cells(&filing, &boxes, &pairs);
+    found.extend(pairs_with_oversized(
+        &filing.oversized,
+        &boxes,
+        &usable,
+        &pairs,
+    ));
     found.par_sort_unstable();
     let layers = mesh.face_layers();
     let (mut folded_neighbours, mut between_layers) = (0, 0);
@@ -146,41 +151,62 @@ impl Cells {
     }
 }
 
-/// Every usable face filed in the cells its box overlaps, as (cell key, face) entries sorted by
-/// cell; and the faces whose boxes span more than [`MAX_CELLS_PER_FACE`] cells, filed nowhere.
-fn file_in_cells(boxes: &[Aabb], usable: &[bool], cells: &Cells) -> (Vec<(u64, u32)>, Vec<u32>) {
-    type Filing = (Vec<(u64, u32)>, Option<u32>);
-    let (filed, oversized): (Vec<_>, Vec<_>) = boxes
+/// The broad phase's filing: every usable face in the cells its box overlaps, and where each
+/// face's box begins.
+struct Filing {
+    /// (cell key, face) for every cell a face's box overlaps, sorted by cell.
+    entries: Vec<(u64, u32)>,
+    /// The cell holding each face's box's lowest corner.
+    lowest: Vec<I64Vec3>,
+    /// The faces whose boxes span more than [`MAX_CELLS_PER_FACE`] cells, filed nowhere.
+    oversized: Vec<u32>,
+}
+
+fn file_in_cells(boxes: &[Aabb], usable: &[bool], cells: &Cells) -> Filing {
+    let spans: Vec<(I64Vec3, I64Vec3)> = boxes
         .par_iter()
-        .enumerate()
-        .filter(|(f, _)| usable[*f])
-        .map(|(f, b)| {
-            let (lo, hi) = (cells.of(b.min), cells.of(b.max));
-            let span = hi - lo + I64Vec3::ONE;
-            if span.x * span.y * span.z > MAX_CELLS_PER_FACE {
-                return (Vec::new(), Some(f as u32));
-            }
-            let mut entries = Vec::with_capacity((span.x * span.y * span.z) as usize);
-            for z in lo.z..=hi.z {
-                for y in lo.y..=hi.y {
-                    for x in lo.x..=hi.x {
-                        entries.push((Cells::key(I64Vec3::new(x, y, z)), f as u32));
-                    }
-                }
-            }
-            (entries, None)
+        .map(|b| (cells.of(b.min), cells.of(b.max)))
+        .collect();
+    let filed = |f: usize| {
+        let (lo, hi) = spans[f];
+        let span = hi - lo + I64Vec3::ONE;
+        usable[f] && span.x * span.y * span.z <= MAX_CELLS_PER_FACE
+    };
+    let oversized = (0..boxes.len())
+        .filter(|&f| usable[f] && !filed(f))
+        .map(|f| f as u32)
+        .collect();
+    let mut entries: Vec<(u64, u32)> = (0..boxes.len())
+        .into_par_iter()
+        .filter(|&f| filed(f))
+        .flat_map_iter(|f| {
+            let (lo, hi) = spans[f];
+            (lo.z..=hi.z).flat_map(move |z| {
+                (lo.y..=hi.y).flat_map(move |y| {
+                    (lo.x..=hi.x).map(move |x| (Cells::key(I64Vec3::new(x, y, z)), f as u32))
+                })
+            })
         })
-        .collect::<Vec<Filing>>()
-        .into_iter()
-        .unzip();
-    let mut entries: Vec<(u64, u32)> = filed.into_iter().flatten().collect();
+        .collect();
     entries.par_sort_unstable();
-    (entries, oversized.into_iter().flatten().collect())
+    Filing {
+        entries,
+        lowest: spans.into_iter().map(|(lo, _)| lo).collect(),
+        oversized,
+    }
 }
 
 /// The narrow phase of one pair of faces.
 struct PairTest<'a> {
     mesh: &'a Mesh,
+}
+
+/// What the narrow phase reads of one face, gathered once for all its pairs in a cell.
+struct Face {
+    index: u32,
+    ids: [u32; 3],
+    corners: [Vec3; 3],
+    layer: LayerId,
 }
 
 impl PairTest<'_> {
@@ -191,32 +217,37 @@ impl PairTest<'_> {
             .any(|v| faces[b as usize].contains(v))
     }
 
+    fn face(&self, f: u32) -> Face {
+        Face {
+            index: f,
+            ids: self.mesh.faces()[f as usize],
+            corners: self.mesh.face_positions(f as usize),
+            layer: self.mesh.face_layers()[f as usize],
+        }
+    }
+
+    fn intersect(&self, a: u32, b: u32) -> bool {
+        Self::faces_intersect(&self.face(a), &self.face(b))
+    }
+
     /// Neighbours by [`neighbours_overlap`]; faces of different layers by
     /// [`seam_pair_intersects`]; the rest by [`triangles_intersect`].
-    fn intersect(&self, a: u32, b: u32) -> bool {
-        let (faces, layers) = (self.mesh.faces(), self.mesh.face_layers());
-        let (ta, tb) = (
-            self.mesh.face_positions(a as usize),
-            self.mesh.face_positions(b as usize),
-        );
-        if self.shares_vertex(a, b) {
-            return neighbours_overlap(ta, faces[a as usize], tb, faces[b as usize]);
+    fn faces_intersect(a: &Face, b: &Face) -> bool {
+        if a.ids.iter().any(|v| b.ids.contains(v)) {
+            return neighbours_overlap(a.corners, a.ids, b.corners, b.ids);
         }
-        if layers[a as usize] != layers[b as usize] {
-            return seam_pair_intersects(ta, faces[a as usize], tb, faces[b as usize]);
+        if a.layer != b.layer {
+            return seam_pair_intersects(a.corners, a.ids, b.corners, b.ids);
         }
-        triangles_intersect(ta, tb)
+        triangles_intersect(a.corners, b.corners)
     }
 }
 
 /// The intersecting pairs among the faces filed in each cell, each pair tested only in the
-/// cell of the lowest corner of its two boxes' overlap.
-fn pairs_in_cells(
-    entries: &[(u64, u32)],
-    boxes: &[Aabb],
-    cells: &Cells,
-    pairs: &PairTest<'_>,
-) -> Vec<IntersectingPair> {
+/// cell of the lowest corner of its two boxes' overlap: the higher, on each axis, of the cells
+/// their lowest corners lie in (the cell of a point only grows with the point).
+fn pairs_in_cells(filing: &Filing, boxes: &[Aabb], pairs: &PairTest<'_>) -> Vec<IntersectingPair> {
+    let entries = &filing.entries;
     let mut group_starts: Vec<usize> = (0..entries.len())
         .into_par_iter()
         .filter(|&i| i == 0 || entries[i].0 != entries[i - 1].0)
@@ -227,17 +258,24 @@ fn pairs_in_cells(
         .flat_map_iter(|w| {
             let group = &entries[w[0]..w[1]];
             let cell_key = group[0].0;
+            if group.len() < 2 {
+                return Vec::new();
+            }
+            // Each face's box, first cell and corners read once here, not once a pair.
+            let near: Vec<(Aabb, I64Vec3, Face)> = group
+                .iter()
+                .map(|&(_, f)| (boxes[f as usize], filing.lowest[f as usize], pairs.face(f)))
+                .collect();
             let mut found = Vec::new();
-            for (i, &(_, a)) in group.iter().enumerate() {
-                for &(_, b) in &group[i + 1..] {
-                    let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                    if !ba.overlaps(bb) || Cells::key(cells.of(ba.min.max(bb.min))) != cell_key {
+            for (i, (box_a, lowest_a, a)) in near.iter().enumerate() {
+                for (box_b, lowest_b, b) in &near[i + 1..] {
+                    if !box_a.overlaps(box_b) || Cells::key(lowest_a.max(*lowest_b)) != cell_key {
                         continue;
                     }
-                    if pairs.intersect(a, b) {
+                    if PairTest::faces_intersect(a, b) {
                         found.push(IntersectingPair {
-                            face_a: a.min(b),
-                            face_b: a.max(b),
+                            face_a: a.index.min(b.index),
+                            face_b: a.index.max(b.index),
                         });
                     }
                 }

@@ -99,6 +99,23 @@ impl LocalFaceGrid {
         });
     }
 
+    /// Calls `f` once with every local face filed in a cell overlapping `query` (`boxes` the
+    /// boxes the grid was built from): a face is taken only in the lowest cell that both its
+    /// box and the query cover, with no list to sort and deduplicate.
+    pub fn for_each_face_once(&self, query: &Aabb, boxes: &[Aabb], mut f: impl FnMut(u32)) {
+        if self.offsets.is_empty() {
+            return;
+        }
+        let span = self.cell_span(query);
+        self.for_each_cell(span, |c, at| {
+            for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                if self.cell_span(&boxes[e as usize]).0.max(span.0) == at {
+                    f(e);
+                }
+            }
+        });
+    }
+
     /// Calls `f` with the index and coordinates of every cell of `span`.
     pub fn for_each_cell(&self, (lo, hi): (IVec3, IVec3), mut f: impl FnMut(usize, IVec3)) {
         if self.offsets.is_empty() {

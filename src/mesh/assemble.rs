@@ -2,7 +2,9 @@
 //! appended as new layers, faces and layers removed. The layer tools (`crate::tools`) are built
 //! on these; each keeps the mesh manifold because layers never share a vertex.
 
-use super::{INVALID, LayerId, Mesh, MeshError, VertexFlags};
+use glam::Vec3;
+
+use super::{Brdf, CornerTable, INVALID, LayerId, Mesh, MeshError, MeshVersion, VertexFlags};
 
 impl Mesh {
     /// The live faces in `faces` as a one-layer mesh named `name`, with their BRDFs, and for
@@ -10,6 +12,9 @@ impl Mesh {
     /// not make a manifold surface on their own (two fans of the selection meeting at one
     /// vertex), naming the vertex of the copy.
     pub fn extract_faces(&self, faces: &[u32], name: &str) -> Result<(Mesh, Vec<u32>), MeshError> {
+        // The new index of each face kept; a face named twice is left to `Mesh::new` to refuse.
+        let mut kept = vec![INVALID; self.face_count()];
+        let mut named_twice = false;
         let mut new_vertex = vec![INVALID; self.vertex_count()];
         let mut sources = Vec::new();
         let mut tris = Vec::with_capacity(faces.len());
@@ -17,6 +22,8 @@ impl Mesh {
             if self.is_face_dead(f as usize) {
                 continue;
             }
+            named_twice |= kept[f as usize] != INVALID;
+            kept[f as usize] = tris.len() as u32;
             tris.push(self.faces[f as usize].map(|v| {
                 if new_vertex[v as usize] == INVALID {
                     new_vertex[v as usize] = sources.len() as u32;
@@ -25,14 +32,45 @@ impl Mesh {
                 new_vertex[v as usize]
             }));
         }
-        let positions = sources
+        let positions: Vec<Vec3> = sources
             .iter()
             .map(|&v| self.positions[v as usize])
             .collect();
         let layers = vec![0; tris.len()];
-        let mut piece = Mesh::new(positions, tris, layers, vec![name.to_string()])?;
+        let mut piece = if named_twice {
+            Mesh::new(positions, tris, layers, vec![name.to_string()])?
+        } else {
+            let adjacency = self.adjacency.restricted(&kept, &tris, sources.len())?;
+            Mesh::with_table(positions, (tris, layers), adjacency, name)
+        };
         piece.set_brdfs(sources.iter().map(|&v| self.brdfs[v as usize]).collect())?;
         Ok((piece, sources))
+    }
+
+    /// A one-layer mesh from faces whose table is known good (every vertex used, no repeated
+    /// index: faces taken from a valid mesh).
+    fn with_table(
+        positions: Vec<Vec3>,
+        (faces, face_layers): (Vec<[u32; 3]>, Vec<LayerId>),
+        adjacency: CornerTable,
+        name: &str,
+    ) -> Mesh {
+        let vertex_count = positions.len();
+        let mut mesh = Mesh {
+            normals: vec![Vec3::Z; vertex_count],
+            brdfs: vec![Brdf::CLAY; vertex_count],
+            flags: vec![VertexFlags::empty(); vertex_count],
+            vertex_layers: vec![0; vertex_count],
+            positions,
+            faces,
+            face_layers,
+            adjacency,
+            layer_names: vec![name.to_string()],
+            version: MeshVersion::fresh(),
+        };
+        mesh.recompute_normals();
+        mesh.reserve_for_edits();
+        mesh
     }
 
     /// Appends every live face and vertex of `piece` as new layers after the last (named as

@@ -145,6 +145,34 @@ impl CornerTable {
         Ok(table)
     }
 
+    /// The table of some of this table's faces, renumbered: `kept[f]` is the new index of
+    /// face `f` (or `INVALID`), `faces` the kept faces' new vertices, corner for corner. Opposite
+    /// corners carry over where both faces are kept (a manifold table has one answer, so this is
+    /// the table [`CornerTable::build`] would make); each vertex's fan is then checked as it
+    /// does, since dropping faces can leave two fans at one vertex.
+    pub fn restricted(
+        &self,
+        kept: &[u32],
+        faces: &[[u32; 3]],
+        vertex_count: usize,
+    ) -> Result<Self, MeshError> {
+        let mut opposite = vec![INVALID; faces.len() * 3];
+        for (old, &new) in kept.iter().enumerate().filter(|(_, new)| **new != INVALID) {
+            for k in 0..3 {
+                let o = self.opposite[3 * old + k];
+                if o != INVALID && kept[face_of(o) as usize] != INVALID {
+                    opposite[3 * new as usize + k] = 3 * kept[face_of(o) as usize] + o % 3;
+                }
+            }
+        }
+        let mut table = CornerTable {
+            opposite,
+            vertex_corner: vec![INVALID; vertex_count],
+        };
+        table.assign_vertex_corners(faces)?;
+        Ok(table)
+    }
+
     /// Picks each vertex's corner (the start of its fan on a boundary) and checks that every
     /// vertex has exactly one fan.
     fn assign_vertex_corners(&mut self, faces: &[[u32; 3]]) -> Result<(), MeshError> {

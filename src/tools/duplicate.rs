@@ -16,7 +16,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::obstacles::Obstacles;
+use super::obstacles::{Obstacles, Passing};
 use super::select::{Selection, selected_faces};
 use super::shell::thicken;
 use super::{ToolError, check_length};
@@ -178,33 +178,86 @@ pub(super) fn check_settings(mesh: &Mesh, settings: &DuplicateSettings) -> Resul
 
 /// How far each vertex of `piece` can be lifted along its normal, up to `total`, and the
 /// layer that stopped it (its own source layer where nothing did).
+///
+/// The walk goes in steps of `d/4` and stops before the first step that comes within `d` of
+/// another layer, or within a step of its own layer's surface ahead (a groove's far wall).
 fn lift_all(
     piece: &Mesh,
     obstacles: &Obstacles,
     source: LayerId,
     (total, d): (f32, f32),
 ) -> Vec<(f32, LayerId)> {
-    let step = d / 4.0;
-    let steps = (total / step).ceil() as usize;
+    let walk = Walk {
+        step: d / 4.0,
+        steps: (total / (d / 4.0)).ceil() as usize,
+        total,
+        d,
+        source,
+    };
     (0..piece.vertex_count())
         .into_par_iter()
-        .map(|v| {
-            let (start, normal) = (piece.positions()[v], piece.normals()[v]);
-            let mut lift = (0.0, source);
-            for k in 1..=steps {
-                let t = (k as f32 * step).min(total);
-                let p = start + normal * t;
-                if let Some((layer, _)) = obstacles.nearest_within(p, d, |l| l != source) {
-                    return (lift.0, layer);
-                }
-                if obstacles.own_surface_ahead(p, start, step, source) {
-                    return lift;
-                }
-                lift.0 = t;
-            }
-            lift
+        .map_init(Vec::new, |passing, v| {
+            walk.lift(
+                obstacles,
+                (piece.positions()[v], piece.normals()[v]),
+                passing,
+            )
         })
         .collect()
+}
+
+/// One vertex's walk off its surface ([`lift_all`]).
+struct Walk {
+    step: f32,
+    steps: usize,
+    total: f32,
+    d: f32,
+    source: LayerId,
+}
+
+impl Walk {
+    fn at(&self, k: usize) -> f32 {
+        (k as f32 * self.step).min(self.total)
+    }
+
+    /// The lift from `start` along `normal`, and what stopped it.
+    fn lift(
+        &self,
+        obstacles: &Obstacles,
+        (start, normal): (Vec3, Vec3),
+        passing: &mut Vec<Passing>,
+    ) -> (f32, LayerId) {
+        let source = self.source;
+        let reach = |layer| if layer == source { self.step } else { self.d };
+        let span = (self.at(1), self.total);
+        obstacles.passing((start, normal), span, (reach, self.d), passing);
+        // Each face is tried only at the steps within its reach, up to the first step found
+        // so far that stops the walk: that step, over all faces, is where the walk stops.
+        let mut stop = self.steps + 1;
+        for near in passing.iter() {
+            let first = ((near.from / self.step).floor() as usize).max(1);
+            let last = ((near.to / self.step).ceil() as usize).min(stop - 1);
+            for k in first..=last {
+                let p = start + normal * self.at(k);
+                let stops = if near.layer == source {
+                    obstacles.ahead(near.face, p, start, self.step)
+                } else {
+                    obstacles.distance_within(near.face, p, self.d).is_some()
+                };
+                if stops {
+                    stop = k;
+                    break;
+                }
+            }
+        }
+        if stop > self.steps {
+            return (self.at(self.steps), source);
+        }
+        let lift = if stop == 1 { 0.0 } else { self.at(stop - 1) };
+        let p = start + normal * self.at(stop);
+        let other = obstacles.nearest_passing(passing, (p, self.d), |l| l != source);
+        (lift, other.map_or(source, |(layer, _)| layer))
+    }
 }
 
 /// The lifted sheet thickened if asked, remeshed (where that keeps it clear), painted, and
@@ -267,4 +320,75 @@ fn check_clear(piece: &Mesh, obstacles: &Obstacles, d: f32) -> Result<(), ToolEr
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{SceneKind, SceneSpec, generate};
+
+    /// The walk as first written: every step asks the grid for the nearest face of another
+    /// layer and tries every face of its own.
+    fn lift_step_by_step(
+        obstacles: &Obstacles,
+        (start, normal): (Vec3, Vec3),
+        source: LayerId,
+        (total, d): (f32, f32),
+    ) -> (f32, LayerId) {
+        let step = d / 4.0;
+        let mut lift = (0.0, source);
+        for k in 1..=(total / step).ceil() as usize {
+            let t = (k as f32 * step).min(total);
+            let p = start + normal * t;
+            if let Some((layer, _)) = obstacles.nearest_within(p, d, |l| l != source) {
+                return (lift.0, layer);
+            }
+            let mut own = (0..obstacles.len() as u32).filter(|&i| obstacles.layer(i) == source);
+            if own.any(|i| obstacles.ahead(i, p, start, step)) {
+                return lift;
+            }
+            lift.0 = t;
+        }
+        lift
+    }
+
+    /// Each material's layers lifted far enough that many walks stop on another layer or on
+    /// the far wall of a groove: every lift and every stopper as step by step.
+    #[test]
+    fn each_walk_stops_where_a_step_by_step_walk_does() {
+        let (mut by_other, mut by_own) = (0, 0);
+        for kind in [SceneKind::Plaster, SceneKind::Bark, SceneKind::Metal] {
+            let spec = SceneSpec {
+                kind,
+                triangles: 5_000,
+                seed: 3,
+            };
+            let mesh = generate(&spec).unwrap();
+            let edge = mesh.mean_edge_length();
+            let (lo, hi) = mesh.bounds().unwrap();
+            let region = Aabb::of_points(&[lo, hi]).expanded(edge);
+            let obstacles = Obstacles::near(&mesh, region, 1.5 * edge);
+            for source in 0..mesh.layer_count() as LayerId {
+                let layer: Vec<u32> = (0..mesh.face_count() as u32)
+                    .filter(|&f| mesh.face_layers()[f as usize] == source)
+                    .collect();
+                let (piece, _) = mesh.extract_faces(&layer, "piece").unwrap();
+                let reach = (6.0 * edge, edge);
+                let lifts = lift_all(&piece, &obstacles, source, reach);
+                for (v, &(lift, stopper)) in lifts.iter().enumerate() {
+                    let walk = (piece.positions()[v], piece.normals()[v]);
+                    let expected = lift_step_by_step(&obstacles, walk, source, reach);
+                    assert_eq!(
+                        (lift, stopper),
+                        expected,
+                        "{kind:?}, layer {source}, vertex {v}"
+                    );
+                    by_other += usize::from(stopper != source);
+                    by_own += usize::from(stopper == source && lift < reach.0);
+                }
+            }
+        }
+        let stops = format!("{by_other} stopped by another layer, {by_own} by their own");
+        assert!(by_other > 1000 && by_own > 50, "{stops}");
+    }
 }

@@ -10,6 +10,16 @@ use crate::geom::{
 };
 use crate::mesh::{LayerId, Mesh};
 
+/// A face that a walk along a line passes near ([`Obstacles::passing`]): its index here,
+/// its layer, and the stretch of the line's parameter within reach of its box.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Passing {
+    pub face: u32,
+    pub layer: LayerId,
+    pub from: f32,
+    pub to: f32,
+}
+
 /// The live faces of a mesh whose boxes meet a region.
 pub(super) struct Obstacles {
     /// The mesh's index of each face here.
@@ -23,26 +33,25 @@ pub(super) struct Obstacles {
 impl Obstacles {
     /// The faces of `mesh` whose boxes meet `region`, in a grid of cell `cell`.
     pub(super) fn near(mesh: &Mesh, region: Aabb, cell: f32) -> Obstacles {
+        let (faces, boxes): (Vec<u32>, Vec<Aabb>) = (0..mesh.face_count())
+            .into_par_iter()
+            .filter(|&f| !mesh.is_face_dead(f))
+            .map(|f| (f as u32, Aabb::of_points(&mesh.face_positions(f))))
+            .filter(|(_, b)| b.overlaps(&region))
+            .unzip();
         let mut obstacles = Obstacles {
-            faces: Vec::new(),
-            triangles: Vec::new(),
-            layers: Vec::new(),
-            boxes: Vec::new(),
+            triangles: faces
+                .par_iter()
+                .map(|&f| mesh.face_positions(f as usize))
+                .collect(),
+            layers: faces
+                .iter()
+                .map(|&f| mesh.face_layers()[f as usize])
+                .collect(),
+            faces,
+            boxes,
             grid: LocalFaceGrid::default(),
         };
-        for f in 0..mesh.face_count() {
-            if mesh.is_face_dead(f) {
-                continue;
-            }
-            let tri = mesh.face_positions(f);
-            let b = Aabb::of_points(&tri);
-            if b.overlaps(&region) {
-                obstacles.faces.push(f as u32);
-                obstacles.triangles.push(tri);
-                obstacles.layers.push(mesh.face_layers()[f]);
-                obstacles.boxes.push(b);
-            }
-        }
         let bounds = obstacles
             .boxes
             .iter()
@@ -62,18 +71,116 @@ impl Obstacles {
         counts: impl Fn(LayerId) -> bool,
     ) -> Option<(LayerId, f32)> {
         let query = Aabb::of_points(&[p]).expanded(reach);
-        let mut best: Option<(LayerId, f32)> = None;
+        let mut best = None;
         self.grid.for_each_candidate(&query, |i| {
-            let i = i as usize;
-            if !counts(self.layers[i]) || !self.boxes[i].within(p, reach) {
-                return;
-            }
-            let [a, b, c] = self.triangles[i];
-            let d2 = point_triangle_distance_squared(p, a, b, c);
-            if d2 < reach * reach && best.is_none_or(|(_, d)| d2 < d * d) {
-                best = Some((self.layers[i], d2.sqrt()));
+            self.keep_nearer(&mut best, i, (p, reach), &counts);
+        });
+        best
+    }
+
+    /// The faces here whose boxes come within `reach(layer)` of the segment `start + dir·t`,
+    /// `t` in `span`, each once, into `passing`, with the stretch of `t` where the line does
+    /// (`widest`: the largest reach). Every query of a walk along the segment then reads
+    /// these few, with no grid.
+    pub(super) fn passing(
+        &self,
+        (start, dir): (Vec3, Vec3),
+        span: (f32, f32),
+        (reach, widest): (impl Fn(LayerId) -> f32, f32),
+        passing: &mut Vec<Passing>,
+    ) {
+        passing.clear();
+        let ends = [start + dir * span.0, start + dir * span.1];
+        let region = Aabb::of_points(&ends).expanded(widest);
+        let layer = LayerId::MAX;
+        self.grid.for_each_face_once(&region, &self.boxes, |face| {
+            if self.boxes[face as usize].overlaps(&region) {
+                passing.push(Passing {
+                    face,
+                    layer,
+                    from: 0.0,
+                    to: 0.0,
+                });
             }
         });
+        // Slack for the rounding of the slab test's divisions, relative to the coordinates.
+        let slack = 1e-6 * region.min.abs().max(region.max.abs()).max_element();
+        passing.retain_mut(|near| {
+            near.layer = self.layers[near.face as usize];
+            let grown = self.boxes[near.face as usize].expanded(reach(near.layer) * 1.001 + slack);
+            match stretch_through(&grown, (start, dir)) {
+                Some((from, to)) if from <= span.1 && to >= span.0 => {
+                    (near.from, near.to) = (from, to);
+                    true
+                }
+                _ => false,
+            }
+        });
+    }
+
+    /// How many faces are here.
+    #[cfg(test)]
+    pub(super) fn len(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Face `i`'s layer.
+    #[cfg(test)]
+    pub(super) fn layer(&self, i: u32) -> LayerId {
+        self.layers[i as usize]
+    }
+
+    /// Face `i`'s distance from `p`, where it is within `reach`.
+    pub(super) fn distance_within(&self, i: u32, p: Vec3, reach: f32) -> Option<f32> {
+        let i = i as usize;
+        if !self.boxes[i].within(p, reach) {
+            return None;
+        }
+        let [a, b, c] = self.triangles[i];
+        let d2 = point_triangle_distance_squared(p, a, b, c);
+        (d2 < reach * reach).then(|| d2.sqrt())
+    }
+
+    /// Whether face `i` lies within `reach` of `p` and nearer to `p` than to `start`: the
+    /// surface ahead of a point walking away from `start` (a groove's far wall), not the one
+    /// it left (whose faces around `start` are nearer to `start`).
+    pub(super) fn ahead(&self, i: u32, p: Vec3, start: Vec3, reach: f32) -> bool {
+        let [a, b, c] = self.triangles[i as usize];
+        self.distance_within(i, p, reach)
+            .is_some_and(|d| d * d < point_triangle_distance_squared(start, a, b, c))
+    }
+
+    /// Makes `best` face `i` where it lies nearer to `p` than `best`, within `reach`, and of a
+    /// layer `counts` lets in.
+    fn keep_nearer(
+        &self,
+        best: &mut Option<(LayerId, f32)>,
+        i: u32,
+        (p, reach): (Vec3, f32),
+        counts: &impl Fn(LayerId) -> bool,
+    ) {
+        let layer = self.layers[i as usize];
+        if !counts(layer) {
+            return;
+        }
+        if let Some(d) = self.distance_within(i, p, reach)
+            && best.is_none_or(|(_, nearest)| d < nearest)
+        {
+            *best = Some((layer, d));
+        }
+    }
+
+    /// [`Obstacles::nearest_within`] among the faces `passing` names.
+    pub(super) fn nearest_passing(
+        &self,
+        passing: &[Passing],
+        (p, reach): (Vec3, f32),
+        counts: impl Fn(LayerId) -> bool,
+    ) -> Option<(LayerId, f32)> {
+        let mut best = None;
+        for near in passing {
+            self.keep_nearer(&mut best, near.face, (p, reach), &counts);
+        }
         best
     }
 
@@ -97,28 +204,6 @@ impl Obstacles {
         best.map(|(f, q, _)| (f, q))
     }
 
-    /// Whether a face of `layer` lies within `reach` of `p` and nearer to `p` than to
-    /// `start`: the surface ahead of a point walking away from `start` (a groove's far wall),
-    /// not the one it left (whose faces around `start` are nearer to `start`).
-    pub(super) fn own_surface_ahead(
-        &self,
-        p: Vec3,
-        start: Vec3,
-        reach: f32,
-        layer: LayerId,
-    ) -> bool {
-        let query = Aabb::of_points(&[p]).expanded(reach);
-        self.grid.any_candidate(&query, |i| {
-            let i = i as usize;
-            if self.layers[i] != layer || !self.boxes[i].within(p, reach) {
-                return false;
-            }
-            let [a, b, c] = self.triangles[i];
-            let d2 = point_triangle_distance_squared(p, a, b, c);
-            d2 < reach * reach && d2 < point_triangle_distance_squared(start, a, b, c)
-        })
-    }
-
     /// How many pairs of one of `triangles` and a face here intersect (exact test).
     pub(super) fn intersecting_pairs(&self, triangles: &[[Vec3; 3]]) -> usize {
         triangles
@@ -138,4 +223,23 @@ impl Obstacles {
             })
             .sum()
     }
+}
+
+/// Where the line `start + dir·t` runs through `bounds`: the `t` where it enters and leaves
+/// (a slab test), or `None`.
+fn stretch_through(bounds: &Aabb, (start, dir): (Vec3, Vec3)) -> Option<(f32, f32)> {
+    let (mut from, mut to) = (f32::NEG_INFINITY, f32::INFINITY);
+    for axis in 0..3 {
+        let (lo, hi, s) = (bounds.min[axis], bounds.max[axis], start[axis]);
+        if dir[axis] == 0.0 {
+            if s < lo || s > hi {
+                return None;
+            }
+            continue;
+        }
+        let (a, b) = ((lo - s) / dir[axis], (hi - s) / dir[axis]);
+        from = from.max(a.min(b));
+        to = to.min(a.max(b));
+    }
+    (from <= to).then_some((from, to))
 }
