@@ -132,13 +132,7 @@ impl Obstacles {
 
     /// Face `i`'s distance from `p`, where it is within `reach`.
     pub(super) fn distance_within(&self, i: u32, p: Vec3, reach: f32) -> Option<f32> {
-        let i = i as usize;
-        if !self.boxes[i].within(p, reach) {
-            return None;
-        }
-        let [a, b, c] = self.triangles[i];
-        let d2 = point_triangle_distance_squared(p, a, b, c);
-        (d2 < reach * reach).then(|| d2.sqrt())
+        self.distance_squared_within(i, p, reach).map(f32::sqrt)
     }
 
     /// Whether face `i` lies within `reach` of `p` and nearer to `p` than to `start`: the
@@ -146,8 +140,18 @@ impl Obstacles {
     /// it left (whose faces around `start` are nearer to `start`).
     pub(super) fn ahead(&self, i: u32, p: Vec3, start: Vec3, reach: f32) -> bool {
         let [a, b, c] = self.triangles[i as usize];
-        self.distance_within(i, p, reach)
-            .is_some_and(|d| d * d < point_triangle_distance_squared(start, a, b, c))
+        self.distance_squared_within(i, p, reach)
+            .is_some_and(|d2| d2 < point_triangle_distance_squared(start, a, b, c))
+    }
+
+    fn distance_squared_within(&self, i: u32, p: Vec3, reach: f32) -> Option<f32> {
+        let i = i as usize;
+        if !self.boxes[i].within(p, reach) {
+            return None;
+        }
+        let [a, b, c] = self.triangles[i];
+        let d2 = point_triangle_distance_squared(p, a, b, c);
+        (d2 < reach * reach).then_some(d2)
     }
 
     /// Makes `best` face `i` where it lies nearer to `p` than `best`, within `reach`, and of a
