@@ -212,9 +212,7 @@ struct Face {
 impl PairTest<'_> {
     fn shares_vertex(&self, a: u32, b: u32) -> bool {
         let faces = self.mesh.faces();
-        faces[a as usize]
-            .iter()
-            .any(|v| faces[b as usize].contains(v))
+        share_a_vertex(faces[a as usize], faces[b as usize])
     }
 
     fn face(&self, f: u32) -> Face {
@@ -233,7 +231,7 @@ impl PairTest<'_> {
     /// Neighbours by [`neighbours_overlap`]; faces of different layers by
     /// [`seam_pair_intersects`]; the rest by [`triangles_intersect`].
     fn faces_intersect(a: &Face, b: &Face) -> bool {
-        if a.ids.iter().any(|v| b.ids.contains(v)) {
+        if share_a_vertex(a.ids, b.ids) {
             return neighbours_overlap(a.corners, a.ids, b.corners, b.ids);
         }
         if a.layer != b.layer {
@@ -241,6 +239,10 @@ impl PairTest<'_> {
         }
         triangles_intersect(a.corners, b.corners)
     }
+}
+
+fn share_a_vertex(a: [u32; 3], b: [u32; 3]) -> bool {
+    a.iter().any(|v| b.contains(v))
 }
 
 /// The intersecting pairs among the faces filed in each cell, each pair tested only in the

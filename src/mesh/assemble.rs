@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::{Brdf, CornerTable, INVALID, LayerId, Mesh, MeshError, MeshVersion, VertexFlags};
+use super::{INVALID, LayerId, Mesh, MeshError, VertexFlags};
 
 impl Mesh {
     /// The live faces in `faces` as a one-layer mesh named `name`, with their BRDFs, and for
@@ -40,37 +40,14 @@ impl Mesh {
         let mut piece = if named_twice {
             Mesh::new(positions, tris, layers, vec![name.to_string()])?
         } else {
+            // Faces of a valid mesh: every vertex used, no index repeated, one layer.
             let adjacency = self.adjacency.restricted(&kept, &tris, sources.len())?;
-            Mesh::with_table(positions, (tris, layers), adjacency, name)
+            let vertex_layers = vec![0; sources.len()];
+            let names = vec![name.to_string()];
+            Mesh::from_checked((positions, vertex_layers), (tris, layers), adjacency, names)
         };
         piece.set_brdfs(sources.iter().map(|&v| self.brdfs[v as usize]).collect())?;
         Ok((piece, sources))
-    }
-
-    /// A one-layer mesh from faces whose table is known good (every vertex used, no repeated
-    /// index: faces taken from a valid mesh).
-    fn with_table(
-        positions: Vec<Vec3>,
-        (faces, face_layers): (Vec<[u32; 3]>, Vec<LayerId>),
-        adjacency: CornerTable,
-        name: &str,
-    ) -> Mesh {
-        let vertex_count = positions.len();
-        let mut mesh = Mesh {
-            normals: vec![Vec3::Z; vertex_count],
-            brdfs: vec![Brdf::CLAY; vertex_count],
-            flags: vec![VertexFlags::empty(); vertex_count],
-            vertex_layers: vec![0; vertex_count],
-            positions,
-            faces,
-            face_layers,
-            adjacency,
-            layer_names: vec![name.to_string()],
-            version: MeshVersion::fresh(),
-        };
-        mesh.recompute_normals();
-        mesh.reserve_for_edits();
-        mesh
     }
 
     /// Appends every live face and vertex of `piece` as new layers after the last (named as

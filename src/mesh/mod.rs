@@ -175,6 +175,23 @@ impl Mesh {
             return Err(MeshError::IsolatedVertex { vertex: v as u32 });
         }
         let adjacency = CornerTable::build(&faces, vertex_count)?;
+        Ok(Mesh::from_checked(
+            (positions, vertex_layers),
+            (faces, face_layers),
+            adjacency,
+            layer_names,
+        ))
+    }
+
+    /// A mesh from parts already checked as [`Mesh::new`] checks them, with their table:
+    /// BRDFs [`Brdf::CLAY`], normals computed.
+    fn from_checked(
+        (positions, vertex_layers): (Vec<Vec3>, Vec<LayerId>),
+        (faces, face_layers): (Vec<[u32; 3]>, Vec<LayerId>),
+        adjacency: CornerTable,
+        layer_names: Vec<String>,
+    ) -> Mesh {
+        let vertex_count = positions.len();
         let mut mesh = Mesh {
             normals: vec![Vec3::Z; vertex_count],
             brdfs: vec![Brdf::CLAY; vertex_count],
@@ -189,7 +206,7 @@ impl Mesh {
         };
         mesh.recompute_normals();
         mesh.reserve_for_edits();
-        Ok(mesh)
+        mesh
     }
 
     // ---- sizes and plain data -------------------------------------------------------------

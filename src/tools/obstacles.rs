@@ -92,28 +92,22 @@ impl Obstacles {
         passing.clear();
         let ends = [start + dir * span.0, start + dir * span.1];
         let region = Aabb::of_points(&ends).expanded(widest);
-        let layer = LayerId::MAX;
+        // Slack for the rounding of the slab test's divisions, relative to the coordinates.
+        let slack = 1e-6 * region.min.abs().max(region.max.abs()).max_element();
         self.grid.for_each_face_once(&region, &self.boxes, |face| {
-            if self.boxes[face as usize].overlaps(&region) {
+            let (bounds, layer) = (&self.boxes[face as usize], self.layers[face as usize]);
+            if !bounds.overlaps(&region) {
+                return;
+            }
+            let grown = bounds.expanded(reach(layer) * 1.001 + slack);
+            let stretch = stretch_through(&grown, (start, dir));
+            if let Some((from, to)) = stretch.filter(|&(from, to)| from <= span.1 && to >= span.0) {
                 passing.push(Passing {
                     face,
                     layer,
-                    from: 0.0,
-                    to: 0.0,
+                    from,
+                    to,
                 });
-            }
-        });
-        // Slack for the rounding of the slab test's divisions, relative to the coordinates.
-        let slack = 1e-6 * region.min.abs().max(region.max.abs()).max_element();
-        passing.retain_mut(|near| {
-            near.layer = self.layers[near.face as usize];
-            let grown = self.boxes[near.face as usize].expanded(reach(near.layer) * 1.001 + slack);
-            match stretch_through(&grown, (start, dir)) {
-                Some((from, to)) if from <= span.1 && to >= span.0 => {
-                    (near.from, near.to) = (from, to);
-                    true
-                }
-                _ => false,
             }
         });
     }
@@ -212,18 +206,16 @@ impl Obstacles {
     pub(super) fn intersecting_pairs(&self, triangles: &[[Vec3; 3]]) -> usize {
         triangles
             .par_iter()
-            .map_init(Vec::new, |seen: &mut Vec<u32>, tri| {
+            .map(|tri| {
                 let b = Aabb::of_points(tri);
-                seen.clear();
-                self.grid.for_each_candidate(&b, |i| seen.push(i));
-                seen.sort_unstable();
-                seen.dedup();
-                seen.iter()
-                    .filter(|&&i| {
-                        self.boxes[i as usize].overlaps(&b)
-                            && triangles_intersect(*tri, self.triangles[i as usize])
-                    })
-                    .count()
+                let mut crossing = 0;
+                self.grid.for_each_face_once(&b, &self.boxes, |i| {
+                    let i = i as usize;
+                    crossing += usize::from(
+                        self.boxes[i].overlaps(&b) && triangles_intersect(*tri, self.triangles[i]),
+                    );
+                });
+                crossing
             })
             .sum()
     }
