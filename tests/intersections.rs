@@ -146,6 +146,27 @@ proptest! {
     }
 }
 
+/// Sheets crumpled in all three directions, from gently to past folding: the count, which skips
+/// the pairs around vertices whose fans project one-to-one, equals all pairs tested one by one.
+/// Both flat fans and folds onto neighbours must occur, or the comparison proves little.
+#[test]
+fn crumpled_sheets_count_as_all_pairs_do() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(48);
+    let mut folded = 0;
+    for case in 0..60 {
+        let mut mesh = shapes::stacked_sheets(2, 7, 7, 1.0, 1.0);
+        let amplitude = 0.6 * case as f32 / 60.0;
+        for p in mesh.positions_mut() {
+            *p += Vec3::from_array([(); 3].map(|_| rng.random_range(-amplitude..=amplitude)));
+        }
+        let (found, all_pairs) = (counts(&mesh), brute_force(&mesh));
+        assert_eq!(found, all_pairs, "case {case}, amplitude {amplitude}");
+        folded += found.2;
+    }
+    assert!(folded > 20, "only {folded} folded neighbours over the cases");
+}
+
 #[test]
 fn a_layer_pushed_through_another_is_counted() {
     let mut mesh = shapes::stacked_sheets(2, 8, 8, 1.0, 1.0);

@@ -6,7 +6,10 @@
 //! tested once. Narrow phase: [`triangles_intersect`] on exact predicates. Pairs that share a
 //! vertex touch there by construction: they count, apart, only where they meet beyond what they
 //! share ([`neighbours_overlap`]: a face folded onto its neighbour, which twist, pinch, crease
-//! and flips can make and the pair test alone cannot see). Faces of different layers that meet
+//! and flips can make and the pair test alone cannot see). Most such pairs are settled before
+//! that, a vertex at a time: where the faces around a shared vertex project one-to-one onto a
+//! plane ([`fan_projects_one_to_one`]), no two of them meet beyond what they share, so the
+//! pairs around it are not tested at all. Faces of different layers that meet
 //! only at vertex positions they share (a surface split into OBJ groups, welded by position
 //! along the seam) are not crossing either: they count only where they meet beyond those
 //! points ([`neighbours_overlap`]).
@@ -14,7 +17,7 @@
 use glam::{I64Vec3, Vec3};
 use rayon::prelude::*;
 
-use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
+use crate::geom::{Aabb, fan_projects_one_to_one, neighbours_overlap, triangles_intersect};
 use crate::mesh::{INVALID, LayerId, Mesh};
 
 /// A face spanning more cells than this is tested against every face instead of being filed
@@ -81,7 +84,10 @@ fn find_intersections_within(mesh: &Mesh, region: Option<&Aabb>) -> Intersection
         size: broad_phase_cell_size(&boxes, &usable),
     };
     let filing = file_in_cells(&boxes, &usable, &cells);
-    let pairs = PairTest { mesh };
+    let pairs = PairTest {
+        mesh,
+        settled: settled_vertices(mesh, &usable),
+    };
     let mut found = pairs_in_cells(&filing, &boxes, &pairs);
     found.extend(pairs_with_oversized(
         &filing.oversized,
@@ -196,9 +202,41 @@ fn file_in_cells(boxes: &[Aabb], usable: &[bool], cells: &Cells) -> Filing {
     }
 }
 
+/// Per vertex of a face to be tested: whether the faces around it meet only where they share
+/// (their fan projects one-to-one onto a plane), so that no pair sharing it needs a test.
+fn settled_vertices(mesh: &Mesh, usable: &[bool]) -> Vec<bool> {
+    let mut needed = vec![false; mesh.vertex_count()];
+    for (t, _) in mesh.faces().iter().zip(usable).filter(|(_, ok)| **ok) {
+        for &v in t {
+            needed[v as usize] = true;
+        }
+    }
+    let positions = mesh.positions();
+    needed
+        .par_iter()
+        .enumerate()
+        .map(|(v, &needed)| {
+            let v = v as u32;
+            let mut ring = [Vec3::ZERO; 32];
+            let mut count = 0;
+            for q in mesh.ring(v) {
+                if !needed || count == ring.len() {
+                    return false;
+                }
+                ring[count] = positions[q as usize];
+                count += 1;
+            }
+            let closed = !mesh.is_boundary_vertex(v);
+            needed && fan_projects_one_to_one(positions[v as usize], &ring[..count], closed)
+        })
+        .collect()
+}
+
 /// The narrow phase of one pair of faces.
 struct PairTest<'a> {
     mesh: &'a Mesh,
+    /// Per vertex, from [`settled_vertices`].
+    settled: Vec<bool>,
 }
 
 /// What the narrow phase reads of one face, gathered once for all its pairs in a cell.
@@ -207,6 +245,15 @@ struct Face {
     ids: [u32; 3],
     corners: [Vec3; 3],
     layer: LayerId,
+    /// Per corner: whether its vertex's faces meet only where they share.
+    settled: [bool; 3],
+}
+
+impl Face {
+    /// Whether the two faces share a settled vertex, and so meet only where they share.
+    fn meet_only_where_shared(&self, other: &Face) -> bool {
+        (0..3).any(|i| self.settled[i] && other.ids.contains(&self.ids[i]))
+    }
 }
 
 impl PairTest<'_> {
@@ -216,11 +263,13 @@ impl PairTest<'_> {
     }
 
     fn face(&self, f: u32) -> Face {
+        let ids = self.mesh.faces()[f as usize];
         Face {
             index: f,
-            ids: self.mesh.faces()[f as usize],
+            ids,
             corners: self.mesh.face_positions(f as usize),
             layer: self.mesh.face_layers()[f as usize],
+            settled: ids.map(|v| self.settled[v as usize]),
         }
     }
 
@@ -271,7 +320,10 @@ fn pairs_in_cells(filing: &Filing, boxes: &[Aabb], pairs: &PairTest<'_>) -> Vec<
             let mut found = Vec::new();
             for (i, (box_a, lowest_a, a)) in near.iter().enumerate() {
                 for (box_b, lowest_b, b) in &near[i + 1..] {
-                    if !box_a.overlaps(box_b) || Cells::key(lowest_a.max(*lowest_b)) != cell_key {
+                    if !box_a.overlaps(box_b)
+                        || a.meet_only_where_shared(b)
+                        || Cells::key(lowest_a.max(*lowest_b)) != cell_key
+                    {
                         continue;
                     }
                     if PairTest::faces_intersect(a, b) {

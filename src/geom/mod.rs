@@ -3,6 +3,7 @@
 //! triangle–triangle intersection test on Shewchuk's adaptive predicates.
 
 mod closest_point;
+mod fan;
 mod order_free;
 mod ray;
 mod separation;
@@ -11,6 +12,7 @@ mod tri_tri;
 pub use closest_point::{
     closest_point_on_triangle, point_triangle_distance, point_triangle_distance_squared,
 };
+pub use fan::fan_projects_one_to_one;
 pub use order_free::{corner_cross, fan_normal, order_free_sum};
 pub use ray::{Ray, ray_triangle};
 pub use separation::surely_disjoint;
