@@ -71,11 +71,17 @@ enum IntegerSum {
 /// The terms' sum in integers. Integer addition is associative, so the order of the terms does
 /// not matter, and a reflection (negated components) reflects the sum exactly.
 fn integer_sum<I: Iterator<Item = Vec3>>(terms: impl Fn() -> I) -> IntegerSum {
+    // A fan's terms are kept from the first pass, so the second reads them instead of
+    // computing them again; only a fan longer than this computes them twice.
+    let mut kept = [Vec3::ZERO; 16];
     let mut largest = 0.0f32;
     let mut count = 0u32;
     for term in terms() {
         if !term.is_finite() {
             return IntegerSum::NotFinite;
+        }
+        if let Some(slot) = kept.get_mut(count as usize) {
+            *slot = term;
         }
         largest = largest.max(term.abs().max_element());
         count += 1;
@@ -88,9 +94,16 @@ fn integer_sum<I: Iterator<Item = Vec3>>(terms: impl Fn() -> I) -> IntegerSum {
     let above = (largest.to_bits() >> 23) as i32 - 126;
     let bits = TERM_BITS.min(31 - ceil_log2(count)) as i32;
     let exponent = bits - above;
+    // `as` casts truncate toward zero, and every scaled term is finite and within i32.
     let mut sum = IVec3::ZERO;
-    for term in terms() {
-        sum += scaled(term, exponent).trunc().as_ivec3();
+    if count as usize <= kept.len() {
+        for &term in &kept[..count as usize] {
+            sum += scaled(term, exponent).as_ivec3();
+        }
+    } else {
+        for term in terms() {
+            sum += scaled(term, exponent).as_ivec3();
+        }
     }
     IntegerSum::Sum(sum, exponent)
 }
