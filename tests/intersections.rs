@@ -164,7 +164,10 @@ fn crumpled_sheets_count_as_all_pairs_do() {
         assert_eq!(found, all_pairs, "case {case}, amplitude {amplitude}");
         folded += found.2;
     }
-    assert!(folded > 20, "only {folded} folded neighbours over the cases");
+    assert!(
+        folded > 20,
+        "only {folded} folded neighbours over the cases"
+    );
 }
 
 #[test]

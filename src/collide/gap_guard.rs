@@ -36,6 +36,9 @@ pub(super) fn undo_gap_violations(
         .zip(before)
         .map(|((v, _), p)| mesh.positions()[*v as usize].distance(*p))
         .fold(0.0f32, f32::max);
+    if alone_in_region(state, region, mesh, (selection, before), drift) {
+        return 0;
+    }
     // The first round tests the faces around the whole selection: what moved, and what the
     // clamp or the backstop stopped or put back (a face there may now be where a moving vertex
     // was not clamped against). Later rounds test around what is still moved (an undo can
@@ -87,6 +90,48 @@ pub(super) fn undo_gap_violations(
         undone += back.len();
         went_back = back;
     }
+}
+
+/// Whether the first round would find no vertex of another layer to test, known without
+/// listing the faces around the selection: when the region holds every vertex the round could
+/// test and all of them are of one layer, that round finds nothing and there is no other.
+///
+/// The round's query ([`other_layers_near`]) is the box of the faces around the selection,
+/// grown by `d` and the drift. Their corners are the selection, where it started or is now,
+/// and still neighbours, each within an edge of a selected vertex's start: every edge was at
+/// most `max_edge` long when the step began. So the box of the starts and the positions now,
+/// grown by `max_edge` (and a margin for rounding), holds that box.
+fn alone_in_region(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    (selection, before): (&[(u32, f32)], &[Vec3]),
+    drift: f32,
+) -> bool {
+    let Some(&(first, _)) = selection.first() else {
+        return false;
+    };
+    let layers = mesh.vertex_layers();
+    let layer = layers[first as usize];
+    if !state.cull
+        || region
+            .vertices()
+            .iter()
+            .any(|&y| layers[y as usize] != layer)
+    {
+        return false;
+    }
+    let positions = mesh.positions();
+    let now = selection.iter().map(|&(v, _)| positions[v as usize]);
+    let corners = before
+        .iter()
+        .copied()
+        .chain(now)
+        .fold(Aabb::EMPTY, |b, p| b.including(p));
+    let scale = corners.min.abs().max(corners.max.abs()).max_element();
+    let edge = state.max_edge * 1.001 + 4.0 * f32::EPSILON * scale;
+    let near = corners.expanded(edge).expanded(state.collision_distance);
+    region.covers(&near.expanded(drift))
 }
 
 /// The vertices of other layers that face `f` (around a vertex that moved or went back) is now
@@ -198,4 +243,72 @@ fn other_layers_near(
         grid.build(&points, bounds, d);
     }
     Some(OtherLayers { vertices, grid })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::SpatialHash;
+    use crate::scene::shapes;
+
+    /// Two sheets `gap` apart, a patch of the lower one lifted a little: whether the guard's
+    /// first round is skipped, and what that round would have had to test.
+    fn skip_and_round(gap: f32) -> (bool, Option<usize>) {
+        let mesh = shapes::stacked_sheets(2, 16, 16, 1.0, gap);
+        let grid = SpatialHash::build(&mesh, 1.0).unwrap();
+        let active = vec![true; mesh.layer_count()];
+        let state = StrokeState {
+            grid: Some(&grid),
+            active: &active,
+            parallel: false,
+            collision_distance: 0.5,
+            ring: 1,
+            max_edge: mesh.longest_edge() * 1.1,
+            cull: true,
+        };
+        let selection: Vec<(u32, f32)> = [7 * 17 + 7, 7 * 17 + 8, 8 * 17 + 7, 8 * 17 + 8]
+            .iter()
+            .map(|&v| (v, 1.0))
+            .collect();
+        let before: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| mesh.positions()[v as usize])
+            .collect();
+        let targets: Vec<Vec3> = before.iter().map(|p| *p + Vec3::Z * 0.2).collect();
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        for (slot, &(v, _)) in selection.iter().enumerate() {
+            target_of[v as usize] = slot as u32;
+        }
+        let mut region = Region::default();
+        region.size_for(&mesh);
+        region.gather(&state, &mesh, &selection, &targets, &target_of);
+        let mut moved = mesh.clone();
+        for (&(v, _), &q) in selection.iter().zip(&targets) {
+            moved.positions_mut()[v as usize] = q;
+        }
+        let skip = alone_in_region(&state, &region, &moved, (&selection, &before), 0.2);
+        let faces = region.faces_around_once(&moved, selection.iter().map(|&(v, _)| v));
+        let round = other_layers_near(&state, &region, &moved, &faces, 0.2);
+        (skip, round.map(|near| near.vertices.len()))
+    }
+
+    /// The skip is taken only where the round would have found no vertex of another layer in
+    /// a region that holds its query, and it is taken once the other sheet is out of reach.
+    #[test]
+    fn the_first_round_is_skipped_only_where_it_would_find_nothing() {
+        let (mut skipped, mut searched) = (0, 0);
+        for tenth in 5..80 {
+            let (skip, round) = skip_and_round(tenth as f32 / 10.0);
+            if skip {
+                assert_eq!(round, Some(0), "gap {}", tenth as f32 / 10.0);
+                skipped += 1;
+            } else {
+                searched += 1;
+            }
+        }
+        assert!(
+            skipped > 10 && searched > 10,
+            "{skipped} skipped, {searched} searched"
+        );
+    }
 }

@@ -400,10 +400,12 @@ pub(super) fn longest_edge_at(mesh: &Mesh, vertices: &[u32]) -> f32 {
             mesh.adjacency()
                 .corners_around(v)
                 .flat_map(|c| [next(c), prev(c)])
-                .map(|c| p.distance(positions[mesh.corner_vertex(c) as usize]))
+                .map(|c| p.distance_squared(positions[mesh.corner_vertex(c) as usize]))
                 .fold(0.0f32, f32::max)
         })
         .reduce(|| 0.0, f32::max)
+        // One root for all: a correctly rounded root keeps the order, so the same length.
+        .sqrt()
 }
 
 pub(super) fn millis(since: Instant) -> f64 {
