@@ -217,17 +217,9 @@ fn settled_vertices(mesh: &Mesh, usable: &[bool]) -> Vec<bool> {
         .enumerate()
         .map(|(v, &needed)| {
             let v = v as u32;
-            let mut ring = [Vec3::ZERO; 32];
-            let mut count = 0;
-            for q in mesh.ring(v) {
-                if !needed || count == ring.len() {
-                    return false;
-                }
-                ring[count] = positions[q as usize];
-                count += 1;
-            }
+            let ring = mesh.ring(v).map(|q| positions[q as usize]);
             let closed = !mesh.is_boundary_vertex(v);
-            needed && fan_projects_one_to_one(positions[v as usize], &ring[..count], closed)
+            needed && fan_projects_one_to_one(positions[v as usize], ring, closed)
         })
         .collect()
 }

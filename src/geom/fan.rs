@@ -12,8 +12,9 @@ const MAX_RING: usize = 32;
 const MARGIN: f64 = 1e-12;
 
 /// True only when the fan of triangles around `centre` projects one-to-one onto a coordinate
-/// plane. `ring` holds the far corners in fan order: face `i` has corners `centre`, `ring[i]`
-/// and `ring[i + 1]`, and a `closed` fan has the face of the last and the first too.
+/// plane. `ring` yields the far corners in fan order: face `i` has corners `centre`, `ring[i]`
+/// and `ring[i + 1]`, and a `closed` fan has the face of the last and the first too. A ring
+/// longer than `MAX_RING` (32) is not looked at.
 ///
 /// Why that settles every pair in the fan: two faces whose projections overlap only at
 /// `centre` or along the projection of a shared edge meet only there, since a triangle whose
@@ -24,16 +25,24 @@ const MARGIN: f64 = 1e-12;
 /// side of the first ray each later ray lies on (left, straight behind, right), which may only
 /// move on: a ray back on the left would be a wrap. Closed, the last face then adds less than
 /// half a turn to less than one, and a closed fan's turns add up to whole turns: exactly one.
-pub fn fan_projects_one_to_one(centre: Vec3, ring: &[Vec3], closed: bool) -> bool {
-    let n = ring.len();
-    let faces = if closed { n } else { n.saturating_sub(1) };
-    if n > MAX_RING || faces < if closed { 3 } else { 1 } {
-        return false;
-    }
+pub fn fan_projects_one_to_one(
+    centre: Vec3,
+    ring: impl IntoIterator<Item = Vec3>,
+    closed: bool,
+) -> bool {
     let centre = centre.as_dvec3();
     let mut rays = [DVec3::ZERO; MAX_RING];
-    for (ray, q) in rays.iter_mut().zip(ring) {
+    let mut n = 0;
+    for q in ring {
+        let Some(ray) = rays.get_mut(n) else {
+            return false;
+        };
         *ray = q.as_dvec3() - centre;
+        n += 1;
+    }
+    let faces = if closed { n } else { n.saturating_sub(1) };
+    if faces < if closed { 3 } else { 1 } {
+        return false;
     }
     let rays = &rays[..n];
     if !centre.is_finite() || !rays.iter().all(|r| r.is_finite()) {
@@ -131,22 +140,30 @@ mod tests {
         for count in [3, 6, 9] {
             assert!(fan_projects_one_to_one(
                 Vec3::ZERO,
-                &regular_ring(count, 1.0, 0.0),
+                regular_ring(count, 1.0, 0.0),
                 true
             ));
             assert!(fan_projects_one_to_one(
                 Vec3::ZERO,
-                &regular_ring(count, 1.0, 3.0),
+                regular_ring(count, 1.0, 3.0),
                 true
             ));
         }
         // Seven rays two turns round: every face turns left, yet the fan covers the plane twice.
         let twice = regular_ring(7, 2.0, 0.0);
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &twice, true));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            twice.iter().copied(),
+            true
+        ));
         assert!(some_pair_overlaps(Vec3::ZERO, &twice, true));
         // Open: a boundary vertex's half fan, straight rays at both ends, is certified.
         let half: Vec<Vec3> = regular_ring(6, 1.0, 0.0)[..4].to_vec();
-        assert!(fan_projects_one_to_one(Vec3::ZERO, &half, false));
+        assert!(fan_projects_one_to_one(
+            Vec3::ZERO,
+            half.iter().copied(),
+            false
+        ));
     }
 
     #[test]
@@ -154,21 +171,41 @@ mod tests {
         // The last face comes back over the first: an open fan of more than one turn.
         let mut ring = regular_ring(6, 1.0, 0.0);
         ring.push(Vec3::new(1.0, 0.5, 0.0));
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &ring, false));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            ring.iter().copied(),
+            false
+        ));
         assert!(some_pair_overlaps(Vec3::ZERO, &ring, false));
         // A face flipped over (turning the other way), and a degenerate one.
         let mut flipped = regular_ring(6, 1.0, 0.0);
         flipped.swap(2, 3);
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &flipped, true));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            flipped.iter().copied(),
+            true
+        ));
         let mut degenerate = regular_ring(6, 1.0, 0.0);
         degenerate[2] = Vec3::ZERO;
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &degenerate, true));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            degenerate.iter().copied(),
+            true
+        ));
         // A face seen edge-on from the axis: its projection has no area, so the proof is void.
         let mut edge_on = regular_ring(6, 1.0, 0.0);
         edge_on[3] = edge_on[2] * 2.0 + Vec3::Z;
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &edge_on, true));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            edge_on.iter().copied(),
+            true
+        ));
         let not_finite = [Vec3::X, Vec3::Y, Vec3::new(f32::NAN, 0.0, 0.0)];
-        assert!(!fan_projects_one_to_one(Vec3::ZERO, &not_finite, true));
+        assert!(!fan_projects_one_to_one(
+            Vec3::ZERO,
+            not_finite.iter().copied(),
+            true
+        ));
     }
 
     /// A certified fan has no overlapping pair, over 20,000 random fans: regular rings jittered
@@ -198,7 +235,7 @@ mod tests {
                 })
                 .collect();
             let overlaps = some_pair_overlaps(Vec3::ZERO, &ring, closed);
-            if fan_projects_one_to_one(Vec3::ZERO, &ring, closed) {
+            if fan_projects_one_to_one(Vec3::ZERO, ring.iter().copied(), closed) {
                 assert!(
                     !overlaps,
                     "certified, yet a pair overlaps: {ring:?}, closed {closed}"
