@@ -22,21 +22,10 @@ pub fn smallest_layer_gap(mesh: &Mesh, reach: f32) -> Result<Option<f32>, GridEr
     }
     let positions = mesh.positions();
     let (vertex_layers, face_layers) = (mesh.vertex_layers(), mesh.face_layers());
-    // Every live face with finite corners, its box filed in a grid of cell `reach`: a face
-    // within `reach` of a point has its box within `reach` of it, so a query of the point's
-    // box grown by `reach` meets it, once.
-    let faces: Vec<u32> = (0..mesh.face_count() as u32)
-        .filter(|&f| {
-            !mesh.is_face_dead(f as usize)
-                && mesh.faces()[f as usize]
-                    .iter()
-                    .all(|&v| positions[v as usize].is_finite())
-        })
-        .collect();
-    let boxes: Vec<Aabb> = faces
-        .par_iter()
-        .map(|&f| Aabb::of_points(&mesh.face_positions(f as usize)))
-        .collect();
+    // Every live face with finite corners (`usable`), its box filed in a grid of cell
+    // `reach`: a face within `reach` of a point has its box within `reach` of it, so a query
+    // of the point's box grown by `reach` meets it, once.
+    let (usable, boxes) = super::intersections::face_boxes(mesh);
     let bounds = boxes.iter().fold(Aabb::EMPTY, |b, f| b.including_box(f));
     let mut grid = LocalFaceGrid::default();
     grid.build(&boxes, bounds, reach);
@@ -51,10 +40,11 @@ pub fn smallest_layer_gap(mesh: &Mesh, reach: f32) -> Result<Option<f32>, GridEr
             let grow = reach * (1.0 + 1e-4) + 4.0 * f32::EPSILON * p.abs().max_element();
             let query = Aabb::of_points(&[p]).expanded(grow);
             let mut nearest = f32::INFINITY;
-            grid.for_each_face_once(&query, &boxes, |i| {
-                let f = faces[i as usize] as usize;
-                if face_layers[f] == vertex_layers[v]
-                    || boxes[i as usize].distance_squared_to(p) > nearest.min(r2)
+            grid.for_each_face_once(&query, &boxes, |f| {
+                let f = f as usize;
+                if !usable[f]
+                    || face_layers[f] == vertex_layers[v]
+                    || boxes[f].distance_squared_to(p) > nearest.min(r2)
                 {
                     return;
                 }

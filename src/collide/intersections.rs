@@ -115,7 +115,7 @@ fn find_intersections_within(mesh: &Mesh, region: Option<&Aabb>) -> Intersection
 }
 
 /// Which faces can be tested (live, every corner finite), and their boxes (empty where not).
-fn face_boxes(mesh: &Mesh) -> (Vec<bool>, Vec<Aabb>) {
+pub(super) fn face_boxes(mesh: &Mesh) -> (Vec<bool>, Vec<Aabb>) {
     let positions = mesh.positions();
     let usable: Vec<bool> = mesh
         .faces()
