@@ -77,6 +77,8 @@ struct Active {
     captured: Option<Vec<(u32, f32)>>,
     /// What a mirrored grab's image caught at its first sample.
     captured_image: Option<Vec<(u32, f32)>>,
+    /// The long edges around a grab its last remesh between samples could not split.
+    left_long: remeshing::LeftLong,
     /// Per layer: whether a volume-keeping sweep holds its volume (it is closed); empty for
     /// other brushes.
     closed_layers: Vec<bool>,
@@ -150,6 +152,7 @@ impl<'a> StrokeInProgress<'a> {
                 samples_run: 0,
                 captured: None,
                 captured_image: None,
+                left_long: remeshing::LeftLong::default(),
                 closed_layers,
                 touched_list: Vec::new(),
                 remeshed: Vec::new(),

@@ -2,14 +2,13 @@
 //! between its samples where it stretched the surface), the fuse layers' topology pass after
 //! it, and the running bound on edge lengths both leave behind.
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use super::{Active, SamplesReport};
 use crate::mesh::Mesh;
 use crate::pipeline::Remeshing;
-use crate::pipeline::engine::{
-    fuse_touched, longest_edge, longest_edge_at, millis, remesh_touched,
-};
+use crate::pipeline::engine::{fuse_touched, longest_edge_at, millis, remesh_touched};
 use crate::pipeline::kernels::StepKernels;
 
 impl Active {
@@ -57,10 +56,9 @@ impl Active {
         moved: &[u32],
         call: &mut SamplesReport,
     ) {
-        let mut faces: Vec<u32> = moved.iter().flat_map(|&v| mesh.faces_around(v)).collect();
-        faces.sort_unstable();
-        faces.dedup();
-        if longest_edge(mesh, Some(&faces)) <= GRAB_STRETCH * self.lengths.edge {
+        let bound = GRAB_STRETCH * self.lengths.edge;
+        let faces = faces_around(mesh, moved.iter().copied());
+        if !self.left_long.any_due(mesh, &faces, bound) {
             return;
         }
         let first_new = mesh.vertex_count() as u32;
@@ -71,6 +69,9 @@ impl Active {
         {
             regrab(mesh, captured, first_new);
         }
+        let live = moved.iter().copied().filter(|&v| mesh.is_vertex_live(v));
+        let faces = faces_around(mesh, live.chain(first_new..mesh.vertex_count() as u32));
+        self.left_long.record(mesh, &faces, bound);
     }
 
     /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved, and
@@ -156,6 +157,72 @@ impl Active {
 /// once: the work stays local).
 const GRAB_STRETCH: f32 = 2.0;
 
+/// The live faces around `vertices`, ascending, each once.
+fn faces_around(mesh: &Mesh, vertices: impl Iterator<Item = u32>) -> Vec<u32> {
+    let mut faces: Vec<u32> = vertices.flat_map(|v| mesh.faces_around(v)).collect();
+    faces.sort_unstable();
+    faces.dedup();
+    faces
+}
+
+/// How much an edge that remeshing left over the stretch bound must grow before remeshing
+/// tries it again.
+const REGROWTH: f32 = 1.25;
+
+/// The edges around a grab that its last remesh left longer than the stretch bound (a split
+/// that would put a vertex within the collision distance of the needle's other side is
+/// refused), with their length then. Without it every later sample remeshed the grab's whole
+/// region again to refuse the same splits: a drag of 32 units spent 13.5 s refusing 369K
+/// edits. Such an edge is tried again once it has grown by [`REGROWTH`], so a needle drawn
+/// out evenly is retried a number of times logarithmic in its length.
+#[derive(Debug, Default)]
+pub(super) struct LeftLong {
+    lengths: HashMap<(u32, u32), f32>,
+}
+
+impl LeftLong {
+    /// Whether `faces` hold an edge over `bound` that the last remesh did not leave, or one
+    /// it left that has grown by [`REGROWTH`] since.
+    fn any_due(&self, mesh: &Mesh, faces: &[u32], bound: f32) -> bool {
+        let mut due = false;
+        for_each_long_edge(mesh, faces, bound, |edge, length| {
+            due |= self
+                .lengths
+                .get(&edge)
+                .is_none_or(|&was| length > was * REGROWTH);
+        });
+        due
+    }
+
+    /// Keeps the edges of `faces` over `bound`, as remeshing left them.
+    fn record(&mut self, mesh: &Mesh, faces: &[u32], bound: f32) {
+        self.lengths.clear();
+        for_each_long_edge(mesh, faces, bound, |edge, length| {
+            self.lengths.insert(edge, length);
+        });
+    }
+}
+
+/// Calls `found` with each edge of `faces` longer than `bound` (its ends in ascending order)
+/// and its length; an edge two faces share comes twice.
+fn for_each_long_edge(
+    mesh: &Mesh,
+    faces: &[u32],
+    bound: f32,
+    mut found: impl FnMut((u32, u32), f32),
+) {
+    let positions = mesh.positions();
+    for &f in faces {
+        let corners = mesh.faces()[f as usize];
+        for (a, b) in [(0, 1), (1, 2), (2, 0)].map(|(i, j)| (corners[i], corners[j])) {
+            let length = positions[a as usize].distance(positions[b as usize]);
+            if length > bound {
+                found((a.min(b), a.max(b)), length);
+            }
+        }
+    }
+}
+
 /// The grab's caught vertices after remeshing between its samples: those remeshing removed
 /// leave; each vertex it added (numbered from `first_new` on) joins with the smallest weight
 /// among its caught neighbours, and only when all its earlier neighbours were caught — so a
@@ -163,7 +230,6 @@ const GRAB_STRETCH: f32 = 2.0;
 /// extrudes instead of stretching every edge again), and none moves ahead of its
 /// neighbours. Deterministic: the new vertices are taken in index order.
 fn regrab(mesh: &Mesh, captured: &mut Vec<(u32, f32)>, first_new: u32) {
-    use std::collections::HashMap;
     captured.retain(|&(v, _)| !mesh.is_vertex_dead(v));
     let mut weight_of: HashMap<u32, f32> = captured.iter().copied().collect();
     for v in first_new..mesh.vertex_count() as u32 {
