@@ -5,6 +5,7 @@
 //! remeshes what the stroke touched. Feeding the samples one at a time or all at once runs the
 //! same samples through the same arithmetic, so the CPU backend's meshes are bit-identical.
 
+mod let_go;
 mod mirrored;
 mod remeshing;
 mod volume;
@@ -13,6 +14,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
+use self::let_go::LetGo;
 use super::engine::{Pipeline, Prepared, Scratch, longest_edge_at, millis};
 use super::kernels::{CallAt, Deformed, EngineVertices, FrameSource, SampleProbe, StepKernels};
 use super::step::{brush_frame, longest_move, paint, select_for_mask, steps_for};
@@ -77,6 +79,8 @@ struct Active {
     captured: Option<Vec<(u32, f32)>>,
     /// What a mirrored grab's image caught at its first sample.
     captured_image: Option<Vec<(u32, f32)>>,
+    /// What of it the grab has let go of: vertices collisions hold still.
+    let_go: LetGo,
     /// The long edges around a grab its last remesh between samples could not split.
     left_long: remeshing::LeftLong,
     /// Per layer: whether a volume-keeping sweep holds its volume (it is closed); empty for
@@ -152,6 +156,7 @@ impl<'a> StrokeInProgress<'a> {
                 samples_run: 0,
                 captured: None,
                 captured_image: None,
+                let_go: LetGo::default(),
                 left_long: remeshing::LeftLong::default(),
                 closed_layers,
                 touched_list: Vec::new(),
@@ -335,6 +340,20 @@ impl Active {
         }
     }
 
+    /// Whether the stroke is a grab that lets go of what collisions hold still (`let_go`):
+    /// not one that should press a fuse layer onto itself, whose contact joins it.
+    fn lets_go(&self) -> bool {
+        self.stroke.brush.kind == BrushKind::Grab && self.stroke.fuse.is_empty()
+    }
+
+    /// What a grab moves of what it `caught`: all of it, less what it let go of.
+    fn still_held(&self, caught: &[(u32, f32)]) -> Vec<(u32, f32)> {
+        match self.lets_go() {
+            true => self.let_go.still_held(caught),
+            false => caught.to_vec(),
+        }
+    }
+
     /// What a step reads that lasts for the stroke.
     fn state(&self) -> StrokeState<'_> {
         stroke_state(
@@ -447,10 +466,14 @@ impl Active {
         let probe = self.probe_at(sample, self.previous);
         self.previous = Some(sample.position);
         let kind = self.stroke.brush.kind;
-        let deformed = match (&self.captured, kind == BrushKind::Grab) {
-            (Some(held), true) => Deformed {
-                selection: held.clone(),
-                frame: brush_frame(mesh, held, &probe, sample.normal),
+        if self.lets_go() && self.captured.is_some() {
+            self.let_go.start_sample(probe.frame.motion);
+        }
+        let held = self.captured.as_ref().filter(|_| kind == BrushKind::Grab);
+        let deformed = match held.map(|caught| self.still_held(caught)) {
+            Some(held) => Deformed {
+                frame: brush_frame(mesh, &held, &probe, sample.normal),
+                selection: held,
                 targets: None,
                 deform_millis: 0.0,
             },
@@ -586,6 +609,14 @@ impl Active {
         );
         for &(v, _) in selection {
             target_of[v as usize] = INVALID;
+        }
+        if self.lets_go() {
+            let asked = selection.iter().zip(&before).zip(targets);
+            for (((&(v, _), p), target), q) in asked.zip(&outcome.positions) {
+                if p == q && p != target {
+                    self.let_go.held_still(v);
+                }
+            }
         }
         let moved: Vec<u32> = selection
             .iter()

@@ -36,6 +36,9 @@ impl Active {
         let started = Instant::now();
         let probe = self.probe_at(sample, self.previous);
         self.previous = Some(sample.position);
+        if self.lets_go() && self.captured.is_some() {
+            self.let_go.start_sample(probe.frame.motion);
+        }
         let image = image_dab(&probe, &mirror);
         let image_normal = sample.normal.map(|n| mirror.direction_image(n));
         let drawn = self.open_side(kernels, mesh, (probe, sample.normal), Side::Drawn);
@@ -72,10 +75,11 @@ impl Active {
             Side::Drawn => &self.captured,
             Side::Image => &self.captured_image,
         };
-        let deformed = match captured.as_ref().filter(|_| kind == BrushKind::Grab) {
+        let held = captured.as_ref().filter(|_| kind == BrushKind::Grab);
+        let deformed = match held.map(|caught| self.still_held(caught)) {
             Some(held) => Deformed {
-                selection: held.clone(),
-                frame: brush_frame(mesh, held, &probe, normal),
+                frame: brush_frame(mesh, &held, &probe, normal),
+                selection: held,
                 targets: None,
                 deform_millis: 0.0,
             },

@@ -72,6 +72,9 @@ impl Active {
         let live = moved.iter().copied().filter(|&v| mesh.is_vertex_live(v));
         let faces = faces_around(mesh, live.chain(first_new..mesh.vertex_count() as u32));
         self.left_long.record(mesh, &faces, bound);
+        if self.lets_go() {
+            self.let_go.let_go_of(self.left_long.ends());
+        }
     }
 
     /// After the stroke (as `remeshing` says): remeshes every vertex the stroke moved, and
@@ -193,6 +196,11 @@ impl LeftLong {
                 .is_none_or(|&was| length > was * REGROWTH);
         });
         due
+    }
+
+    /// The ends of the edges kept.
+    fn ends(&self) -> impl Iterator<Item = u32> + '_ {
+        self.lengths.keys().flat_map(|&(a, b)| [a, b])
     }
 
     /// Keeps the edges of `faces` over `bound`, as remeshing left them.
