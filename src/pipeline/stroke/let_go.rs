@@ -36,10 +36,11 @@ impl LetGo {
         self.this_sample.push(vertex);
     }
 
-    /// Vertices at edges that remeshing left stretched and could not split: let go at once,
-    /// since the grab would only draw their faces out into slivers (a drag of 64 units drew
-    /// faces 7 units long between vertices let go and those still moving, and each moving
-    /// face's box then covered the whole collision region).
+    /// Lets go of `vertices` at once, measuring the turn from the running sample's motion if
+    /// they are the first. The pipeline gives it the ends of edges that remeshing left
+    /// stretched and could not split: the grab would only draw their faces out into slivers
+    /// (a drag of 64 units drew faces 7 units long between vertices let go and those still
+    /// moving, and each moving face's box then covered the whole collision region).
     pub(super) fn let_go_of(&mut self, vertices: impl Iterator<Item = u32>) {
         if self.vertices.is_empty() {
             self.motion = self.running;
@@ -60,12 +61,7 @@ impl LetGo {
             .filter(|v| self.last_sample.binary_search(v).is_ok())
             .collect();
         if !twice.is_empty() {
-            if self.vertices.is_empty() {
-                self.motion = self.running;
-            }
-            self.vertices.extend(twice);
-            self.vertices.sort_unstable();
-            self.vertices.dedup();
+            self.let_go_of(twice.into_iter());
         }
         self.last_sample = std::mem::take(&mut self.this_sample);
         let turned = motion.dot(self.motion) < TURN_COS * motion.length() * self.motion.length();
