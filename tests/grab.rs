@@ -119,17 +119,7 @@ fn a_grab_dragged_on_past_where_it_is_held_clamps_no_more_than_in_proportion() {
 
 #[test]
 fn a_grab_pushed_into_a_layer_and_pulled_back_brings_the_surface_back() {
-    // Two sheets 3 apart; the upper one is grabbed at its middle, pushed 5 down onto the
-    // lower one (collisions hold it there) and pulled back up to where it began.
-    let mut mesh = slayer::scene::shapes::stacked_sheets(2, 20, 20, 1.0, 3.0);
-    let middle = Vec3::new(10.0, 10.0, 3.0);
-    let down = middle - Vec3::Z * 5.0;
-    let path: Vec<Vec3> = common::line(middle, down, 11)
-        .into_iter()
-        .chain(common::line(down, middle, 11).into_iter().skip(1))
-        .collect();
-    let mut stroke = common::one_brush_stroke(BrushKind::Grab, 4.0, &path);
-    stroke.layers = vec![1];
+    let (mut mesh, stroke) = common::grab_pushed_into_a_layer_and_back();
     let report = Pipeline::new(PipelineSettings::default())
         .apply_stroke(&mut mesh, &stroke)
         .unwrap();
@@ -137,12 +127,9 @@ fn a_grab_pushed_into_a_layer_and_pulled_back_brings_the_surface_back() {
     assert!(report.clamped > 0, "the push never met the lower sheet");
     assert_eq!(find_intersections(&mesh).total(), 0);
     // The vertices let go rejoined the grab when it turned back. How far the sheet is left
-    // below where it began, summed over its vertices: 47 before grabs let go; letting go for
-    // the rest of the stroke left 88.
-    let sunk: f32 = (mesh.positions().iter().zip(mesh.vertex_layers()))
-        .filter(|&(_, &layer)| layer == 1)
-        .map(|(p, _)| (3.0 - p.z).max(0.0))
-        .sum();
+    // below where it began: 47 before grabs let go; letting go for the rest of the stroke
+    // left 88.
+    let sunk = common::upper_sheet_sunk(&mesh);
     assert!(
         sunk < 60.0,
         "the upper sheet is left {sunk} below where it began"

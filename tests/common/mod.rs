@@ -129,6 +129,33 @@ pub fn line(from: glam::Vec3, to: glam::Vec3, count: usize) -> Vec<glam::Vec3> {
         .collect()
 }
 
+/// Two sheets 3 apart (20×20 quads of edge 1, layers 0 and 1) and a grab of radius 4 caught at
+/// the upper sheet's middle, pushed 5 down onto the lower sheet (collisions hold it there) and
+/// pulled back up to where it began: a grab outside any fuse layer whose vertices collisions hold
+/// still, so it lets go of them and takes them back when the drag turns.
+pub fn grab_pushed_into_a_layer_and_back() -> (slayer::mesh::Mesh, slayer::brush::Stroke) {
+    use glam::Vec3;
+    let mesh = slayer::scene::shapes::stacked_sheets(2, 20, 20, 1.0, 3.0);
+    let middle = Vec3::new(10.0, 10.0, 3.0);
+    let down = middle - Vec3::Z * 5.0;
+    let path: Vec<Vec3> = line(middle, down, 11)
+        .into_iter()
+        .chain(line(down, middle, 11).into_iter().skip(1))
+        .collect();
+    let mut stroke = one_brush_stroke(slayer::brush::BrushKind::Grab, 4.0, &path);
+    stroke.layers = vec![1];
+    (mesh, stroke)
+}
+
+/// How far the upper sheet of [`grab_pushed_into_a_layer_and_back`] is left below where it
+/// began (z = 3), summed over its vertices.
+pub fn upper_sheet_sunk(mesh: &slayer::mesh::Mesh) -> f32 {
+    (mesh.positions().iter().zip(mesh.vertex_layers()))
+        .filter(|&(_, &layer)| layer == 1)
+        .map(|(p, _)| (3.0 - p.z).max(0.0))
+        .sum()
+}
+
 /// The volume `mesh` encloses, which must be one closed component.
 pub fn closed_volume(mesh: &slayer::mesh::Mesh) -> f64 {
     let closed = mesh.closed_components();
