@@ -112,6 +112,7 @@ fn soak(kind: SceneKind, seed: u64) {
     let (mut refused, mut collisions, mut slowest) = (0usize, 0usize, (0.0f64, String::new()));
     let faces_at_start = input.live_face_count();
     let edge_at_start = input.mean_edge_length();
+    let soak_started = Instant::now();
     for i in 0..count {
         let spec = random_stroke(session.mesh(), &mut rng);
         let file = StrokeFile {
@@ -161,6 +162,15 @@ fn soak(kind: SceneKind, seed: u64) {
         }
         if (i + 1) % check_every() == 0 || i + 1 == count {
             let mesh = session.mesh();
+            if count > SHORT_STROKES / 2 {
+                // The full version runs for hours: say how far it has come.
+                eprintln!(
+                    "{kind:?}: {} strokes in {:.0} s, {} faces, {collisions} collisions, {refused} refused",
+                    i + 1,
+                    soak_started.elapsed().as_secs_f64(),
+                    mesh.live_face_count()
+                );
+            }
             mesh.validate()
                 .unwrap_or_else(|e| panic!("{kind:?} stroke {i}: {e}"));
             let crossings = find_intersections(mesh).total();

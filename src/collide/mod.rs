@@ -15,6 +15,7 @@ mod local_grid;
 pub mod neighbourhood;
 mod region;
 mod response;
+mod rings;
 mod sheet;
 mod stamps;
 mod state;
@@ -29,6 +30,7 @@ pub use region::{Region, Scratch, StepMoves};
 pub use response::{
     CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, collide, collide_with, pull_back,
 };
+pub use rings::RingCache;
 pub(crate) use sheet::{boundary_loop, normal_cone, projected_loop_is_simple, rim_loop};
 pub use stamps::Stamps;
 pub use state::StrokeState;

@@ -56,8 +56,8 @@ pub fn altitude_bound(mesh: &Mesh) -> f64 {
     *kth
 }
 
-/// The vertices within graph distance `ring` of `vertex` (itself included), appended to `out`
-/// unsorted. `scratch` is reused between calls.
+/// The vertices within graph distance `ring` of `vertex` (itself included), in `out`, sorted
+/// (test membership with [`in_ring`]). `out` is reused between calls.
 pub fn ring_vertices(mesh: &Mesh, vertex: u32, ring: u32, out: &mut Vec<u32>) {
     out.clear();
     out.push(vertex);
@@ -82,4 +82,10 @@ pub fn ring_vertices(mesh: &Mesh, vertex: u32, ring: u32, out: &mut Vec<u32>) {
         }
         frontier_start = frontier_end;
     }
+    out.sort_unstable();
+}
+
+/// Whether `w` is in a ring [`ring_vertices`] found.
+pub fn in_ring(ring: &[u32], w: u32) -> bool {
+    ring.binary_search(&w).is_ok()
 }

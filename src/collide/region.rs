@@ -6,6 +6,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::rings::RingCache;
 use super::sheet::Cone;
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps};
@@ -76,6 +77,8 @@ pub struct Region {
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
     face_marks: Stamps,
+    /// The moving vertices' exclusion rings, kept from step to step.
+    pub(super) rings: RingCache,
 }
 
 impl Region {

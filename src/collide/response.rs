@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::backstop::{Backstop, undo_crossings};
 use super::gap_guard::undo_gap_violations;
-use super::neighbourhood::ring_vertices;
+use super::neighbourhood::{in_ring, ring_vertices};
 use super::region::{Region, Scratch, StepMoves, map_with_scratch, triangle};
 use super::state::StrokeState;
 // The slack a vertex already within the collision distance is allowed (see its doc): the GPU's
@@ -47,6 +47,7 @@ pub fn pull_back(
     if own_sheet && region.single_layer() {
         return None;
     }
+    let kept_ring = region.rings.get(mesh, v, state.ring);
     let mut ring_ready = false;
     let mut ring = std::mem::take(&mut scratch.ring);
     let mut nearby = std::mem::take(&mut scratch.nearby);
@@ -67,11 +68,12 @@ pub fn pull_back(
             if own_sheet {
                 continue;
             }
-            if !ring_ready {
+            if kept_ring.is_none() && !ring_ready {
                 ring_vertices(mesh, v, state.ring, &mut ring);
                 ring_ready = true;
             }
-            if tri.iter().any(|u| ring.contains(u)) {
+            let own_ring = kept_ring.unwrap_or(&ring);
+            if tri.iter().any(|&u| in_ring(own_ring, u)) {
                 continue;
             }
         }
@@ -249,6 +251,13 @@ pub fn clamp_moves(
             .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
             .collect();
         region.find_sheets(state, mesh);
+        // Vertices of a layer that is a sheet here skip their own layer: they need no ring.
+        let unsheeted: Vec<u32> = (moving.iter().map(|&i| selection[i].0))
+            .filter(|&v| !region.is_sheet(mesh.vertex_layers()[v as usize]))
+            .collect();
+        region
+            .rings
+            .prepare(mesh, state.ring, &unsheeted, state.parallel);
         if region.worth_searching() {
             region.file_faces(mesh, moves, before);
         }

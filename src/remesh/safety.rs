@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::{NearFace, Remesher, SPLIT_AT};
-use crate::collide::neighbourhood::ring_vertices;
+use crate::collide::neighbourhood::{in_ring, ring_vertices};
 use crate::geom::{Aabb, neighbours_overlap, point_triangle_distance, triangles_intersect};
 use crate::mesh::INVALID;
 
@@ -69,6 +69,8 @@ impl Remesher<'_> {
             let mut more = Vec::new();
             ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
             ring.extend(more);
+            ring.sort_unstable();
+            ring.dedup();
         }
         let layer = self.mesh.vertex_layers()[v as usize];
         let (positions, faces) = (self.mesh.positions(), self.mesh.faces());
@@ -88,7 +90,7 @@ impl Remesher<'_> {
             let (face, tri) = (candidate.face, candidate.ids);
             // The neighbourhood skipped is the vertex's own, in its own layer.
             if self.mesh.face_layers()[face as usize] == layer
-                && tri.iter().any(|w| ring.contains(w))
+                && tri.iter().any(|&w| in_ring(&ring, w))
             {
                 continue;
             }

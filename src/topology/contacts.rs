@@ -6,7 +6,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::collide::LocalFaceGrid;
-use crate::collide::neighbourhood::ring_vertices;
+use crate::collide::neighbourhood::{in_ring, ring_vertices};
 use crate::geom::{Aabb, point_triangle_distance_squared};
 use crate::mesh::Mesh;
 
@@ -93,7 +93,8 @@ fn nearest_stranger(
     grid.for_each_candidate(&query, |local| {
         let f = faces[local as usize];
         let tri = mesh.faces()[f as usize];
-        if mesh.face_layers()[f as usize] != layer || tri.iter().any(|w| ring_scratch.contains(w)) {
+        if mesh.face_layers()[f as usize] != layer || tri.iter().any(|&w| in_ring(ring_scratch, w))
+        {
             return;
         }
         let [a, b, c] = tri.map(|w| mesh.positions()[w as usize]);
