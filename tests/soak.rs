@@ -133,15 +133,24 @@ fn soak(kind: SceneKind, seed: u64) {
         }
         dump_before(i, session.mesh(), &as_json);
         let started = Instant::now();
-        match session.apply_stroke(&mut pipeline, &strokes[0]) {
-            Ok((report, _)) => collisions += report.clamped,
-            Err(_) => refused += 1,
-        }
+        let phases = match session.apply_stroke(&mut pipeline, &strokes[0]) {
+            Ok((report, _)) => {
+                collisions += report.clamped;
+                Some(report.phases)
+            }
+            Err(_) => {
+                refused += 1;
+                None
+            }
+        };
         let seconds = started.elapsed().as_secs_f64();
         if seconds > 2.0 {
             let s = &strokes[0];
+            let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
             eprintln!(
-                "{kind:?} stroke {i}: {seconds:.1} s, {:?} radius {:.4} strength {} over {} samples",
+                "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {:?} radius {:.4} strength {} over {} samples",
+                collision / 1e3,
+                remesh / 1e3,
                 s.brush.kind,
                 s.brush.radius,
                 s.brush.strength,
