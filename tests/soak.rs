@@ -5,7 +5,7 @@
 //! undone at the end back to the input (and, where strokes grew the mesh past four times its
 //! faces, undone on the way back to twice).
 //!
-//! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 2.5 minutes
+//! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 15 s
 //! on two cores). The full one, 10⁴ strokes on ~20K faces:
 //! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --nocapture`. Times are
 //! printed, never asserted. `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke;

@@ -1,7 +1,8 @@
 //! Exclusion rings kept from step to step. A ring depends on the topology alone, and a grab
-//! moves the same vertices at every step of its stroke: finding the ring of each moving vertex
-//! again at every step (up to 4 rings deep, ~60 vertices, walked through the corner table) was a
-//! quarter of a long grab's time. Each ring is now found once while the topology stands.
+//! moves the same vertices at every step of its stroke: finding rings (up to 4 deep, ~60
+//! vertices, walked through the corner table) was a quarter of a long grab's time, half of it
+//! the collision phase finding the same rings again at every step. Each is now found once while
+//! the topology stands.
 
 use rayon::prelude::*;
 
@@ -34,12 +35,16 @@ impl RingCache {
             self.forget();
             (self.topology, self.ring) = (topology, ring);
         }
-        crate::grow::grow_to(&mut self.start, mesh.vertex_count(), INVALID);
         let missing: Vec<u32> = vertices
             .iter()
             .copied()
-            .filter(|&v| self.start[v as usize] == INVALID)
+            .filter(|&v| self.start.get(v as usize).is_none_or(|&s| s == INVALID))
             .collect();
+        // Sized for the vertices met, not the mesh: a stroke whose layers are all sheets
+        // needs no ring, and keeps no array.
+        if let Some(&highest) = missing.iter().max() {
+            crate::grow::grow_to(&mut self.start, highest as usize + 1, INVALID);
+        }
         let find = |scratch: &mut Vec<u32>, v: u32| {
             ring_vertices(mesh, v, ring, scratch);
             scratch.clone()
