@@ -128,53 +128,57 @@ fn soak(kind: SceneKind, seed: u64) {
             fuse: Vec::new(),
         };
         let as_json = serde_json::to_string(&file).unwrap_or_default();
-        let strokes = match file.resolve(session.mesh(), "soak") {
-            Ok(strokes) => strokes,
-            Err(_) => {
-                refused += 1;
-                continue;
+        // A stroke refused before it runs still reaches the check below (skipping it there
+        // skipped the check whenever the stroke at a check's turn was refused).
+        'stroke: {
+            let strokes = match file.resolve(session.mesh(), "soak") {
+                Ok(strokes) => strokes,
+                Err(_) => {
+                    refused += 1;
+                    break 'stroke;
+                }
+            };
+            if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
+                eprintln!("stroke {i}: {as_json}");
             }
-        };
-        if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
-            eprintln!("stroke {i}: {as_json}");
-        }
-        dump_before(i, session.mesh(), &as_json);
-        let started = Instant::now();
-        let phases = match session.apply_stroke(&mut pipeline, &strokes[0]) {
-            Ok((report, _)) => {
-                collisions += report.clamped;
-                Some(report.phases)
-            }
-            Err(_) => {
-                refused += 1;
-                None
-            }
-        };
-        let seconds = started.elapsed().as_secs_f64();
-        if seconds > 2.0 {
-            let s = &strokes[0];
-            let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
-            eprintln!(
-                "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {:?} radius {:.4} strength {} over {} samples",
-                collision / 1e3,
-                remesh / 1e3,
-                s.brush.kind,
-                s.brush.radius,
-                s.brush.strength,
-                s.samples.len()
-            );
-        }
-        if seconds > slowest.0 {
-            let s = &strokes[0];
-            slowest = (
-                seconds,
-                format!(
-                    "{:?} radius {:.4} over {} samples",
+            dump_before(i, session.mesh(), &as_json);
+            let started = Instant::now();
+            let phases = match session.apply_stroke(&mut pipeline, &strokes[0]) {
+                Ok((report, _)) => {
+                    collisions += report.clamped;
+                    Some(report.phases)
+                }
+                Err(_) => {
+                    refused += 1;
+                    None
+                }
+            };
+            let seconds = started.elapsed().as_secs_f64();
+            if seconds > 2.0 {
+                let s = &strokes[0];
+                let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
+                eprintln!(
+                    "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {:?} radius {:.4} strength {} over {} samples",
+                    collision / 1e3,
+                    remesh / 1e3,
                     s.brush.kind,
                     s.brush.radius,
+                    s.brush.strength,
                     s.samples.len()
-                ),
-            );
+                );
+            }
+            if seconds > slowest.0 {
+                let s = &strokes[0];
+                slowest = (
+                    seconds,
+                    format!(
+                        "{:?} radius {:.4} over {} samples",
+                        s.brush.kind,
+                        s.brush.radius,
+                        s.samples.len()
+                    ),
+                );
+            }
         }
         if (i + 1) % check_every() == 0 || i + 1 == count {
             let mesh = session.mesh();
