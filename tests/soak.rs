@@ -191,35 +191,8 @@ fn soak(kind: SceneKind, seed: u64) {
                     mesh.live_face_count()
                 );
             }
-            mesh.validate()
-                .unwrap_or_else(|e| panic!("{kind:?} stroke {i}: {e}"));
-            let crossings = find_intersections(mesh).total();
-            assert_eq!(
-                crossings, 0,
-                "{kind:?}: {crossings} crossings after stroke {i}, the last {as_json}"
-            );
-            // Layers stay the collision distance apart (the pipeline's `d`, 1·L), remeshing
-            // included.
-            let d = pipeline.edge_length().unwrap_or(edge_at_start)
-                * PipelineSettings::default().collision_distance;
-            let gap = smallest_layer_gap(mesh, 3.0 * d).unwrap();
-            assert!(
-                gap.is_none_or(|g| g >= 0.99 * d),
-                "{kind:?}: layers {gap:?} apart after stroke {i} (d = {d}), the last {as_json}"
-            );
-            // Remeshing keeps the edge length; the surface grows where grabs pull it out (a
-            // grab as wide as the sphere dragged five of its radii out of a crumpled side
-            // grew it from 18K to 60K faces), but within a bound.
-            let faces = mesh.live_face_count();
-            let edge = mesh.mean_edge_length();
-            assert!(
-                faces < 32 * faces_at_start,
-                "{kind:?}: {faces} faces after stroke {i}"
-            );
-            assert!(
-                (0.5 * edge_at_start..=1.5 * edge_at_start).contains(&edge),
-                "{kind:?}: mean edge {edge} after stroke {i}, {edge_at_start} at the start"
-            );
+            let start = (faces_at_start, edge_at_start);
+            check_sound(kind, (i, &as_json), mesh, pipeline.edge_length(), start);
             undone += undo_growth(&mut session, faces_at_start);
         }
     }
@@ -240,6 +213,46 @@ fn soak(kind: SceneKind, seed: u64) {
             "{kind:?}: undo all"
         );
     }
+}
+
+/// The exact checks after stroke `i` (`last`, as a stroke file, for the messages): a valid mesh,
+/// 0 crossings, layers the collision distance apart, growth within a bound and the edge length
+/// kept. `edge` is the pipeline's `L`; `start` the faces and mean edge the scene began with.
+fn check_sound(
+    kind: SceneKind,
+    (i, last): (usize, &str),
+    mesh: &Mesh,
+    edge: Option<f32>,
+    (faces_at_start, edge_at_start): (usize, f32),
+) {
+    mesh.validate()
+        .unwrap_or_else(|e| panic!("{kind:?} stroke {i}: {e}"));
+    let crossings = find_intersections(mesh).total();
+    assert_eq!(
+        crossings, 0,
+        "{kind:?}: {crossings} crossings after stroke {i}, the last {last}"
+    );
+    // Layers stay the collision distance apart (the pipeline's `d`, 1·L), remeshing
+    // included.
+    let d = edge.unwrap_or(edge_at_start) * PipelineSettings::default().collision_distance;
+    let gap = smallest_layer_gap(mesh, 3.0 * d).unwrap();
+    assert!(
+        gap.is_none_or(|g| g >= 0.99 * d),
+        "{kind:?}: layers {gap:?} apart after stroke {i} (d = {d}), the last {last}"
+    );
+    // Remeshing keeps the edge length; the surface grows where grabs pull it out (a
+    // grab as wide as the sphere dragged five of its radii out of a crumpled side
+    // grew it from 18K to 60K faces), but within a bound.
+    let faces = mesh.live_face_count();
+    let mean_edge = mesh.mean_edge_length();
+    assert!(
+        faces < 32 * faces_at_start,
+        "{kind:?}: {faces} faces after stroke {i}"
+    );
+    assert!(
+        (0.5 * edge_at_start..=1.5 * edge_at_start).contains(&mean_edge),
+        "{kind:?}: mean edge {mean_edge} after stroke {i}, {edge_at_start} at the start"
+    );
 }
 
 /// Past [`GROWTH_UNDONE`] times the faces it began with, strokes are undone until the mesh is
