@@ -87,11 +87,18 @@ fn a_long_grab_is_remeshed_as_it_stretches_and_never_crosses() {
     );
 }
 
-#[test]
-fn a_grab_dragged_on_past_where_it_is_held_remeshes_no_more_than_in_proportion() {
+/// Drags of 10 and 100 units, past where the needle holds the grab; the long one crosses
+/// nothing.
+fn drags_of_ten_and_a_hundred_units() -> (StrokeReport, StrokeReport) {
     let (mut ten_units, mut hundred) = (sphere(), sphere());
     let (ten, long) = (drag(&mut ten_units, 10.0), drag(&mut hundred, 100.0));
     assert_eq!(find_intersections(&hundred).total(), 0);
+    (ten, long)
+}
+
+#[test]
+fn a_grab_dragged_on_past_where_it_is_held_remeshes_no_more_than_in_proportion() {
+    let (ten, long) = drags_of_ten_and_a_hundred_units();
     // Ten times the drag, at most ten times the remeshing refused: every sample tried the
     // needle's edges again, 16,036 and 246,093 (15 times).
     assert!(
@@ -104,9 +111,7 @@ fn a_grab_dragged_on_past_where_it_is_held_remeshes_no_more_than_in_proportion()
 
 #[test]
 fn a_grab_dragged_on_past_where_it_is_held_clamps_no_more_than_in_proportion() {
-    let (mut ten_units, mut hundred) = (sphere(), sphere());
-    let (ten, long) = (drag(&mut ten_units, 10.0), drag(&mut hundred, 100.0));
-    assert_eq!(find_intersections(&hundred).total(), 0);
+    let (ten, long) = drags_of_ten_and_a_hundred_units();
     // Ten times the drag, at most ten times the clamps. Clamping the vertices the needle
     // holds again at every step made it 36 times (17,130 and 618,781).
     assert!(

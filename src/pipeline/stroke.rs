@@ -346,12 +346,30 @@ impl Active {
         self.stroke.brush.kind == BrushKind::Grab && self.stroke.fuse.is_empty()
     }
 
-    /// What a grab moves of what it `caught`: all of it, less what it let go of.
-    fn still_held(&self, caught: &[(u32, f32)]) -> Vec<(u32, f32)> {
-        match self.lets_go() {
-            true => self.let_go.still_held(caught),
-            false => caught.to_vec(),
+    /// At each sample, before its selection: a grab that caught something counts the
+    /// vertices held still and measures the drag's turn with the brush's `motion`.
+    fn start_grab_sample(&mut self, motion: Vec3) {
+        if self.lets_go() && self.captured.is_some() {
+            self.let_go.start_sample(motion);
         }
+    }
+
+    /// A grab's sample after its first: what it `caught`, less what it let go of (nothing,
+    /// unless [`Self::lets_go`]), with the brush frame of that; `None` for other brushes.
+    fn held_by_grab(
+        &self,
+        mesh: &Mesh,
+        caught: Option<&Vec<(u32, f32)>>,
+        (probe, normal): (&Dab, Option<Vec3>),
+    ) -> Option<Deformed> {
+        let caught = caught.filter(|_| self.stroke.brush.kind == BrushKind::Grab)?;
+        let held = self.let_go.still_held(caught);
+        Some(Deformed {
+            frame: brush_frame(mesh, &held, probe, normal),
+            selection: held,
+            targets: None,
+            deform_millis: 0.0,
+        })
     }
 
     /// What a step reads that lasts for the stroke.
@@ -466,18 +484,11 @@ impl Active {
         let probe = self.probe_at(sample, self.previous);
         self.previous = Some(sample.position);
         let kind = self.stroke.brush.kind;
-        if self.lets_go() && self.captured.is_some() {
-            self.let_go.start_sample(probe.frame.motion);
-        }
-        let held = self.captured.as_ref().filter(|_| kind == BrushKind::Grab);
-        let deformed = match held.map(|caught| self.still_held(caught)) {
-            Some(held) => Deformed {
-                frame: brush_frame(mesh, &held, &probe, sample.normal),
-                selection: held,
-                targets: None,
-                deform_millis: 0.0,
-            },
-            _ => {
+        self.start_grab_sample(probe.frame.motion);
+        let held = self.held_by_grab(mesh, self.captured.as_ref(), (&probe, sample.normal));
+        let deformed = match held {
+            Some(held) => held,
+            None => {
                 let state = self.state();
                 let source = FrameSource::Selection {
                     normal: sample.normal,

@@ -15,7 +15,8 @@ use glam::Vec3;
 /// keeps the vertices let go out of the grab (45°).
 const TURN_COS: f32 = std::f32::consts::FRAC_1_SQRT_2;
 
-/// The vertices a grab has let go of, and the motion that held the first of them.
+/// The vertices a grab has let go of, and the motion that held the first of them. Empty for
+/// a stroke that does not let go (the pipeline tells it nothing then).
 #[derive(Debug, Default)]
 pub(super) struct LetGo {
     /// Let go: ascending, no repeats.

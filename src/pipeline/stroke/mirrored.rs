@@ -13,8 +13,8 @@ use super::{Active, Opened, SamplesReport, refresh_normals};
 use crate::brush::{BrushKind, Dab, DabFrame, Mirror, Sample};
 use crate::mesh::Mesh;
 use crate::pipeline::engine::millis;
-use crate::pipeline::kernels::{Deformed, FrameSource, StepKernels};
-use crate::pipeline::step::{brush_frame, longest_move, steps_for};
+use crate::pipeline::kernels::{FrameSource, StepKernels};
+use crate::pipeline::step::{longest_move, steps_for};
 
 /// Which of a mirrored sample's two dabs.
 #[derive(Clone, Copy, PartialEq)]
@@ -36,9 +36,7 @@ impl Active {
         let started = Instant::now();
         let probe = self.probe_at(sample, self.previous);
         self.previous = Some(sample.position);
-        if self.lets_go() && self.captured.is_some() {
-            self.let_go.start_sample(probe.frame.motion);
-        }
+        self.start_grab_sample(probe.frame.motion);
         let image = image_dab(&probe, &mirror);
         let image_normal = sample.normal.map(|n| mirror.direction_image(n));
         let drawn = self.open_side(kernels, mesh, (probe, sample.normal), Side::Drawn);
@@ -75,14 +73,8 @@ impl Active {
             Side::Drawn => &self.captured,
             Side::Image => &self.captured_image,
         };
-        let held = captured.as_ref().filter(|_| kind == BrushKind::Grab);
-        let deformed = match held.map(|caught| self.still_held(caught)) {
-            Some(held) => Deformed {
-                frame: brush_frame(mesh, &held, &probe, normal),
-                selection: held,
-                targets: None,
-                deform_millis: 0.0,
-            },
+        let deformed = match self.held_by_grab(mesh, captured.as_ref(), (&probe, normal)) {
+            Some(held) => held,
             None => {
                 let how = (FrameSource::Selection { normal }, kind.deforms());
                 kernels.select_and_deform(&self.state(), mesh, &probe, how)
