@@ -1,5 +1,6 @@
 //! Issue 22, item 1: work derived from input is bounded before it starts. Two samples far
-//! apart, streamed or in a file, are refused with a clear error and leave the mesh alone.
+//! apart, streamed or in a file, are refused with a clear error and leave the mesh alone; a
+//! stroke whose remeshing would create more faces than its bound stops splitting there.
 
 use std::time::{Duration, Instant};
 
@@ -232,4 +233,50 @@ fn a_runaway_sample_moves_its_most_steps_each_within_the_limit_and_is_counted() 
         .map(|(p, q)| p.distance(*q))
         .fold(0.0f32, f32::max);
     assert!(farthest <= limit, "a vertex moved {farthest}");
+}
+
+/// A grab pulling a tall tent out of a sheet of 392 faces whose remeshing would create
+/// hundreds more: with a bound of 400 new faces it creates at most 400, says so, and
+/// leaves a valid mesh with edges long where it stopped; the default bound lets the same
+/// stroke create more, so the bound is what stopped it.
+#[test]
+fn a_stroke_creates_at_most_its_bound_of_new_faces() {
+    let tent = |new_faces_per_stroke: usize| {
+        let mut mesh = slayer::scene::shapes::stacked_sheets(1, 14, 14, 1.0, 0.0);
+        let mut stroke = stroke_of(StrokeSettings {
+            layers: vec![0],
+            ..settings(5.0)
+        });
+        stroke.brush.kind = BrushKind::Grab;
+        stroke.brush.strength = 1.0;
+        stroke.samples = (0..4).map(|i| sample(7.0, 7.0, 4.0 * i as f32)).collect();
+        let mut pipeline = Pipeline::new(PipelineSettings {
+            new_faces_per_stroke,
+            ..PipelineSettings::default()
+        });
+        let faces = mesh.live_face_count();
+        let report = pipeline.apply_stroke(&mut mesh, &stroke).unwrap();
+        mesh.validate().unwrap();
+        (report, faces, mesh)
+    };
+    let (report, faces_before, mesh) = tent(400);
+    assert!(report.remesh.growth_capped > 0, "{:?}", report.remesh);
+    assert!(report.remesh.splits <= 200, "{:?}", report.remesh);
+    let created = mesh.live_face_count().saturating_sub(faces_before);
+    assert!(created <= 400, "{faces_before} → {} faces", mesh.live_face_count());
+    assert_eq!(slayer::collide::find_intersections(&mesh).total(), 0);
+    let (unbounded, _, remeshed) = tent(slayer::pipeline::NEW_FACES_PER_STROKE);
+    let split_above = slayer::remesh::SPLIT_ABOVE; // × L, which is 1 here
+    assert!(
+        mesh.longest_edge() > 1.2 * split_above && remeshed.longest_edge() < mesh.longest_edge(),
+        "edges left long: {} (all split: {})",
+        mesh.longest_edge(),
+        remeshed.longest_edge()
+    );
+    assert_eq!(unbounded.remesh.growth_capped, 0, "{:?}", unbounded.remesh);
+    assert!(
+        unbounded.remesh.splits > 200,
+        "the default bound lets it split more: {:?}",
+        unbounded.remesh
+    );
 }

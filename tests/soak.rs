@@ -10,7 +10,8 @@
 //! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --nocapture`. Times are
 //! printed, never asserted. `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke;
 //! `SLAYER_SOAK_TRACE=1` prints each stroke (as a stroke file) before it runs;
-//! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N` and the stroke into `DIR`.
+//! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N` and the stroke into `DIR`
+//! (`SLAYER_SOAK_DUMP=each:DIR` before every stroke, over the last, to catch one that never ends).
 
 use std::time::Instant;
 
@@ -143,9 +144,21 @@ fn soak(kind: SceneKind, seed: u64) {
             }
             dump_before(i, session.mesh(), &as_json);
             let started = Instant::now();
+            let faces_before = session.mesh().live_face_count();
             let phases = match session.apply_stroke(&mut pipeline, &strokes[0]) {
                 Ok((report, _)) => {
                     collisions += report.clamped;
+                    // The stroke's bound on the faces its remeshing creates (two a split at
+                    // most), which also bounds its time: a crease over all of the plaster
+                    // once crumpled it from 53K to 212K faces in 2 minutes.
+                    let bound = PipelineSettings::default()
+                        .new_faces_per_stroke
+                        .max(faces_before);
+                    assert!(
+                        2 * report.remesh.splits <= bound,
+                        "{kind:?} stroke {i}: {} splits, the bound {bound} faces: {as_json}",
+                        report.remesh.splits
+                    );
                     Some(report.phases)
                 }
                 Err(_) => {
@@ -193,7 +206,16 @@ fn soak(kind: SceneKind, seed: u64) {
             }
             let start = (faces_at_start, edge_at_start);
             check_sound(kind, (i, &as_json), mesh, pipeline.edge_length(), start);
-            undone += undo_growth(&mut session, faces_at_start);
+            let now = undo_growth(&mut session, faces_at_start);
+            if now > 0 && count > SHORT_STROKES / 2 {
+                eprintln!(
+                    "{kind:?}: {now} strokes undone to {} faces (history {:.1} MiB, {} entries dropped)",
+                    session.mesh().live_face_count(),
+                    session.history().bytes() as f64 / 1048576.0,
+                    session.history().dropped()
+                );
+            }
+            undone += now;
         }
     }
     eprintln!(
@@ -270,7 +292,8 @@ fn undo_growth(session: &mut Session, faces_at_start: usize) -> usize {
 }
 
 /// With `SLAYER_SOAK_DUMP=N:DIR`, writes the mesh before stroke `N` to `DIR/before.ply` and
-/// the stroke to `DIR/stroke.json`, for `slayer sculpt` to replay it alone.
+/// the stroke to `DIR/stroke.json`, for `slayer sculpt` to replay it alone; with `each:DIR`,
+/// before every stroke (each over the last: what is there when a stroke never ends is its own).
 fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
     let Ok(spec) = std::env::var("SLAYER_SOAK_DUMP") else {
         return;
@@ -278,7 +301,7 @@ fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
     let Some((at, dir)) = spec.split_once(':') else {
         return;
     };
-    if at.parse() == Ok(stroke) {
+    if at == "each" || at.parse() == Ok(stroke) {
         let dir = std::path::Path::new(dir);
         slayer::io::write_mesh(mesh, &dir.join("before.ply")).unwrap();
         std::fs::write(dir.join("stroke.json"), stroke_json).unwrap();

@@ -328,18 +328,20 @@ impl Pipeline {
     }
 }
 
-/// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring,
+/// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring (and
+/// at most `max_splits` splits: what is left of the stroke's bound on new faces),
 /// keeping `grid` exact, and tells `kernels` what changed; returns what it did and the
 /// vertices it changed (ascending).
 pub(super) fn remesh_touched(
     mesh: &mut Mesh,
     (grid, kernels, sets): (&mut SpatialHash, &mut dyn StepKernels, &mut RemeshSets),
     seeds: &[u32],
-    (edge, distance, ring): (f32, f32, u32),
+    (edge, distance, ring, max_splits): (f32, f32, u32, usize),
 ) -> (RemeshReport, Vec<u32>) {
     let settings = RemeshSettings {
         collision_distance: distance,
         exclusion_ring: ring,
+        max_splits,
         ..RemeshSettings::new(edge)
     };
     let since = mesh.version();

@@ -76,12 +76,21 @@ pub struct PipelineSettings {
     /// The most dabs (samples after resampling) one stroke may make; samples that would take a
     /// stroke past it are refused with [`PipelineError::TooManyDabs`] before they run.
     pub max_dabs_per_stroke: usize,
+    /// The faces one stroke's remeshing may create: this many, or as many as the mesh had when
+    /// the stroke began where that is more. Past it, splits are left undone (edges stay long;
+    /// [`RemeshReport::growth_capped`]), so that a stroke can neither exhaust memory nor run
+    /// for minutes crumpling a layer into ever more faces.
+    pub new_faces_per_stroke: usize,
     /// Skip the collision searches that provably find nothing: within a layer where it is a
     /// sheet that cannot touch itself, against other layers where none is near
     /// (`collide::sheet`). The result is the same, bit for bit; off only to compare
     /// (`slayer bench --no-cull`).
     pub cull: bool,
 }
+
+/// [`PipelineSettings::new_faces_per_stroke`] by default: 2¹⁶ faces (a crease over the whole of
+/// a 53K-face plaster crumpled its paint layer to 159K faces in one stroke, 2 minutes).
+pub const NEW_FACES_PER_STROKE: usize = 1 << 16;
 
 /// When the pipeline remeshes what the brush touched (sLayer discusses both; docs/design.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -120,6 +129,7 @@ impl Default for PipelineSettings {
             edge_length: None,
             remeshing: Remeshing::AfterStroke,
             max_dabs_per_stroke: crate::brush::MAX_DABS_PER_STROKE,
+            new_faces_per_stroke: NEW_FACES_PER_STROKE,
             cull: true,
         }
     }

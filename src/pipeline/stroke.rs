@@ -91,6 +91,9 @@ struct Active {
     /// its end the bound is brought back to what the stroke left ([`Active::tighten_edge_bound`]).
     remeshed: Vec<u32>,
     edge_bound_at_start: f32,
+    /// Splits the stroke's remeshing may still make (each creates up to two faces:
+    /// [`PipelineSettings::new_faces_per_stroke`]).
+    splits_left: usize,
     report: StrokeReport,
 }
 
@@ -133,6 +136,7 @@ impl<'a> StrokeInProgress<'a> {
             _ => Vec::new(),
         };
         let (settings, fast) = (pipeline.settings, !pipeline.reference);
+        let new_faces = settings.new_faces_per_stroke.max(mesh.live_face_count());
         Ok(StrokeInProgress {
             pipeline,
             mesh,
@@ -162,6 +166,7 @@ impl<'a> StrokeInProgress<'a> {
                 touched_list: Vec::new(),
                 remeshed: Vec::new(),
                 edge_bound_at_start,
+                splits_left: new_faces / 2,
                 report: StrokeReport {
                     phases,
                     ..StrokeReport::default()

@@ -51,6 +51,10 @@ impl Remesher<'_> {
             if budget == 0 {
                 break;
             }
+            if self.report.splits >= self.settings.max_splits {
+                self.report.growth_capped = 1;
+                break;
+            }
             budget -= 1;
             if !self.split_is_clear(c) {
                 self.report.refused += 1;

@@ -70,6 +70,9 @@ pub struct RemeshSettings {
     /// Collision distance (world units) and the neighbourhood ring a vertex skips.
     pub collision_distance: f32,
     pub exclusion_ring: u32,
+    /// Splits the pass may make at most: a stroke's share of its bound on the faces it
+    /// creates (`PipelineSettings::new_faces_per_stroke`); unbounded elsewhere.
+    pub max_splits: usize,
 }
 
 impl RemeshSettings {
@@ -80,6 +83,7 @@ impl RemeshSettings {
             region_rings: 2,
             collision_distance: target_edge,
             exclusion_ring: 1,
+            max_splits: usize::MAX,
         }
     }
 }
@@ -105,6 +109,8 @@ pub struct RemeshReport {
     pub shape_refused: usize,
     /// Edits whose safety checks a sheet zone settled (whole-mesh remeshing, `zone`).
     pub culled: usize,
+    /// Passes that stopped splitting at [`RemeshSettings::max_splits`], leaving long edges.
+    pub growth_capped: usize,
     /// Longest edge among the faces around the region afterwards (the pipeline's running
     /// bound on edge lengths).
     pub longest_edge: f32,
@@ -123,6 +129,7 @@ impl RemeshReport {
         self.refused += other.refused;
         self.shape_refused += other.shape_refused;
         self.culled += other.culled;
+        self.growth_capped += other.growth_capped;
         self.longest_edge = self.longest_edge.max(other.longest_edge);
         self.millis += other.millis;
     }

@@ -115,6 +115,10 @@ enum Command {
         /// The most dabs (samples after resampling at the stroke's spacing) one stroke may make.
         #[arg(long, default_value_t = slayer::brush::MAX_DABS_PER_STROKE, value_name = "N")]
         max_dabs: usize,
+        /// The most faces one stroke's remeshing may create (or as many as the mesh has, where
+        /// that is more); past it, long edges are left unsplit and `sculpt` warns.
+        #[arg(long, default_value_t = slayer::pipeline::NEW_FACES_PER_STROKE, value_name = "N")]
+        max_new_faces: usize,
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
@@ -405,6 +409,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             output,
             in_place,
             max_dabs,
+            max_new_faces,
             stats,
             symmetry,
             remesh,
@@ -417,6 +422,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             output: &output,
             in_place,
             max_dabs,
+            max_new_faces,
             stats: stats.as_deref(),
             symmetry: symmetry.as_deref(),
             remeshing: remesh,

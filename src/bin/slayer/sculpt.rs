@@ -19,6 +19,7 @@ pub struct Args<'a> {
     pub in_place: bool,
     /// The most dabs one stroke may make.
     pub max_dabs: usize,
+    pub max_new_faces: usize,
     pub stats: Option<&'a Path>,
     /// `x`, `y` or `z`: the mirror of strokes that name none.
     pub symmetry: Option<&'a str>,
@@ -113,6 +114,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         PipelineSettings {
             remeshing: args.remeshing,
             max_dabs_per_stroke: args.max_dabs,
+            new_faces_per_stroke: args.max_new_faces,
             cull: args.cull,
             ..PipelineSettings::default()
         },
@@ -128,6 +130,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
     for (i, stroke) in strokes.iter().enumerate() {
+        let faces_before = session.mesh().live_face_count();
         let (report, recorded) = session
             .apply_stroke(&mut pipeline, stroke)
             .with_context(|| format!("{name}: strokes[{i}]"))?;
@@ -142,6 +145,12 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
             bar.println(&format!(
                 "warning: strokes[{i}]: {} samples moved farther than {MAX_STEPS_PER_SAMPLE} steps allow and were cut short (a runaway brush: lower its strength or radius)",
                 report.capped_samples
+            ));
+        }
+        if report.remesh.growth_capped > 0 {
+            bar.println(&format!(
+                "warning: strokes[{i}]: remeshing stopped splitting at {} new faces, the bound for one stroke (edges were left long; raise it with --max-new-faces)",
+                args.max_new_faces.max(faces_before)
             ));
         }
         reports.push(report);

@@ -26,6 +26,7 @@ impl Active {
             self.lengths.edge,
             self.lengths.collision_distance,
             self.prepared.ring,
+            self.splits_left,
         );
         let (pass, changed) = remesh_touched(
             mesh,
@@ -34,6 +35,7 @@ impl Active {
             lengths,
         );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.splits_left -= pass.splits;
         self.report.remesh.add(&pass);
         self.remeshed.extend_from_slice(&changed);
         self.scratch.size_for(mesh);
@@ -100,6 +102,7 @@ impl Active {
             self.lengths.edge,
             self.lengths.collision_distance,
             self.prepared.ring,
+            self.splits_left,
         );
         let seeds = &self.touched_list;
         let (pass, changed) = remesh_touched(
@@ -109,6 +112,7 @@ impl Active {
             lengths,
         );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
+        self.splits_left -= pass.splits;
         self.report.remesh.add(&pass);
         self.report.phases.remesh += millis(started);
         changed
