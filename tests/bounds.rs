@@ -263,7 +263,11 @@ fn a_stroke_creates_at_most_its_bound_of_new_faces() {
     assert!(report.remesh.growth_capped > 0, "{:?}", report.remesh);
     assert!(report.remesh.splits <= 200, "{:?}", report.remesh);
     let created = mesh.live_face_count().saturating_sub(faces_before);
-    assert!(created <= 400, "{faces_before} → {} faces", mesh.live_face_count());
+    assert!(
+        created <= 400,
+        "{faces_before} → {} faces",
+        mesh.live_face_count()
+    );
     assert_eq!(slayer::collide::find_intersections(&mesh).total(), 0);
     let (unbounded, _, remeshed) = tent(slayer::pipeline::NEW_FACES_PER_STROKE);
     let split_above = slayer::remesh::SPLIT_ABOVE; // × L, which is 1 here

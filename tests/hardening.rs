@@ -429,6 +429,47 @@ fn unbounded_work_is_refused_at_once_with_the_bound() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A grab pulling a tent out of a 390-face plane splits past a bound of 200 new faces (so 390,
+/// the mesh's own faces): `sculpt` says where it stopped and how to raise it, writes the mesh,
+/// and its stats count the capped pass; without the option the same stroke is not capped.
+#[test]
+fn a_stroke_that_grows_past_its_bound_of_new_faces_is_warned_of() {
+    let dir = scratch("growth");
+    let input = dir.join("in.ply");
+    write_scene("plane", 400, &[], &input);
+    let strokes = stroke_file(
+        &dir,
+        "tent.json",
+        r#"{"brush": "grab", "radius": 0.35, "strength": 1.0, "layers": [0],
+            "samples": [{"position": [0, 0, 0]}, {"position": [0, 0, 0.6]},
+                        {"position": [0, 0, 1.2]}, {"position": [0, 0, 1.8]}]}"#,
+    );
+    let sculpt = |bound: Option<&str>| {
+        let (output, stats) = (dir.join("out.ply"), dir.join("stats.json"));
+        let mut args = vec!["sculpt", "--input", arg(&input), "--strokes", arg(&strokes)];
+        args.extend(["--output", arg(&output), "--stats", arg(&stats)]);
+        args.extend(bound.map(|b| ["--max-new-faces", b]).into_iter().flatten());
+        let out = slayer(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let stats: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+        (text(&out.stderr), stats["strokes"][0]["remesh"].clone())
+    };
+    let (said, remesh) = sculpt(Some("200"));
+    assert!(
+        said.contains("strokes[0]: remeshing stopped splitting at 390 new faces")
+            && said.contains("--max-new-faces"),
+        "{said}"
+    );
+    assert!(remesh["growth_capped"].as_u64().unwrap() >= 1, "{remesh}");
+    assert!(remesh["splits"].as_u64().unwrap() <= 195, "{remesh}");
+    let (said, remesh) = sculpt(None);
+    assert!(!said.contains("stopped splitting"), "{said}");
+    assert_eq!(remesh["growth_capped"], 0, "{remesh}");
+    assert!(remesh["splits"].as_u64().unwrap() > 195, "{remesh}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// `slayer sculpt` killed with SIGKILL while it writes a 1M-face output: the previous output is
 /// byte-identical, and the temporary file the killed run left is swept by the next write into
 /// that folder.
