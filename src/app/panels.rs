@@ -49,11 +49,12 @@ pub fn status_bar(app: &mut SlayerApp, ui: &mut Ui) {
                 if let Some(stroke) = &app.last_stroke {
                     ui.separator();
                     ui.label(format!(
-                        "last stroke: {} samples, {:.0} ms ({:.0} remeshing), {} moves clamped",
+                        "last stroke: {} samples, {:.0} ms ({:.0} remeshing), {} moves clamped{}",
                         stroke.samples,
                         stroke.phases.total(),
                         stroke.phases.remesh,
-                        stroke.clamped
+                        stroke.clamped,
+                        stroke_bounds_met(stroke)
                     ));
                 }
             }
@@ -528,4 +529,17 @@ pub fn brush_circle(app: &SlayerApp, painter: &Painter, rect: Rect) {
     ) {
         painter.line_segment([a, b], Line::new(1.5, colour));
     }
+}
+
+/// What a stroke's bounds cut short, for the status bar: samples that moved their most steps,
+/// remeshing that stopped at its bound of new faces (edges left long).
+fn stroke_bounds_met(stroke: &crate::pipeline::StrokeReport) -> String {
+    let mut said = String::new();
+    if stroke.capped_samples > 0 {
+        said += &format!("; {} samples cut short (a runaway brush)", stroke.capped_samples);
+    }
+    if stroke.remesh.growth_capped > 0 {
+        said += "; remeshing stopped at its bound of new faces (edges left long)";
+    }
+    said
 }
