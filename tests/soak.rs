@@ -1,7 +1,8 @@
 //! The soak test: random strokes of every brush, with random layers, radii (extreme ones
 //! included), strengths and pressures, remeshing on, over plaster and a closed sphere, checked
 //! exactly every 25 strokes — 0 intersecting triangle pairs, layers at least the collision
-//! distance apart, `validate()`, bounded growth — through the session, so every stroke is also
+//! distance apart, `validate()`, bounded growth and memory, each stroke within its bound of new
+//! faces (what bounds its time) — through the session, so every stroke is also
 //! undone at the end back to the input (and, where strokes grew the mesh past four times its
 //! faces, undone on the way back to twice).
 //!
@@ -206,6 +207,7 @@ fn soak(kind: SceneKind, seed: u64) {
             }
             let start = (faces_at_start, edge_at_start);
             check_sound(kind, (i, &as_json), mesh, pipeline.edge_length(), start);
+            check_memory(kind, i);
             let now = undo_growth(&mut session, faces_at_start);
             if now > 0 && count > SHORT_STROKES / 2 {
                 eprintln!(
@@ -225,7 +227,10 @@ fn soak(kind: SceneKind, seed: u64) {
         faces_at_start,
         session.mesh().live_face_count(),
         session.history().bytes() as f64 / 1048576.0,
-        peak_memory()
+        peak_memory().map_or("unknown".into(), |b| format!(
+            "{:.0} MiB",
+            b as f64 / 1048576.0
+        ))
     );
     while session.undo().is_some() {}
     if session.history().dropped() == 0 {
@@ -308,16 +313,31 @@ fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
     }
 }
 
-/// The process's peak resident memory as Linux reports it (`VmHWM`), for the printout.
-fn peak_memory() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .map(|l| l[6..].trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".into())
+/// The process's peak resident memory in bytes as Linux reports it (`VmHWM`).
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line[6..]
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kib * 1024)
+}
+
+/// The test process's peak memory stays under this, both scenes together: each session's
+/// history is capped at 512 MiB and each mesh at [`GROWTH_UNDONE`] times its faces at a check
+/// (the full soak's plaster peaked at 324 MB over 300 strokes; the short version at 44 MB).
+const MEMORY_BOUND: u64 = 3 << 30;
+
+fn check_memory(kind: SceneKind, i: usize) {
+    if let Some(peak) = peak_memory() {
+        assert!(
+            peak < MEMORY_BOUND,
+            "{kind:?} stroke {i}: the process peaked at {peak} bytes"
+        );
+    }
 }
 
 #[test]

@@ -536,7 +536,10 @@ pub fn brush_circle(app: &SlayerApp, painter: &Painter, rect: Rect) {
 fn stroke_bounds_met(stroke: &crate::pipeline::StrokeReport) -> String {
     let mut said = String::new();
     if stroke.capped_samples > 0 {
-        said += &format!("; {} samples cut short (a runaway brush)", stroke.capped_samples);
+        said += &format!(
+            "; {} samples cut short (a runaway brush)",
+            stroke.capped_samples
+        );
     }
     if stroke.remesh.growth_capped > 0 {
         said += "; remeshing stopped at its bound of new faces (edges left long)";
