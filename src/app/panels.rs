@@ -546,3 +546,20 @@ fn stroke_bounds_met(stroke: &crate::pipeline::StrokeReport) -> String {
     }
     said
 }
+
+#[cfg(test)]
+mod tests {
+    use super::stroke_bounds_met;
+    use crate::pipeline::StrokeReport;
+
+    #[test]
+    fn the_status_bar_names_the_bounds_a_stroke_met() {
+        let mut stroke = StrokeReport::default();
+        assert_eq!(stroke_bounds_met(&stroke), "");
+        stroke.capped_samples = 2;
+        stroke.remesh.growth_capped = 1;
+        let said = stroke_bounds_met(&stroke);
+        assert!(said.contains("2 samples cut short"), "{said}");
+        assert!(said.contains("bound of new faces"), "{said}");
+    }
+}
