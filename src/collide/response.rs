@@ -52,7 +52,12 @@ pub fn pull_back(
     let mut ring = std::mem::take(&mut scratch.ring);
     let mut nearby = std::mem::take(&mut scratch.nearby);
     nearby.clear();
-    region.candidates(&query, scratch, |local| nearby.push(local as u32));
+    let gather = |local| nearby.push(local as u32);
+    match changed {
+        // Only the faces the last pass changed are tested: those filed apart, if they are.
+        Some(_) => region.changed_candidates(&query, scratch, gather),
+        None => region.candidates(&query, scratch, gather),
+    }
     let mut t = 1.0f32;
     for &local in &nearby {
         if changed.is_some_and(|marks| !marks[local as usize]) {
@@ -239,6 +244,7 @@ pub fn clamp_moves(
         }
     }
     region.positions_changed();
+    region.forget_changed();
 
     // Per local face: changed by the last pass (the first pass tests every face).
     let mut changed: Option<Vec<bool>> = None;
@@ -303,6 +309,7 @@ pub fn clamp_moves(
                 }
             }
         }
+        region.file_changed(&marks);
         changed = Some(marks);
     }
 }
