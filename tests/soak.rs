@@ -153,9 +153,7 @@ fn soak(kind: SceneKind, seed: u64) {
                     // The stroke's bound on the faces its remeshing creates (two a split at
                     // most), which also bounds its time: a crease over all of the plaster
                     // once crumpled it from 53K to 212K faces in 2 minutes.
-                    let bound = PipelineSettings::default()
-                        .new_faces_per_stroke
-                        .max(faces_before);
+                    let bound = PipelineSettings::default().new_faces_bound(faces_before);
                     assert!(
                         2 * report.remesh.splits <= bound,
                         "{kind:?} stroke {i}: {} splits, the bound {bound} faces: {as_json}",

@@ -325,7 +325,8 @@ impl Region {
             .faces
             .extend((0..marks.len() as u32).filter(|&l| marks[l as usize]));
         changed.boxes.clear();
-        (changed.boxes).extend(changed.faces.iter().map(|&l| self.boxes[l as usize]));
+        let boxes = changed.faces.iter().map(|&l| self.boxes[l as usize]);
+        changed.boxes.extend(boxes);
         if let Some(cell) = self.cell {
             changed.grid.build(&changed.boxes, self.reach, cell);
         }

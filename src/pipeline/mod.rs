@@ -121,6 +121,14 @@ impl std::str::FromStr for Remeshing {
     }
 }
 
+impl PipelineSettings {
+    /// The faces a stroke that begins on a mesh of `faces` may create by remeshing
+    /// ([`PipelineSettings::new_faces_per_stroke`], or `faces` where that is more).
+    pub fn new_faces_bound(&self, faces: usize) -> usize {
+        self.new_faces_per_stroke.max(faces)
+    }
+}
+
 impl Default for PipelineSettings {
     fn default() -> Self {
         PipelineSettings {

@@ -136,7 +136,7 @@ impl<'a> StrokeInProgress<'a> {
             _ => Vec::new(),
         };
         let (settings, fast) = (pipeline.settings, !pipeline.reference);
-        let new_faces = settings.new_faces_per_stroke.max(mesh.live_face_count());
+        let new_faces = settings.new_faces_bound(mesh.live_face_count());
         Ok(StrokeInProgress {
             pipeline,
             mesh,

@@ -109,17 +109,14 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let load_peak = slayer::memory::peak_bytes();
     slayer::memory::reset_peak();
     check_dabs(&strokes, args.max_dabs, &name)?;
-    let mut pipeline = crate::backend::choose(
-        args.backend,
-        PipelineSettings {
-            remeshing: args.remeshing,
-            max_dabs_per_stroke: args.max_dabs,
-            new_faces_per_stroke: args.max_new_faces,
-            cull: args.cull,
-            ..PipelineSettings::default()
-        },
-    )?
-    .pipeline;
+    let settings = PipelineSettings {
+        remeshing: args.remeshing,
+        max_dabs_per_stroke: args.max_dabs,
+        new_faces_per_stroke: args.max_new_faces,
+        cull: args.cull,
+        ..PipelineSettings::default()
+    };
+    let mut pipeline = crate::backend::choose(args.backend, settings)?.pipeline;
     // What is proportional to the mesh (the grid, per-vertex scratch) is built here, once,
     // and reported as set-up: a stroke's cost follows the brush.
     let started = std::time::Instant::now();
@@ -150,7 +147,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         if report.remesh.growth_capped > 0 {
             bar.println(&format!(
                 "warning: strokes[{i}]: remeshing stopped splitting at {} new faces, the bound for one stroke (edges were left long; raise it with --max-new-faces)",
-                args.max_new_faces.max(faces_before)
+                settings.new_faces_bound(faces_before)
             ));
         }
         reports.push(report);
