@@ -84,3 +84,12 @@ pub fn peak_bytes() -> Option<usize> {
 pub fn reset_peak() {
     PEAK.store(LIVE.load(Relaxed), Relaxed);
 }
+
+/// The process's peak resident memory in bytes, as Linux reports it (`VmHWM`); `None`
+/// elsewhere. Unlike [`peak_bytes`] it needs no allocator installed, and counts all memory.
+pub fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}

@@ -232,14 +232,6 @@ fn try_case(kind: Kind, bytes: &[u8], mesh_for_strokes: &Mesh) -> bool {
     }
 }
 
-/// The process's peak resident memory, where the system says (Linux).
-fn peak_rss_mib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024)
-}
-
 /// Runs cases on a worker thread, so that a case that never ends is caught by a timeout
 /// instead of stalling the run: the test fails, naming and saving the case.
 struct Worker {
@@ -303,7 +295,7 @@ fn mangled_files_of_every_kind_give_an_error_or_a_valid_result() {
             counts.errors += 1;
         }
     }
-    let peak = peak_rss_mib();
+    let peak = slayer::memory::peak_resident_bytes().map(|b| b >> 20);
     eprintln!(
         "fuzz: {} cases, {} errors, {} valid, 0 panics, 0 hangs, slowest case {:?}, peak RSS {} MiB",
         counts.cases,

@@ -19,7 +19,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use slayer::brush::{BrushKind, LayerRef, SampleSpec, StrokeFile, StrokeSpec};
+use slayer::brush::{BrushKind, LayerRef, SampleSpec, Stroke, StrokeFile, StrokeSpec};
 use slayer::collide::{find_intersections, smallest_layer_gap};
 use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings};
@@ -168,29 +168,16 @@ fn soak(kind: SceneKind, seed: u64) {
             };
             let seconds = started.elapsed().as_secs_f64();
             if seconds > 2.0 {
-                let s = &strokes[0];
                 let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
                 eprintln!(
-                    "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {:?} radius {:.4} strength {} over {} samples",
+                    "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {}",
                     collision / 1e3,
                     remesh / 1e3,
-                    s.brush.kind,
-                    s.brush.radius,
-                    s.brush.strength,
-                    s.samples.len()
+                    describe(&strokes[0])
                 );
             }
             if seconds > slowest.0 {
-                let s = &strokes[0];
-                slowest = (
-                    seconds,
-                    format!(
-                        "{:?} radius {:.4} over {} samples",
-                        s.brush.kind,
-                        s.brush.radius,
-                        s.samples.len()
-                    ),
-                );
+                slowest = (seconds, describe(&strokes[0]));
             }
         }
         if (i + 1) % check_every() == 0 || i + 1 == count {
@@ -221,7 +208,7 @@ fn soak(kind: SceneKind, seed: u64) {
         faces_at_start,
         session.mesh().live_face_count(),
         session.history().bytes() as f64 / 1048576.0,
-        peak_memory().map_or("unknown".into(), |b| format!(
+        slayer::memory::peak_resident_bytes().map_or("unknown".into(), |b| format!(
             "{:.0} MiB",
             b as f64 / 1048576.0
         ))
@@ -234,6 +221,18 @@ fn soak(kind: SceneKind, seed: u64) {
             "{kind:?}: undo all"
         );
     }
+}
+
+/// A stroke in a few words, for the printout of slow strokes.
+fn describe(s: &Stroke) -> String {
+    let brush = &s.brush;
+    format!(
+        "{:?} radius {:.4} strength {} over {} samples",
+        brush.kind,
+        brush.radius,
+        brush.strength,
+        s.samples.len()
+    )
 }
 
 /// The exact checks after stroke `i` (`last`, as a stroke file, for the messages): a valid mesh,
@@ -307,26 +306,13 @@ fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
     }
 }
 
-/// The process's peak resident memory in bytes as Linux reports it (`VmHWM`).
-fn peak_memory() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: u64 = line[6..]
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
-    Some(kib * 1024)
-}
-
 /// The test process's peak memory stays under this, both scenes together: each session's
 /// history is capped at 512 MiB and each mesh at [`GROWTH_UNDONE`] times its faces at a check
 /// (the full soak's plaster peaked at 324 MB over 300 strokes; the short version at 44 MB).
 const MEMORY_BOUND: u64 = 3 << 30;
 
 fn check_memory(kind: SceneKind, i: usize) {
-    if let Some(peak) = peak_memory() {
+    if let Some(peak) = slayer::memory::peak_resident_bytes() {
         assert!(
             peak < MEMORY_BOUND,
             "{kind:?} stroke {i}: the process peaked at {peak} bytes"

@@ -310,7 +310,7 @@ impl Metrics {
             stroking_frames_drawn_from_engine_buffers: self.stroking_from_engine,
             longest_frame_work_ms: self.longest_frame_work,
             longest_frame_bytes_uploaded: self.longest_frame_uploaded,
-            peak_memory_mib: peak_memory_mib(),
+            peak_memory_mib: crate::memory::peak_resident_bytes().map(|b| b as f64 / 1048576.0),
             seconds: started.elapsed().as_secs_f64(),
         }
     }
@@ -329,12 +329,4 @@ impl Metrics {
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1000.0
-}
-
-/// The process's peak resident memory (Linux), MiB.
-fn peak_memory_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
 }

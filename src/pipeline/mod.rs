@@ -201,6 +201,9 @@ pub struct StrokeReport {
     pub touched: usize,
     /// What remeshing did, summed over the stroke's remeshing passes.
     pub remesh: RemeshReport,
+    /// The faces the stroke's remeshing was allowed to create
+    /// ([`PipelineSettings::new_faces_bound`] of the mesh it began on).
+    pub new_faces_bound: usize,
     /// Joins and splits of fuse layers after the stroke (`crate::topology`).
     pub topology: TopologyReport,
     pub phases: PhaseTimes,

@@ -169,6 +169,7 @@ impl<'a> StrokeInProgress<'a> {
                 splits_left: new_faces / 2,
                 report: StrokeReport {
                     phases,
+                    new_faces_bound: new_faces,
                     ..StrokeReport::default()
                 },
             }),
@@ -491,22 +492,19 @@ impl Active {
         let kind = self.stroke.brush.kind;
         self.start_grab_sample(probe.frame.motion);
         let held = self.held_by_grab(mesh, self.captured.as_ref(), (&probe, sample.normal));
-        let deformed = match held {
-            Some(held) => held,
-            None => {
-                let state = self.state();
-                let source = FrameSource::Selection {
-                    normal: sample.normal,
-                };
-                let at = CallAt::Start { sample: number };
-                if kind.deforms() {
-                    let limit = self.lengths.step_limit;
-                    kernels.select_deform_and_clamp(&state, mesh, &probe, (source, at), limit)
-                } else {
-                    kernels.select_and_deform(&state, mesh, &probe, (source, false))
-                }
+        let deformed = held.unwrap_or_else(|| {
+            let state = self.state();
+            let source = FrameSource::Selection {
+                normal: sample.normal,
+            };
+            let at = CallAt::Start { sample: number };
+            if kind.deforms() {
+                let limit = self.lengths.step_limit;
+                kernels.select_deform_and_clamp(&state, mesh, &probe, (source, at), limit)
+            } else {
+                kernels.select_and_deform(&state, mesh, &probe, (source, false))
             }
-        };
+        });
         if kind == BrushKind::Grab && self.captured.is_none() {
             self.captured = Some(deformed.selection.clone());
         }

@@ -109,14 +109,17 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let load_peak = slayer::memory::peak_bytes();
     slayer::memory::reset_peak();
     check_dabs(&strokes, args.max_dabs, &name)?;
-    let settings = PipelineSettings {
-        remeshing: args.remeshing,
-        max_dabs_per_stroke: args.max_dabs,
-        new_faces_per_stroke: args.max_new_faces,
-        cull: args.cull,
-        ..PipelineSettings::default()
-    };
-    let mut pipeline = crate::backend::choose(args.backend, settings)?.pipeline;
+    let mut pipeline = crate::backend::choose(
+        args.backend,
+        PipelineSettings {
+            remeshing: args.remeshing,
+            max_dabs_per_stroke: args.max_dabs,
+            new_faces_per_stroke: args.max_new_faces,
+            cull: args.cull,
+            ..PipelineSettings::default()
+        },
+    )?
+    .pipeline;
     // What is proportional to the mesh (the grid, per-vertex scratch) is built here, once,
     // and reported as set-up: a stroke's cost follows the brush.
     let started = std::time::Instant::now();
@@ -127,7 +130,6 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     let bar = Bar::new("sculpt", strokes.len() as u64);
     let mut reports: Vec<StrokeReport> = Vec::with_capacity(strokes.len());
     for (i, stroke) in strokes.iter().enumerate() {
-        let faces_before = session.mesh().live_face_count();
         let (report, recorded) = session
             .apply_stroke(&mut pipeline, stroke)
             .with_context(|| format!("{name}: strokes[{i}]"))?;
@@ -147,7 +149,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
         if report.remesh.growth_capped > 0 {
             bar.println(&format!(
                 "warning: strokes[{i}]: remeshing stopped splitting at {} new faces, the bound for one stroke (edges were left long; raise it with --max-new-faces)",
-                settings.new_faces_bound(faces_before)
+                report.new_faces_bound
             ));
         }
         reports.push(report);

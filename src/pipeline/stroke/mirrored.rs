@@ -73,13 +73,11 @@ impl Active {
             Side::Drawn => &self.captured,
             Side::Image => &self.captured_image,
         };
-        let deformed = match self.held_by_grab(mesh, captured.as_ref(), (&probe, normal)) {
-            Some(held) => held,
-            None => {
-                let how = (FrameSource::Selection { normal }, kind.deforms());
-                kernels.select_and_deform(&self.state(), mesh, &probe, how)
-            }
-        };
+        let held = self.held_by_grab(mesh, captured.as_ref(), (&probe, normal));
+        let deformed = held.unwrap_or_else(|| {
+            let how = (FrameSource::Selection { normal }, kind.deforms());
+            kernels.select_and_deform(&self.state(), mesh, &probe, how)
+        });
         if kind == BrushKind::Grab {
             let slot = match side {
                 Side::Drawn => &mut self.captured,
