@@ -280,7 +280,7 @@ fn crossings(
         if in_sheet(f) && region.single_layer() {
             return found;
         }
-        region.candidates(&box_f, scratch, |local| {
+        region.candidates_along(tri_f, scratch, |local| {
             let g = region.faces[local];
             if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
                 return;

@@ -7,7 +7,7 @@
 
 use glam::{IVec3, Vec3};
 
-use crate::geom::Aabb;
+use crate::geom::{Aabb, Polygon};
 
 /// Cells per axis at most for a grid of few faces; larger regions get larger cells…
 const MAX_CELLS_PER_AXIS: f32 = 64.0;
@@ -26,32 +26,32 @@ pub struct LocalFaceGrid {
     /// Local face indices (positions in the face list the grid was built from).
     entries: Vec<u32>,
     cursor: Vec<u32>,
+    /// [`LocalFaceGrid::build_swept`]'s cells of every face, face after face, and where each
+    /// face's end.
+    spill: Vec<u32>,
+    spill_ends: Vec<u32>,
 }
+
+/// A face where a step starts, and the box of its corners' moves over the step (holding zero):
+/// wherever its corners are along their moves, the face lies in the triangle swept by the box.
+#[derive(Debug, Clone, Copy)]
+pub struct SweptTriangle {
+    pub corners: [Vec3; 3],
+    pub moves: Aabb,
+}
+
+/// A face whose box spans more cells than this is filed only in the cells it can pass
+/// through: a surface stretched far past its edge length (a sweep dragging all of a sphere
+/// twenty of its radii) had faces a hundred edges long whose boxes covered 10⁴ cells each,
+/// 57 times the entries of the unstretched mesh, and every query met them.
+const SWEPT_ABOVE_CELLS: i32 = 8;
 
 impl LocalFaceGrid {
     /// Files `boxes[i]` (local face `i`) in every cell it overlaps. `region` bounds all boxes;
     /// `cell` is the preferred cell side.
     pub fn build(&mut self, boxes: &[Aabb], region: Aabb, cell: f32) {
-        let extent = (region.max - region.min).max(Vec3::splat(cell));
-        let axis_cap = MAX_CELLS_PER_AXIS.powi(3) as usize;
-        let mut cell = cell;
-        if boxes.len() * MAX_CELLS_PER_FACE <= axis_cap {
-            cell = cell.max(extent.max_element() / MAX_CELLS_PER_AXIS);
-        } else {
-            let cells = |cell: f32| {
-                let dims = (extent / cell).floor() + Vec3::ONE;
-                dims.x as f64 * dims.y as f64 * dims.z as f64
-            };
-            while cells(cell) > (boxes.len() * MAX_CELLS_PER_FACE) as f64 {
-                cell *= 1.25;
-            }
-        }
-        self.origin = region.min;
-        self.inv_cell = 1.0 / cell;
-        self.dims = ((extent * self.inv_cell).floor().as_ivec3() + IVec3::ONE).max(IVec3::ONE);
-        let cell_count = (self.dims.x * self.dims.y * self.dims.z) as usize;
-        self.offsets.clear();
-        self.offsets.resize(cell_count + 1, 0);
+        self.size(boxes.len(), region, cell);
+        let cell_count = self.offsets.len() - 1;
         for b in boxes {
             let (lo, hi) = self.cell_span(b);
             for z in lo.z..=hi.z {
@@ -86,6 +86,141 @@ impl LocalFaceGrid {
         self.cursor = cursor;
     }
 
+    /// Files local face `i` in the cells of `boxes[i]` that `swept[i]` can pass through (all
+    /// of them for a face of a few cells): a query box meets a face only where the face may
+    /// be. `region` bounds all boxes; `cell` is the preferred cell side.
+    pub fn build_swept(
+        &mut self,
+        boxes: &[Aabb],
+        swept: &[SweptTriangle],
+        region: Aabb,
+        cell: f32,
+    ) {
+        debug_assert_eq!(boxes.len(), swept.len(), "one swept face per box");
+        self.size(boxes.len(), region, cell);
+        let mut spill = std::mem::take(&mut self.spill);
+        let mut ends = std::mem::take(&mut self.spill_ends);
+        spill.clear();
+        ends.clear();
+        for (b, s) in boxes.iter().zip(swept) {
+            self.swept_cells(b, s, &mut spill);
+            ends.push(spill.len() as u32);
+        }
+        let cell_count = self.offsets.len() - 1;
+        for &c in &spill {
+            self.offsets[c as usize + 1] += 1;
+        }
+        for c in 0..cell_count {
+            self.offsets[c + 1] += self.offsets[c];
+        }
+        self.entries.clear();
+        self.entries.resize(self.offsets[cell_count] as usize, 0);
+        let mut cursor = std::mem::take(&mut self.cursor);
+        cursor.clear();
+        cursor.extend_from_slice(&self.offsets);
+        let mut start = 0;
+        for (i, &end) in ends.iter().enumerate() {
+            for &c in &spill[start..end as usize] {
+                self.entries[cursor[c as usize] as usize] = i as u32;
+                cursor[c as usize] += 1;
+            }
+            start = end as usize;
+        }
+        self.cursor = cursor;
+        self.spill = spill;
+        self.spill_ends = ends;
+    }
+
+    /// The cells of `b` (the box of `swept`) that the swept face can reach, into `out`. A
+    /// point `p + m` of it (`p` on the triangle, `m` in the move box) lies in cell (x, y, z)
+    /// only if `p` lies in that cell's z slab widened by the move box, and within it in the
+    /// y row widened likewise; the x cells then follow from that part's x range. Slabs are
+    /// widened by a slack above the clipping's rounding, and the border cells reach out to
+    /// infinity as [`LocalFaceGrid::cell_span`] clamps.
+    fn swept_cells(&self, b: &Aabb, swept: &SweptTriangle, out: &mut Vec<u32>) {
+        let (lo, hi) = self.cell_span(b);
+        let span = hi - lo + IVec3::ONE;
+        if span.x * span.y * span.z <= SWEPT_ABOVE_CELLS {
+            self.for_each_cell((lo, hi), |c, _| out.push(c as u32));
+            return;
+        }
+        let scale = b.min.abs().max(b.max.abs()).max_element();
+        let slack = 1e-3 / self.inv_cell + 8.0 * f32::EPSILON * scale;
+        let moves = swept.moves;
+        let triangle = Polygon::triangle(swept.corners);
+        for z in lo.z..=hi.z {
+            let (z0, z1) = self.slab(2, z, &moves, slack);
+            let in_z = triangle.within_slab(2, z0, z1);
+            let Some((y_lo, y_hi)) = in_z.range(1) else {
+                continue;
+            };
+            let rows = (y_lo + moves.min.y - slack, y_hi + moves.max.y + slack);
+            let rows = (
+                self.cell_of(1, rows.0).max(lo.y),
+                self.cell_of(1, rows.1).min(hi.y),
+            );
+            for y in rows.0..=rows.1 {
+                let (y0, y1) = self.slab(1, y, &moves, slack);
+                let Some((x_lo, x_hi)) = in_z.within_slab(1, y0, y1).range(0) else {
+                    continue;
+                };
+                let first = self.cell_of(0, x_lo + moves.min.x - slack).max(lo.x);
+                let last = self.cell_of(0, x_hi + moves.max.x + slack).min(hi.x);
+                for x in first..=last {
+                    out.push(self.index(IVec3::new(x, y, z)) as u32);
+                }
+            }
+        }
+    }
+
+    /// Where a point of a triangle must be along `axis` for the triangle moved by some `m` in
+    /// `moves` to reach cell row `k` there, give or take `slack`.
+    fn slab(&self, axis: usize, k: i32, moves: &Aabb, slack: f32) -> (f32, f32) {
+        let cell = 1.0 / self.inv_cell;
+        let lower = match k {
+            0 => f32::NEG_INFINITY,
+            _ => self.origin[axis] + k as f32 * cell,
+        };
+        let upper = match k == self.dims[axis] - 1 {
+            true => f32::INFINITY,
+            false => self.origin[axis] + (k + 1) as f32 * cell,
+        };
+        (
+            lower - moves.max[axis] - slack,
+            upper - moves.min[axis] + slack,
+        )
+    }
+
+    /// The cell row along `axis` holding `value`, clamped to the grid as queries are.
+    fn cell_of(&self, axis: usize, value: f32) -> i32 {
+        let row = ((value - self.origin[axis]) * self.inv_cell).max(0.0) as i32;
+        row.min(self.dims[axis] - 1)
+    }
+
+    /// Sizes the grid for `faces` boxes within `region`, all cells empty.
+    fn size(&mut self, faces: usize, region: Aabb, cell: f32) {
+        let extent = (region.max - region.min).max(Vec3::splat(cell));
+        let axis_cap = MAX_CELLS_PER_AXIS.powi(3) as usize;
+        let mut cell = cell;
+        if faces * MAX_CELLS_PER_FACE <= axis_cap {
+            cell = cell.max(extent.max_element() / MAX_CELLS_PER_AXIS);
+        } else {
+            let cells = |cell: f32| {
+                let dims = (extent / cell).floor() + Vec3::ONE;
+                dims.x as f64 * dims.y as f64 * dims.z as f64
+            };
+            while cells(cell) > (faces * MAX_CELLS_PER_FACE) as f64 {
+                cell *= 1.25;
+            }
+        }
+        self.origin = region.min;
+        self.inv_cell = 1.0 / cell;
+        self.dims = ((extent * self.inv_cell).floor().as_ivec3() + IVec3::ONE).max(IVec3::ONE);
+        let cell_count = (self.dims.x * self.dims.y * self.dims.z) as usize;
+        self.offsets.clear();
+        self.offsets.resize(cell_count + 1, 0);
+    }
+
     /// Calls `f` with every local face filed in a cell overlapping `query` (a face may come
     /// more than once; callers deduplicate).
     pub fn for_each_candidate(&self, query: &Aabb, mut f: impl FnMut(u32)) {
@@ -97,6 +232,29 @@ impl LocalFaceGrid {
                 f(e);
             }
         });
+    }
+
+    /// Calls `f` with every local face filed in a cell that `swept` (whose box is `query`)
+    /// can pass through, as [`LocalFaceGrid::build_swept`] files faces (`cells` is scratch; a
+    /// face may come more than once): what can meet a long face, without the whole of its box.
+    pub fn for_each_candidate_along(
+        &self,
+        query: &Aabb,
+        swept: &SweptTriangle,
+        cells: &mut Vec<u32>,
+        mut f: impl FnMut(u32),
+    ) {
+        if self.offsets.is_empty() {
+            return;
+        }
+        cells.clear();
+        self.swept_cells(query, swept, cells);
+        for &c in cells.iter() {
+            let c = c as usize;
+            for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                f(e);
+            }
+        }
     }
 
     /// Calls `f` once with every local face filed in a cell overlapping `query` (`boxes` the
@@ -169,5 +327,108 @@ impl LocalFaceGrid {
     #[inline]
     fn index(&self, c: IVec3) -> usize {
         ((c.z * self.dims.y + c.y) * self.dims.x + c.x) as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn point(scale: f32) -> impl Strategy<Value = Vec3> {
+        let axis = move || -scale..scale;
+        (axis(), axis(), axis()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    /// Faces of a few cells' size and faces stretched across the grid, each moving or not.
+    fn swept_face() -> impl Strategy<Value = SweptTriangle> {
+        let size = prop_oneof![Just(0.05f32), Just(2.0f32)];
+        (
+            size,
+            point(1.0),
+            point(1.0),
+            point(1.0),
+            prop::option::of(point(0.1)),
+        )
+            .prop_map(|(size, at, a, b, moved)| {
+                let corners = [at, at + a * size, at + b * size];
+                let moves = Aabb::EMPTY.including(Vec3::ZERO);
+                let moves = moved.map_or(moves, |m| moves.including(m).including(-0.5 * m));
+                SweptTriangle { corners, moves }
+            })
+    }
+
+    fn swept_box(s: &SweptTriangle) -> Aabb {
+        let start = Aabb::of_points(&s.corners);
+        Aabb {
+            min: start.min + s.moves.min,
+            max: start.max + s.moves.max,
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// Every point a swept face can take (a point of the triangle moved by anything in its
+        /// move box) is in a cell the face is filed in, so a query box around it meets the face;
+        /// the faces stretched across the grid are filed in fewer cells than their boxes cover.
+        #[test]
+        fn a_swept_face_is_filed_wherever_it_can_be(
+            faces in prop::collection::vec(swept_face(), 1..12),
+            picks in prop::collection::vec((0.0f32..=1.0, 0.0f32..=1.0, point(1.0)), 32),
+        ) {
+            let boxes: Vec<Aabb> = faces.iter().map(swept_box).collect();
+            let region = boxes.iter().fold(Aabb::EMPTY, |b, f| b.including_box(f));
+            let mut grid = LocalFaceGrid::default();
+            grid.build_swept(&boxes, &faces, region, 0.02);
+            for (i, face) in faces.iter().enumerate() {
+                let [a, b, c] = face.corners;
+                for &(u, v, m) in &picks {
+                    let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                    let on_triangle = a + (b - a) * u + (c - a) * v;
+                    let m = (m * 0.5 + Vec3::splat(0.5)) * (face.moves.max - face.moves.min);
+                    let p = on_triangle + face.moves.min + m;
+                    let mut met = false;
+                    grid.for_each_candidate(&Aabb { min: p, max: p }, |e| met |= e == i as u32);
+                    prop_assert!(met, "face {i} not filed where it reaches {p}");
+                }
+            }
+            let mut box_cells = 0;
+            for b in &boxes {
+                let (lo, hi) = grid.cell_span(b);
+                let span = hi - lo + IVec3::ONE;
+                box_cells += span.x * span.y * span.z;
+            }
+            prop_assert!(grid.entries.len() <= box_cells as usize);
+        }
+    }
+
+    /// A face sixty cells long across the grid's diagonal is filed along its length, not in
+    /// every cell of its box.
+    #[test]
+    fn a_long_diagonal_face_is_filed_along_its_length() {
+        let face = SweptTriangle {
+            corners: [
+                Vec3::ZERO,
+                Vec3::new(2.0, 2.0, 0.0),
+                Vec3::new(2.01, 1.99, 0.0),
+            ],
+            moves: Aabb::EMPTY.including(Vec3::ZERO),
+        };
+        let boxes = [Aabb::of_points(&face.corners)];
+        let mut grid = LocalFaceGrid::default();
+        grid.build_swept(&boxes, &[face], boxes[0].expanded(0.1), 0.02);
+        let (lo, hi) = grid.cell_span(&boxes[0]);
+        let span = hi - lo + IVec3::ONE;
+        let box_cells = (span.x * span.y * span.z) as usize;
+        assert!(box_cells > 3_000, "{box_cells} cells in the box");
+        assert!(
+            grid.entries.len() < box_cells / 10,
+            "{} cells filed",
+            grid.entries.len()
+        );
+        let mut met = false;
+        let far_corner = Aabb::of_points(&[Vec3::new(1.99, 0.01, 0.0)]);
+        grid.for_each_candidate(&far_corner, |_| met = true);
+        assert!(!met, "the empty corner of the box holds the face");
     }
 }

@@ -25,7 +25,7 @@ pub use gap::smallest_layer_gap;
 pub use intersections::{
     IntersectingPair, IntersectionReport, find_intersections, find_intersections_in,
 };
-pub use local_grid::LocalFaceGrid;
+pub use local_grid::{LocalFaceGrid, SweptTriangle};
 pub use region::{Region, Scratch, StepMoves};
 pub use response::{
     CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, collide, collide_with, pull_back,

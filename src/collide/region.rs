@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::rings::RingCache;
 use super::sheet::Cone;
 use super::state::StrokeState;
-use super::{LocalFaceGrid, Stamps};
+use super::{LocalFaceGrid, Stamps, SweptTriangle};
 use crate::geom::Aabb;
 use crate::mesh::{INVALID, Mesh};
 
@@ -23,6 +23,7 @@ pub struct Scratch {
     seen: Stamps,
     pub(super) ring: Vec<u32>,
     pub(super) nearby: Vec<u32>,
+    cells: Vec<u32>,
 }
 
 /// Maps `f` over `items`, in parallel or not, with per-thread scratch.
@@ -50,6 +51,8 @@ pub struct Region {
     pub(super) faces: Vec<u32>,
     /// Per local face: box of its old and target positions.
     pub(super) boxes: Vec<Aabb>,
+    /// Per local face: where it starts and how its corners move (filed by it, not its box).
+    swept: Vec<SweptTriangle>,
     grid: LocalFaceGrid,
     use_grid: bool,
     /// The local grid's cell side (none without a global grid), and whether the faces are
@@ -92,6 +95,7 @@ struct ChangedFaces {
     /// Local face indices, ascending.
     faces: Vec<u32>,
     boxes: Vec<Aabb>,
+    swept: Vec<SweptTriangle>,
     grid: LocalFaceGrid,
     /// Filed for the pass under way.
     filed: bool,
@@ -198,18 +202,29 @@ impl Region {
         let (_, targets, target_of) = moves;
         let positions = mesh.positions();
         self.boxes.clear();
-        self.boxes.extend(self.faces.iter().map(|&f| {
-            mesh.faces()[f as usize]
-                .iter()
-                .fold(Aabb::EMPTY, |b, &v| match target_of[v as usize] {
-                    INVALID => b.including(positions[v as usize]),
-                    slot => b
-                        .including(before[slot as usize])
-                        .including(targets[slot as usize]),
-                })
-        }));
+        self.swept.clear();
+        for &f in &self.faces {
+            let mut corners = [Vec3::ZERO; 3];
+            let mut moves = Aabb::EMPTY.including(Vec3::ZERO);
+            let mut swept_box = Aabb::EMPTY;
+            for (corner, &v) in corners.iter_mut().zip(&mesh.faces()[f as usize]) {
+                *corner = match target_of[v as usize] {
+                    INVALID => positions[v as usize],
+                    slot => {
+                        let (start, target) = (before[slot as usize], targets[slot as usize]);
+                        swept_box = swept_box.including(target);
+                        moves = moves.including(target - start);
+                        start
+                    }
+                };
+                swept_box = swept_box.including(*corner);
+            }
+            self.boxes.push(swept_box);
+            self.swept.push(SweptTriangle { corners, moves });
+        }
         if let Some(cell) = self.cell {
-            self.grid.build(&self.boxes, self.reach, cell);
+            self.grid
+                .build_swept(&self.boxes, &self.swept, self.reach, cell);
         }
         self.filed = true;
     }
@@ -325,10 +340,14 @@ impl Region {
             .faces
             .extend((0..marks.len() as u32).filter(|&l| marks[l as usize]));
         changed.boxes.clear();
-        let boxes = changed.faces.iter().map(|&l| self.boxes[l as usize]);
-        changed.boxes.extend(boxes);
+        changed.swept.clear();
+        for &l in &changed.faces {
+            changed.boxes.push(self.boxes[l as usize]);
+            changed.swept.push(self.swept[l as usize]);
+        }
         if let Some(cell) = self.cell {
-            changed.grid.build(&changed.boxes, self.reach, cell);
+            let (boxes, swept) = (&changed.boxes, &changed.swept);
+            changed.grid.build_swept(boxes, swept, self.reach, cell);
         }
     }
 
@@ -363,6 +382,36 @@ impl Region {
                 }
             }
         }
+    }
+
+    /// Local faces whose box overlaps `triangle`'s box and that are filed where `triangle`
+    /// passes, each once: those that can cross it.
+    pub(super) fn candidates_along(
+        &self,
+        triangle: [Vec3; 3],
+        scratch: &mut Scratch,
+        mut f: impl FnMut(usize),
+    ) {
+        debug_assert!(self.filed, "a search before the faces were filed");
+        let query = Aabb::of_points(&triangle);
+        if !self.use_grid {
+            return self.candidates(&query, scratch, f);
+        }
+        let swept = SweptTriangle {
+            corners: triangle,
+            moves: Aabb::EMPTY.including(Vec3::ZERO),
+        };
+        scratch.seen.start(self.faces.len());
+        let mut cells = std::mem::take(&mut scratch.cells);
+        self.grid
+            .for_each_candidate_along(&query, &swept, &mut cells, |local| {
+                if scratch.seen.insert(local as usize)
+                    && self.boxes[local as usize].overlaps(&query)
+                {
+                    f(local as usize);
+                }
+            });
+        scratch.cells = cells;
     }
 
     /// Local faces whose box overlaps `query`, each once.

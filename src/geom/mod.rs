@@ -7,6 +7,7 @@ mod fan;
 mod order_free;
 mod ray;
 mod separation;
+mod slab;
 mod tri_tri;
 
 pub use closest_point::{
@@ -16,6 +17,7 @@ pub use fan::fan_projects_one_to_one;
 pub use order_free::{corner_cross, fan_normal, order_free_sum};
 pub use ray::{Ray, ray_triangle};
 pub use separation::surely_disjoint;
+pub use slab::Polygon;
 pub use tri_tri::{neighbours_overlap, triangles_intersect};
 
 use glam::Vec3;
