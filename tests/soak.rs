@@ -13,6 +13,14 @@
 //! `SLAYER_SOAK_TRACE=1` prints each stroke (as a stroke file) before it runs;
 //! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N` and the stroke into `DIR`
 //! (`SLAYER_SOAK_DUMP=each:DIR` before every stroke, over the last, to catch one that never ends).
+//! `SLAYER_SOAK_CHECKPOINT=DIR` saves each scene's run at every check and takes it up from
+//! there the next time (`checkpoint`): the full soak over several sittings. A run taken up
+//! goes on with the same random stream on the saved session, history included, but with its
+//! pipeline set up afresh as a new process's is, so it need not match an unbroken run to the
+//! bit.
+
+#[path = "soak/checkpoint.rs"]
+mod checkpoint;
 
 use std::time::Instant;
 
@@ -25,6 +33,8 @@ use slayer::mesh::Mesh;
 use slayer::pipeline::{Pipeline, PipelineSettings};
 use slayer::scene::{SceneKind, SceneSpec, generate};
 use slayer::session::Session;
+
+use checkpoint::Progress;
 
 /// Strokes between exact checks (`SLAYER_SOAK_CHECK_EVERY` to narrow a failure down).
 fn check_every() -> usize {
@@ -116,14 +126,24 @@ fn soak(kind: SceneKind, seed: u64) {
     })
     .unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut session = Session::new(input.clone());
-    let mut pipeline = Pipeline::new(PipelineSettings::default());
-    let (mut refused, mut collisions, mut slowest) = (0usize, 0usize, (0.0f64, String::new()));
-    let mut undone = 0;
+    let checkpoints = checkpoint::folder();
+    let (mut session, mut progress) = begin(
+        checkpoints.as_deref(),
+        kind,
+        (strokes, faces),
+        &input,
+        &mut rng,
+    );
+    // A run taken up holds the edge length its first stroke measured, as the run did.
+    let mut pipeline = Pipeline::new(PipelineSettings {
+        edge_length: progress.edge_length_bits.map(f32::from_bits),
+        ..PipelineSettings::default()
+    });
     let faces_at_start = input.live_face_count();
     let edge_at_start = input.mean_edge_length();
+    let (dropped_earlier, seconds_earlier) = (progress.dropped, progress.seconds);
     let soak_started = Instant::now();
-    for i in 0..count {
+    for i in progress.next..count {
         let spec = random_stroke(session.mesh(), &mut rng);
         let file = StrokeFile {
             version: 1,
@@ -131,66 +151,30 @@ fn soak(kind: SceneKind, seed: u64) {
             fuse: Vec::new(),
         };
         let as_json = serde_json::to_string(&file).unwrap_or_default();
-        // A stroke refused before it runs still reaches the check below (skipping it there
-        // skipped the check whenever the stroke at a check's turn was refused).
-        'stroke: {
-            let strokes = match file.resolve(session.mesh(), "soak") {
-                Ok(strokes) => strokes,
-                Err(_) => {
-                    refused += 1;
-                    break 'stroke;
-                }
-            };
-            if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
-                eprintln!("stroke {i}: {as_json}");
-            }
-            dump_before(i, session.mesh(), &as_json);
-            let started = Instant::now();
-            let faces_before = session.mesh().live_face_count();
-            let phases = match session.apply_stroke(&mut pipeline, &strokes[0]) {
-                Ok((report, _)) => {
-                    collisions += report.clamped;
-                    // The stroke's bound on the faces its remeshing creates (two a split at
-                    // most), which also bounds its time: a crease over all of the plaster
-                    // once crumpled it from 53K to 212K faces in 2 minutes.
-                    let bound = PipelineSettings::default().new_faces_bound(faces_before);
-                    assert!(
-                        2 * report.remesh.splits <= bound,
-                        "{kind:?} stroke {i}: {} splits, the bound {bound} faces: {as_json}",
-                        report.remesh.splits
-                    );
-                    Some(report.phases)
-                }
-                Err(_) => {
-                    refused += 1;
-                    None
-                }
-            };
-            let seconds = started.elapsed().as_secs_f64();
-            if seconds > 2.0 {
-                let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
-                eprintln!(
-                    "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {}",
-                    collision / 1e3,
-                    remesh / 1e3,
-                    describe(&strokes[0])
-                );
-            }
-            if seconds > slowest.0 {
-                slowest = (seconds, describe(&strokes[0]));
-            }
-        }
-        if (i + 1) % check_every() == 0 || i + 1 == count {
+        run_stroke(
+            kind,
+            (i, &file, &as_json),
+            &mut session,
+            &mut pipeline,
+            &mut progress,
+        );
+        progress.seconds = seconds_earlier + soak_started.elapsed().as_secs_f64();
+        progress.dropped = dropped_earlier + session.history().dropped();
+        let checked = (i + 1) % check_every() == 0 || i + 1 == count;
+        if checked {
             let mesh = session.mesh();
             if count > SHORT_STROKES / 2 {
                 // The full version runs for hours: say how far it has come.
                 eprintln!(
-                    "{kind:?}: {} strokes in {:.0} s, {} faces, {collisions} collisions, {refused} refused, {undone} undone (history {:.1} MiB, {} entries dropped)",
+                    "{kind:?}: {} strokes in {:.0} s, {} faces, {} collisions, {} refused, {} undone (history {:.1} MiB, {} entries dropped)",
                     i + 1,
-                    soak_started.elapsed().as_secs_f64(),
+                    progress.seconds,
                     mesh.live_face_count(),
+                    progress.collisions,
+                    progress.refused,
+                    progress.undone,
                     session.history().bytes() as f64 / 1048576.0,
-                    session.history().dropped()
+                    progress.dropped
                 );
             }
             let start = (faces_at_start, edge_at_start);
@@ -199,28 +183,127 @@ fn soak(kind: SceneKind, seed: u64) {
         }
         // After every stroke, not only at checks: 100 strokes took the 20K sphere to 148K
         // faces between two checks, and each stroke grew slower with it.
-        undone += undo_growth(&mut session, faces_at_start);
+        progress.undone += undo_growth(&mut session, faces_at_start);
+        if let (true, Some(dir)) = (checked, &checkpoints) {
+            progress.next = i + 1;
+            progress.digest = session.mesh().digest();
+            progress.word_pos = rng.get_word_pos().to_string();
+            progress.edge_length_bits = pipeline.edge_length().map(f32::to_bits);
+            checkpoint::save(dir, kind, &session, &progress);
+        }
     }
-    eprintln!(
-        "{kind:?}: {count} strokes, {refused} refused, {collisions} collisions, {undone} undone to keep the size, slowest {:.2} s ({}), {} → {} faces, history {:.1} MiB, peak memory of the test process {}",
-        slowest.0,
-        slowest.1,
-        faces_at_start,
-        session.mesh().live_face_count(),
-        session.history().bytes() as f64 / 1048576.0,
-        slayer::memory::peak_resident_bytes().map_or("unknown".into(), |b| format!(
-            "{:.0} MiB",
-            b as f64 / 1048576.0
-        ))
-    );
+    print_summary(kind, count, &progress, &session, faces_at_start);
     while session.undo().is_some() {}
-    if session.history().dropped() == 0 {
+    if progress.dropped == 0 {
         assert_eq!(
             session.mesh().digest(),
             input.digest(),
             "{kind:?}: undo all"
         );
     }
+}
+
+/// The session and progress the run starts from: its checkpoint's, if `folder` holds one for
+/// a soak of this size, with `rng` moved on to where it stood; else `input`, at stroke 0.
+fn begin(
+    folder: Option<&std::path::Path>,
+    kind: SceneKind,
+    (strokes, faces): (usize, usize),
+    input: &Mesh,
+    rng: &mut ChaCha8Rng,
+) -> (Session, Progress) {
+    match folder.and_then(|dir| checkpoint::resume(dir, kind, strokes, faces)) {
+        Some((session, progress)) => {
+            eprintln!("{kind:?}: taken up at stroke {}", progress.next);
+            rng.set_word_pos(progress.word_pos.parse().unwrap());
+            (session, progress)
+        }
+        None => (Session::new(input.clone()), Progress::new(strokes, faces)),
+    }
+}
+
+/// Runs stroke `i` (`file`, `as_json` for messages) through the session, counting it in
+/// `progress`: refused (before it runs or by the pipeline), its collisions, its time. A stroke
+/// must stay within its bound of new faces.
+fn run_stroke(
+    kind: SceneKind,
+    (i, file, as_json): (usize, &StrokeFile, &str),
+    session: &mut Session,
+    pipeline: &mut Pipeline,
+    progress: &mut Progress,
+) {
+    let Ok(strokes) = file.resolve(session.mesh(), "soak") else {
+        progress.refused += 1;
+        return;
+    };
+    if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
+        eprintln!("stroke {i}: {as_json}");
+    }
+    dump_before(i, session.mesh(), as_json);
+    let started = Instant::now();
+    let faces_before = session.mesh().live_face_count();
+    let phases = match session.apply_stroke(pipeline, &strokes[0]) {
+        Ok((report, _)) => {
+            progress.collisions += report.clamped;
+            // The stroke's bound on the faces its remeshing creates (two a split at most),
+            // which also bounds its time: a crease over all of the plaster once crumpled it
+            // from 53K to 212K faces in 2 minutes.
+            let bound = PipelineSettings::default().new_faces_bound(faces_before);
+            assert!(
+                2 * report.remesh.splits <= bound,
+                "{kind:?} stroke {i}: {} splits, the bound {bound} faces: {as_json}",
+                report.remesh.splits
+            );
+            Some(report.phases)
+        }
+        Err(_) => {
+            progress.refused += 1;
+            None
+        }
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    if seconds > 2.0 {
+        let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
+        eprintln!(
+            "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {}",
+            collision / 1e3,
+            remesh / 1e3,
+            describe(&strokes[0])
+        );
+    }
+    if seconds > progress.slowest_seconds {
+        progress.slowest_seconds = seconds;
+        progress.slowest = describe(&strokes[0]);
+    }
+}
+
+/// The soak's figures for one scene, printed at its end.
+fn print_summary(
+    kind: SceneKind,
+    count: usize,
+    progress: &Progress,
+    session: &Session,
+    faces_at_start: usize,
+) {
+    let peak = slayer::memory::peak_resident_bytes();
+    eprintln!(
+        "{kind:?}: {count} strokes in {:.0} s, {} refused, {} collisions, {} undone to keep the size, slowest {:.2} s ({}), {} → {} faces (digest {}), history {:.1} MiB, {} entries dropped, peak memory of the test process {}",
+        progress.seconds,
+        progress.refused,
+        progress.collisions,
+        progress.undone,
+        progress.slowest_seconds,
+        progress.slowest,
+        faces_at_start,
+        session.mesh().live_face_count(),
+        &session.mesh().digest()[..16],
+        session.history().bytes() as f64 / 1048576.0,
+        progress.dropped,
+        peak.map_or("unknown".into(), |b| format!(
+            "{:.0} MiB",
+            b as f64 / 1048576.0
+        ))
+    );
 }
 
 /// A stroke in a few words, for the printout of slow strokes.
@@ -328,4 +411,54 @@ fn random_strokes_on_plaster_keep_it_sound() {
 #[test]
 fn random_strokes_on_a_closed_sphere_keep_it_sound() {
     soak(SceneKind::Sphere, 43);
+}
+
+/// A checkpoint gives back the session (mesh and history) and progress it saved, and the
+/// random stream goes on from where it stood.
+#[test]
+fn a_checkpoint_takes_a_run_up_where_it_stood() {
+    let input = generate(&SceneSpec {
+        kind: SceneKind::Sphere,
+        triangles: 500,
+        seed: 9,
+    })
+    .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut session = Session::new(input.clone());
+    let mut pipeline = Pipeline::new(PipelineSettings::default());
+    let mut progress = Progress::new(10, 500);
+    for i in 0..3 {
+        let file = StrokeFile {
+            version: 1,
+            strokes: vec![random_stroke(session.mesh(), &mut rng)],
+            fuse: Vec::new(),
+        };
+        run_stroke(
+            SceneKind::Sphere,
+            (i, &file, ""),
+            &mut session,
+            &mut pipeline,
+            &mut progress,
+        );
+    }
+    progress.next = 3;
+    progress.digest = session.mesh().digest();
+    progress.word_pos = rng.get_word_pos().to_string();
+    let dir = std::env::temp_dir().join(format!("slayer-soak-checkpoint-{}", std::process::id()));
+    checkpoint::save(&dir, SceneKind::Sphere, &session, &progress);
+    let (mut taken_up, saved) = checkpoint::resume(&dir, SceneKind::Sphere, 10, 500).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(taken_up.mesh().digest(), session.mesh().digest());
+    assert_eq!(taken_up.history().done(), session.history().done());
+    assert!(taken_up.history().done() > 0, "no stroke ran");
+    assert_eq!(
+        (saved.next, saved.refused, saved.collisions),
+        (3, progress.refused, progress.collisions)
+    );
+    let mut again = ChaCha8Rng::seed_from_u64(7);
+    again.set_word_pos(saved.word_pos.parse().unwrap());
+    let next: u64 = rng.random();
+    assert_eq!(again.random::<u64>(), next);
+    while taken_up.undo().is_some() {}
+    assert_eq!(taken_up.mesh().digest(), input.digest());
 }
