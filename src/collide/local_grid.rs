@@ -27,7 +27,7 @@ pub struct LocalFaceGrid {
     entries: Vec<u32>,
     cursor: Vec<u32>,
     /// [`LocalFaceGrid::build_swept`]'s cells of every face, face after face, and where each
-    /// face's end.
+    /// face's cells end.
     spill: Vec<u32>,
     spill_ends: Vec<u32>,
 }
@@ -42,7 +42,7 @@ pub struct SweptTriangle {
 
 /// A face whose box spans more cells than this is filed only in the cells it can pass
 /// through: a surface stretched far past its edge length (a sweep dragging all of a sphere
-/// twenty of its radii) had faces a hundred edges long whose boxes covered 10⁴ cells each,
+/// nine of its radii) had faces up to 135 edges long whose boxes covered up to 10⁴ cells,
 /// 57 times the entries of the unstretched mesh, and every query met them.
 const SWEPT_ABOVE_CELLS: i32 = 8;
 
@@ -51,7 +51,6 @@ impl LocalFaceGrid {
     /// `cell` is the preferred cell side.
     pub fn build(&mut self, boxes: &[Aabb], region: Aabb, cell: f32) {
         self.size(boxes.len(), region, cell);
-        let cell_count = self.offsets.len() - 1;
         for b in boxes {
             let (lo, hi) = self.cell_span(b);
             for z in lo.z..=hi.z {
@@ -63,14 +62,7 @@ impl LocalFaceGrid {
                 }
             }
         }
-        for c in 0..cell_count {
-            self.offsets[c + 1] += self.offsets[c];
-        }
-        self.entries.clear();
-        self.entries.resize(self.offsets[cell_count] as usize, 0);
-        let mut cursor = std::mem::take(&mut self.cursor);
-        cursor.clear();
-        cursor.extend_from_slice(&self.offsets);
+        let mut cursor = self.counted();
         for (i, b) in boxes.iter().enumerate() {
             let (lo, hi) = self.cell_span(b);
             for z in lo.z..=hi.z {
@@ -106,18 +98,10 @@ impl LocalFaceGrid {
             self.swept_cells(b, s, &mut spill);
             ends.push(spill.len() as u32);
         }
-        let cell_count = self.offsets.len() - 1;
         for &c in &spill {
             self.offsets[c as usize + 1] += 1;
         }
-        for c in 0..cell_count {
-            self.offsets[c + 1] += self.offsets[c];
-        }
-        self.entries.clear();
-        self.entries.resize(self.offsets[cell_count] as usize, 0);
-        let mut cursor = std::mem::take(&mut self.cursor);
-        cursor.clear();
-        cursor.extend_from_slice(&self.offsets);
+        let mut cursor = self.counted();
         let mut start = 0;
         for (i, &end) in ends.iter().enumerate() {
             for &c in &spill[start..end as usize] {
@@ -195,6 +179,21 @@ impl LocalFaceGrid {
     fn cell_of(&self, axis: usize, value: f32) -> i32 {
         let row = ((value - self.origin[axis]) * self.inv_cell).max(0.0) as i32;
         row.min(self.dims[axis] - 1)
+    }
+
+    /// Once `offsets[c + 1]` holds how many entries cell `c` gets: turns the counts into
+    /// offsets, sizes the entries, and returns where each cell's next entry goes.
+    fn counted(&mut self) -> Vec<u32> {
+        let cell_count = self.offsets.len() - 1;
+        for c in 0..cell_count {
+            self.offsets[c + 1] += self.offsets[c];
+        }
+        self.entries.clear();
+        self.entries.resize(self.offsets[cell_count] as usize, 0);
+        let mut cursor = std::mem::take(&mut self.cursor);
+        cursor.clear();
+        cursor.extend_from_slice(&self.offsets);
+        cursor
     }
 
     /// Sizes the grid for `faces` boxes within `region`, all cells empty.
