@@ -40,6 +40,22 @@ pub struct SweptTriangle {
     pub moves: Aabb,
 }
 
+impl SweptTriangle {
+    /// No move: a face at rest.
+    pub const NO_MOVE: Aabb = Aabb {
+        min: Vec3::ZERO,
+        max: Vec3::ZERO,
+    };
+
+    /// A face that does not move.
+    pub fn at_rest(corners: [Vec3; 3]) -> SweptTriangle {
+        SweptTriangle {
+            corners,
+            moves: SweptTriangle::NO_MOVE,
+        }
+    }
+}
+
 /// A face whose box spans more cells than this is filed only in the cells it can pass
 /// through: a surface stretched far past its edge length (a sweep dragging all of a sphere
 /// nine of its radii) had faces up to 135 edges long whose boxes covered up to 10⁴ cells,
@@ -351,7 +367,7 @@ mod tests {
         )
             .prop_map(|(size, at, a, b, moved)| {
                 let corners = [at, at + a * size, at + b * size];
-                let moves = Aabb::EMPTY.including(Vec3::ZERO);
+                let moves = SweptTriangle::NO_MOVE;
                 let moves = moved.map_or(moves, |m| moves.including(m).including(-0.5 * m));
                 SweptTriangle { corners, moves }
             })
@@ -405,14 +421,11 @@ mod tests {
     /// every cell of its box.
     #[test]
     fn a_long_diagonal_face_is_filed_along_its_length() {
-        let face = SweptTriangle {
-            corners: [
-                Vec3::ZERO,
-                Vec3::new(2.0, 2.0, 0.0),
-                Vec3::new(2.01, 1.99, 0.0),
-            ],
-            moves: Aabb::EMPTY.including(Vec3::ZERO),
-        };
+        let face = SweptTriangle::at_rest([
+            Vec3::ZERO,
+            Vec3::new(2.0, 2.0, 0.0),
+            Vec3::new(2.01, 1.99, 0.0),
+        ]);
         let boxes = [Aabb::of_points(&face.corners)];
         let mut grid = LocalFaceGrid::default();
         grid.build_swept(&boxes, &[face], boxes[0].expanded(0.1), 0.02);

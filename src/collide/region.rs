@@ -205,7 +205,7 @@ impl Region {
         self.swept.clear();
         for &f in &self.faces {
             let mut corners = [Vec3::ZERO; 3];
-            let mut moves = Aabb::EMPTY.including(Vec3::ZERO);
+            let mut moves = SweptTriangle::NO_MOVE;
             let mut swept_box = Aabb::EMPTY;
             for (corner, &v) in corners.iter_mut().zip(&mesh.faces()[f as usize]) {
                 *corner = match target_of[v as usize] {
@@ -397,10 +397,7 @@ impl Region {
         if !self.use_grid {
             return self.candidates(&query, scratch, f);
         }
-        let swept = SweptTriangle {
-            corners: triangle,
-            moves: Aabb::EMPTY.including(Vec3::ZERO),
-        };
+        let swept = SweptTriangle::at_rest(triangle);
         scratch.seen.start(self.faces.len());
         let mut cells = std::mem::take(&mut scratch.cells);
         self.grid
