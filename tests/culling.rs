@@ -3,7 +3,8 @@
 //! Every stroke here runs twice, culled and not, on shapes chosen to break a careless bound —
 //! a sheet folded back onto itself, a crumpled one, pinched, twisted and creased ones, a closed
 //! sphere and a layered material with remeshing on — and must end bit-identical, with the same
-//! clamps and undos. The flat sheet shows the culling acts at all.
+//! clamps and undos. The flat sheet shows the culling acts at all, the steep ridge that it
+//! acts where a sheet's bound on proximity fails.
 
 use glam::Vec3;
 use slayer::bench::{BrushMix, ScriptSpec, generate_script};
@@ -167,6 +168,46 @@ fn a_sheet_folded_onto_itself_collides_the_same() {
     assert!(
         run.clamped > 0,
         "the fold must collide with itself: {run:?}"
+    );
+}
+
+#[test]
+fn a_steep_ridge_is_a_sheet_whose_crossings_are_not_searched() {
+    // A ridge across the sheet with flanks at up to 58°: its normals fit in a cone well
+    // under 90°, so it projects one-to-one (a sheet), but too wide a cone for the bound
+    // that clears the proximity clamp's search (cos θ·(r + 1)·ρ ≥ d). Draws along its crest
+    // (the bench's plane after a few passes over the same rows) then skip the backstop's
+    // search and still run the clamp's.
+    let flat = scene(SceneKind::Plane, 6_000);
+    let mesh = reshaped(flat, |u, v| {
+        let across = (u - 0.5) / 0.1;
+        Vec3::new(u, v, 0.17 * (-across * across).exp())
+    });
+    let along_the_crest = |x: f32| Stroke {
+        paint: None,
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius: 0.15,
+            strength: 0.3,
+            falloff: Falloff::Smooth,
+            invert: false,
+        },
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        samples: (0..12)
+            .map(|k| Sample {
+                position: Vec3::new(x, 0.3 + 0.4 * k as f32 / 11.0, 0.17),
+                pressure: 1.0,
+                normal: None,
+            })
+            .collect(),
+    };
+    let strokes: Vec<Stroke> = [0.5, 0.47, 0.53].map(along_the_crest).into();
+    let run = assert_culling_changes_nothing("steep ridge", &mesh, &strokes, Remeshing::Off);
+    assert!(
+        run.culled_steps * 2 > run.steps,
+        "a ridge is a sheet: {run:?}"
     );
 }
 

@@ -5,9 +5,9 @@
 //! predicates (`crate::geom`) decide them.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::region::{Region, StepMoves, map_with_scratch, start_position, triangle};
-use super::sheet;
 use super::state::StrokeState;
 use crate::geom::{Aabb, neighbours_overlap, triangles_intersect};
 use crate::mesh::{INVALID, Mesh};
@@ -77,10 +77,11 @@ pub(super) fn undo_crossings(
                 }
                 region.find_sheets(state, mesh);
                 let all_local = moving_faces.iter().all(|&f| region.local(f).is_some());
-                if region.worth_searching() || !all_local {
+                if region.worth_searching_crossings() || !all_local {
                     region.file_faces(mesh, moves, before);
                 }
-                let kept = kept_orientation(state, region, mesh, (target_of, before));
+                let kept =
+                    kept_orientation(state, region, mesh, &moving_faces, (target_of, before));
                 crossings(
                     state,
                     region,
@@ -160,22 +161,33 @@ fn gather_from_start(
     }
 }
 
-/// Per layer id: whether the layer is a sheet in the region whose faces all kept their
-/// orientation since the step's start (`super::sheet::kept_orientation`).
+/// Per layer id: whether the layer is a sheet in the region none of whose `moving_faces`
+/// turned over in the step. Only those faces are searched, and only their turning over can
+/// make a pair within a sheet (two faces of a sheet never meet beyond what they share,
+/// `super::sheet`): where this holds, a search of them finds nothing, so it is skipped.
 fn kept_orientation(
     state: &StrokeState<'_>,
     region: &Region,
     mesh: &Mesh,
+    moving_faces: &[u32],
     (target_of, before): (&[u32], &[Vec3]),
 ) -> Vec<bool> {
+    let layers = mesh.face_layers();
     let mut kept = vec![false; mesh.layer_count()];
     for (layer, kept) in kept.iter_mut().enumerate() {
-        let Some(cone) = region.sheet_cone(layer as u32) else {
+        if !region.is_sheet(layer as u32) {
             continue;
+        }
+        let turned = |&f: &u32| {
+            layers[f as usize] == layer as u32
+                && region.local(f).is_some()
+                && turned_over(mesh, f, target_of, before)
         };
-        let faces = sheet::faces_of_layer(mesh, region, layer as u32);
-        let start = |v: u32| start_position(mesh, v, target_of, before);
-        *kept = sheet::kept_orientation(state, mesh, &faces, cone, start);
+        *kept = !if state.parallel {
+            moving_faces.par_iter().any(turned)
+        } else {
+            moving_faces.iter().any(turned)
+        };
     }
     kept
 }

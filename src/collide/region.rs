@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::rings::RingCache;
-use super::sheet::Cone;
+use super::sheet::Sheet;
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps, SweptTriangle};
 use crate::geom::Aabb;
@@ -73,9 +73,9 @@ pub struct Region {
     layers: Vec<u32>,
     /// The layers of the step's selection, ascending: those whose searches may be skipped.
     moving_layers: Vec<u32>,
-    /// Per layer id: whether the region's faces of that layer are a sheet where the mesh is
-    /// now (`super::sheet`); `None` once a vertex moved since it was found.
-    sheets: Option<Vec<Option<Cone>>>,
+    /// Per layer id: the region's faces of that layer as a sheet where the mesh is now, if
+    /// they are one (`super::sheet`); `None` once a vertex moved since it was found.
+    sheets: Option<Vec<Option<Sheet>>>,
     /// The first look this step found no sheet.
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
@@ -229,9 +229,15 @@ impl Region {
         self.filed = true;
     }
 
-    /// Whether a search of the region could find anything where the mesh is now: not when
-    /// every layer in it is a sheet and alone there.
-    pub(super) fn worth_searching(&self) -> bool {
+    /// Whether the proximity clamp's search of the region could find anything where the mesh
+    /// is now: not when every layer in it is a clear sheet and alone there.
+    pub(super) fn worth_searching_near(&self) -> bool {
+        !(self.single_layer() && self.layers.iter().all(|&l| self.is_clear(l)))
+    }
+
+    /// Whether the backstop's search of the region could find a crossing where the mesh is
+    /// now: not when every layer in it is a sheet and alone there.
+    pub(super) fn worth_searching_crossings(&self) -> bool {
         !(self.single_layer() && self.layers.iter().all(|&l| self.is_sheet(l)))
     }
 
@@ -274,13 +280,19 @@ impl Region {
         self.sheets = None;
     }
 
-    /// Whether `layer` is a sheet where the mesh is now, as far as known.
+    /// Whether `layer` is a sheet where the mesh is now, as far as known: none of its faces
+    /// meet beyond what they share.
     pub(super) fn is_sheet(&self, layer: u32) -> bool {
-        self.sheet_cone(layer).is_some()
+        self.sheet(layer).is_some()
     }
 
-    /// The normal cone of `layer` where the mesh is now, if it is a sheet, as far as known.
-    pub(super) fn sheet_cone(&self, layer: u32) -> Option<&Cone> {
+    /// Whether `layer` is a clear sheet where the mesh is now, as far as known: none of its
+    /// vertices comes within the collision distance of its faces outside its exclusion ring.
+    pub(super) fn is_clear(&self, layer: u32) -> bool {
+        self.sheet(layer).is_some_and(|sheet| sheet.clear)
+    }
+
+    fn sheet(&self, layer: u32) -> Option<&Sheet> {
         self.sheets.as_ref()?.get(layer as usize)?.as_ref()
     }
 

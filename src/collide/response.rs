@@ -42,9 +42,9 @@ pub fn pull_back(
     let query = Aabb::of_points(&[start, x]).expanded(d);
     let own_layer = mesh.vertex_layers()[v as usize];
     let layers = mesh.face_layers();
-    // Within a sheet nothing outside the ring is within d (`super::sheet`).
-    let own_sheet = region.is_sheet(own_layer);
-    if own_sheet && region.single_layer() {
+    // Within a clear sheet nothing outside the ring is within d (`super::sheet`).
+    let own_clear = region.is_clear(own_layer);
+    if own_clear && region.single_layer() {
         return None;
     }
     let kept_ring = region.rings.get(mesh, v, state.ring);
@@ -70,7 +70,7 @@ pub fn pull_back(
         }
         // The vertex's own neighbourhood is near by construction, not by collision.
         if layers[f as usize] == own_layer {
-            if own_sheet {
+            if own_clear {
                 continue;
             }
             if kept_ring.is_none() && !ring_ready {
@@ -257,14 +257,14 @@ pub fn clamp_moves(
             .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
             .collect();
         region.find_sheets(state, mesh);
-        // Vertices of a layer that is a sheet here skip their own layer: they need no ring.
-        let unsheeted: Vec<u32> = (moving.iter().map(|&i| selection[i].0))
-            .filter(|&v| !region.is_sheet(mesh.vertex_layers()[v as usize]))
+        // Vertices of a layer that is a clear sheet here skip their own layer: no ring.
+        let unclear: Vec<u32> = (moving.iter().map(|&i| selection[i].0))
+            .filter(|&v| !region.is_clear(mesh.vertex_layers()[v as usize]))
             .collect();
         region
             .rings
-            .prepare(mesh, state.ring, &unsheeted, state.parallel);
-        if region.worth_searching() {
+            .prepare(mesh, state.ring, &unclear, state.parallel);
+        if region.worth_searching_near() {
             region.file_faces(mesh, moves, before);
         }
         let region_view: &Region = region;

@@ -6,15 +6,21 @@
 //!
 //! The test is the normal-cone test of Volino & Magnenat-Thalmann (a surface whose normals lie
 //! in a cone of half-angle < 90° around an axis `a`, and whose boundary projected along `a` is
-//! one simple loop, projects one-to-one onto the plane across `a`), adapted to proximity.
+//! one simple loop, projects one-to-one onto the plane across `a`), adapted to proximity. It
+//! has two levels: a layer that projects one-to-one is a sheet, and no two of its faces meet
+//! beyond what they share, so the backstop's pair tests within it are skipped; a sheet that
+//! also passes the bound below is *clear*: no vertex of it comes within `d` of its own faces
+//! outside the exclusion ring, so the proximity clamp's searches within it are skipped too.
+//! A ridge drawn over and over is a sheet whose flanks are too steep to be clear.
 //!
-//! **Why no vertex of a sheet comes within `d` of a face of it outside its exclusion ring.**
-//! Let `S` be the region's faces of one layer, every unit normal `n` with `n·a ≥ cos θ > 0`,
-//! its boundary (edges with one face in `S`) one loop, not on the mesh's rim, simple once
-//! projected along `a`, and every boundary edge farther than `d / cos θ` from the box of the
-//! step's moves. Then:
+//! **Why no vertex of a clear sheet comes within `d` of a face of it outside its exclusion
+//! ring.** Let `S` be the region's faces of one layer, every unit normal `n` with
+//! `n·a ≥ cos θ > 0`, its boundary (edges with one face in `S`) one loop, not on the mesh's
+//! rim, simple once projected along `a`, and every boundary edge farther than `d / cos θ`
+//! from the box of the step's moves. Then:
 //! 1. The projection is one-to-one: all faces keep their orientation in it, so a point of the
 //!    plane has as many points of `S` above it as the projected loop winds around it, 0 or 1.
+//!    (This alone makes a sheet.)
 //! 2. A straight segment of length `h` in the projection of `S` lifts to a path on `S` no
 //!    longer than `h / cos θ` (a face's slope along any direction is at most `tan θ`).
 //! 3. A moving vertex `v` (inside the box of the moves) is more than `d` from the boundary in
@@ -26,13 +32,13 @@
 //!    `(r + 1)·ρ_min` long.
 //! 5. A point `q` of such a face with `|v − q| < d` would be above the disk of radius `d`
 //!    around `v` (inside `S`'s projection by 3), reached by a lifted segment of length at most
-//!    `|v − q| / cos θ` (by 2), so `|v − q| ≥ cos θ·(r + 1)·ρ_min`. The sheet test asks for
+//!    `|v − q| / cos θ` (by 2), so `|v − q| ≥ cos θ·(r + 1)·ρ_min`. The clear test asks for
 //!    that to be at least `d`, with a margin for rounding.
 //!
 //! By 1 no two faces of a sheet meet beyond what they share either, so the backstop's pair
 //! tests within it find nothing. The test costs one pass over the region's faces and its
 //! boundary; `tests/culling.rs` compares culled and unculled strokes on folded, pinched,
-//! twisted and crumpled sheets, which must end identical.
+//! twisted, crumpled and ridged sheets, which must end identical.
 
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
@@ -45,20 +51,29 @@ use crate::mesh::{INVALID, Mesh, face_of, next, prev};
 /// Relative margin on the distance bound: far above `f32` rounding in the clamp's distances.
 const MARGIN: f64 = 1e-3;
 
-/// Per layer id: the normal cone of the region's faces of that layer where the mesh is now, if
-/// they form a sheet (the module's conditions), for the `layers` present in the region.
+/// Per layer id: the region's faces of that layer as a sheet where the mesh is now, if they
+/// are one (the module's conditions), for the `layers` present in the region.
 pub(super) fn find_sheets(
     state: &StrokeState<'_>,
     mesh: &Mesh,
     region: &Region,
     layers: &[u32],
-) -> Vec<Option<Cone>> {
+) -> Vec<Option<Sheet>> {
     let mut sheets = vec![None; mesh.layer_count()];
     for &layer in layers {
         let faces = faces_of_layer(mesh, region, layer);
-        sheets[layer as usize] = sheet_cone(state, mesh, region, &faces);
+        sheets[layer as usize] = sheet_of(state, mesh, region, &faces);
     }
     sheets
+}
+
+/// Faces of one layer in a step's region that project one-to-one along their normal cone's
+/// axis: no two meet beyond what they share.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sheet {
+    /// No vertex of the sheet comes within the collision distance of a face of it outside
+    /// its exclusion ring (the module's bound).
+    pub(crate) clear: bool,
 }
 
 /// The region's faces of `layer`, in the region's order.
@@ -75,12 +90,7 @@ pub(super) fn faces_of_layer<'r>(
     std::borrow::Cow::Owned(faces.filter(|&f| layers[f as usize] == layer).collect())
 }
 
-fn sheet_cone(
-    state: &StrokeState<'_>,
-    mesh: &Mesh,
-    region: &Region,
-    faces: &[u32],
-) -> Option<Cone> {
+fn sheet_of(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]) -> Option<Sheet> {
     // The loop first: a layer with a rim in the region (a flake, a peeling patch) is no
     // sheet, found without computing a normal.
     let layers = mesh.face_layers();
@@ -89,39 +99,20 @@ fn sheet_cone(
     let boundary = boundary_loop(mesh, faces, in_set)?;
     let now = |v: u32| mesh.positions()[v as usize];
     let cone = normal_cone(mesh, faces, now, state.parallel)?;
-    let d = state.collision_distance as f64 * (1.0 + MARGIN);
-    if cone.cos * (state.ring + 1) as f64 * cone.min_altitude < d {
+    if !projected_loop_is_simple(mesh, &boundary, cone.axis) {
         return None;
     }
+    let d = state.collision_distance as f64 * (1.0 + MARGIN);
     let far_enough = d / cone.cos;
-    let edge_far = |&(u, w): &(u32, u32)| {
+    let edge_far = |(u, w): (u32, u32)| {
         let (p, q) = (mesh.positions()[u as usize], mesh.positions()[w as usize]);
         box_gap(&region.bounds, &Aabb::of_points(&[p, q])) > far_enough
     };
     let ends = boundary.windows(2).map(|w| (w[0], w[1]));
     let closing = (boundary[boundary.len() - 1], boundary[0]);
-    let sheet = ends.chain(std::iter::once(closing)).all(|e| edge_far(&e))
-        && projected_loop_is_simple(mesh, &boundary, cone.axis);
-    sheet.then_some(cone)
-}
-
-/// Whether no face of a sheet whose cone is `now` turned over since the step's start, when
-/// the same faces' normals at the start (`start` gives each vertex's start) lie in a cone
-/// too: every normal is then within the two cones' half-angles and their axes' angle of every
-/// other, which stays below 90° with room for rounding — the backstop's turned-over test
-/// (the normals' dot product at most 0) finds nothing.
-pub(super) fn kept_orientation(
-    state: &StrokeState<'_>,
-    mesh: &Mesh,
-    faces: &[u32],
-    now: &Cone,
-    start: impl Fn(u32) -> Vec3 + Sync,
-) -> bool {
-    let Some(then) = normal_cone(mesh, faces, start, state.parallel) else {
-        return false;
-    };
-    let spread = now.cos.acos() + then.cos.acos() + now.axis.angle_between(then.axis);
-    spread < 85f64.to_radians()
+    let clear = cone.cos * (state.ring + 1) as f64 * cone.min_altitude >= d
+        && ends.chain(std::iter::once(closing)).all(edge_far);
+    Some(Sheet { clear })
 }
 
 #[derive(Debug, Clone, Copy)]
