@@ -284,3 +284,52 @@ fn a_stroke_creates_at_most_its_bound_of_new_faces() {
         unbounded.remesh
     );
 }
+
+/// Soak stroke sphere #868 in small: a sweep of twice a closed sphere's size (the most a brush
+/// may be) drags it far, smearing it into slivers. The step that stretches an edge past the stroke's bound
+/// is its last: what it did is kept (valid, nothing crossing), the samples streamed after it
+/// run nothing, and the report says how far it stretched. A bound four times higher lets the
+/// same stroke run longer, so the bound is what stopped it.
+#[test]
+fn a_stroke_that_stretches_an_edge_past_its_bound_stops_there() {
+    let smear = |max_stretch: f32| {
+        let mut mesh = generate(&SceneSpec {
+            kind: SceneKind::Sphere,
+            triangles: 2_000,
+            seed: 1,
+        })
+        .unwrap();
+        let (lo, hi) = mesh.bounds().unwrap();
+        let (centre, size) = ((lo + hi) / 2.0, (hi - lo).max_element());
+        let mut sweep = settings(1.9 * size);
+        (sweep.brush.kind, sweep.brush.strength, sweep.layers) = (BrushKind::Sweep, 0.32, vec![0]);
+        let mut pipeline = Pipeline::new(PipelineSettings {
+            max_stretch,
+            ..PipelineSettings::default()
+        });
+        let path = |t: f32| {
+            let at = centre + Vec3::new(size * (1.0 - 20.0 * t), size * 0.8 * t, 0.0);
+            sample(at.x, at.y, at.z)
+        };
+        let mut stroke = pipeline.begin_stroke(&mut mesh, sweep).unwrap();
+        let first = stroke.add_samples(&[path(0.0), path(0.5)]).unwrap();
+        let later = stroke.add_samples(&[path(0.75), path(1.0)]).unwrap();
+        let report = stroke.finish().unwrap();
+        mesh.validate().unwrap();
+        assert_eq!(slayer::collide::find_intersections(&mesh).total(), 0);
+        (first, later, report)
+    };
+    let (first, later, report) = smear(8.0);
+    let stretched = first.stopped_stretched.expect("stopped in the first call");
+    assert!(stretched > 8.0, "{stretched}");
+    assert_eq!(report.stopped_stretched, Some(stretched));
+    assert_eq!((later.samples, later.steps), (0, 0), "{later:?}");
+    assert!(report.steps > 0 && report.touched > 0, "{report:?}");
+    let (_, _, longer) = smear(32.0);
+    assert!(
+        longer.steps > report.steps,
+        "a higher bound runs on: {} steps against {}",
+        longer.steps,
+        report.steps
+    );
+}

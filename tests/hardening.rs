@@ -470,6 +470,41 @@ fn a_stroke_that_grows_past_its_bound_of_new_faces_is_warned_of() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A sweep of nearly twice a sphere's size dragged ten times its size smears it into slivers
+/// (soak stroke sphere #868 ran 25 minutes so): with `--max-stretch 8` the stroke stops at the
+/// step that stretches an edge past 8 edge lengths, `sculpt` says so and how to raise it, and
+/// writes a valid mesh; an absurd bound is refused in one line.
+#[test]
+fn a_stroke_that_stretches_past_its_bound_stops_and_is_warned_of() {
+    let dir = scratch("stretch");
+    let input = dir.join("in.ply");
+    write_scene("sphere", 2_000, &[], &input);
+    let strokes = stroke_file(
+        &dir,
+        "smear.json",
+        r#"{"brush": "sweep", "radius": 3.2, "strength": 0.32, "layers": [0],
+            "samples": [{"position": [2, 0, 0]}, {"position": [-10, 0.4, 0]}]}"#,
+    );
+    let (output, stats) = (dir.join("out.ply"), dir.join("stats.json"));
+    let mut args = vec!["sculpt", "--input", arg(&input), "--strokes", arg(&strokes)];
+    args.extend(["--output", arg(&output), "--stats", arg(&stats)]);
+    let out = slayer(&[&args[..], &["--max-stretch", "8"]].concat());
+    let said = text(&out.stderr);
+    assert!(out.status.success(), "{said}");
+    assert!(
+        said.contains("strokes[0]: stopped after") && said.contains("--max-stretch"),
+        "{said}"
+    );
+    let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    let stretched = stats["strokes"][0]["stopped_stretched"].as_f64().unwrap();
+    assert!(stretched > 8.0, "{stretched}");
+    let checked = slayer(&["check", arg(&output)]);
+    assert!(checked.status.success(), "{}", text(&checked.stdout));
+    let refused = slayer(&[&args[..], &["--max-stretch", "0.5"]].concat());
+    assert_one_line_error(&refused, &["0.5", "from 2 to 1000000"]);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// `slayer sculpt` killed with SIGKILL while it writes a 1M-face output: the previous output is
 /// byte-identical, and the temporary file the killed run left is swept by the next write into
 /// that folder.

@@ -245,6 +245,7 @@ fn run_stroke(
     let phases = match session.apply_stroke(pipeline, &strokes[0]) {
         Ok((report, _)) => {
             progress.collisions += report.clamped;
+            progress.stopped += usize::from(report.stopped_stretched.is_some());
             // The stroke's bound on the faces its remeshing creates (two a split at most),
             // which also bounds its time: a crease over all of the plaster once crumpled it
             // from 53K to 212K faces in 2 minutes.
@@ -287,10 +288,11 @@ fn print_summary(
 ) {
     let peak = slayer::memory::peak_resident_bytes();
     eprintln!(
-        "{kind:?}: {count} strokes in {:.0} s, {} refused, {} collisions, {} undone to keep the size, slowest {:.2} s ({}), {} → {} faces (digest {}), history {:.1} MiB, {} entries dropped, peak memory of the test process {}",
+        "{kind:?}: {count} strokes in {:.0} s, {} refused, {} collisions, {} stopped for stretching an edge past its bound, {} undone to keep the size, slowest {:.2} s ({}), {} → {} faces (digest {}), history {:.1} MiB, {} entries dropped, peak memory of the test process {}",
         progress.seconds,
         progress.refused,
         progress.collisions,
+        progress.stopped,
         progress.undone,
         progress.slowest_seconds,
         progress.slowest,

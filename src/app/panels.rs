@@ -532,7 +532,8 @@ pub fn brush_circle(app: &SlayerApp, painter: &Painter, rect: Rect) {
 }
 
 /// What a stroke's bounds cut short, for the status bar: samples that moved their most steps,
-/// remeshing that stopped at its bound of new faces (edges left long).
+/// remeshing that stopped at its bound of new faces (edges left long), a stroke that stopped
+/// where it stretched an edge past its bound.
 fn stroke_bounds_met(stroke: &crate::pipeline::StrokeReport) -> String {
     let mut said = String::new();
     if stroke.capped_samples > 0 {
@@ -543,6 +544,9 @@ fn stroke_bounds_met(stroke: &crate::pipeline::StrokeReport) -> String {
     }
     if stroke.remesh.growth_capped > 0 {
         said += "; remeshing stopped at its bound of new faces (edges left long)";
+    }
+    if let Some(stretched) = stroke.stopped_stretched {
+        said += &format!("; stopped where it stretched an edge to {stretched:.0} L");
     }
     said
 }
@@ -558,8 +562,10 @@ mod tests {
         assert_eq!(stroke_bounds_met(&stroke), "");
         stroke.capped_samples = 2;
         stroke.remesh.growth_capped = 1;
+        stroke.stopped_stretched = Some(40.0);
         let said = stroke_bounds_met(&stroke);
         assert!(said.contains("2 samples cut short"), "{said}");
         assert!(said.contains("bound of new faces"), "{said}");
+        assert!(said.contains("stretched an edge to 40 L"), "{said}");
     }
 }

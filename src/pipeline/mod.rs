@@ -81,12 +81,24 @@ pub struct PipelineSettings {
     /// [`RemeshReport::growth_capped`]), so that a stroke can neither exhaust memory nor run
     /// for minutes crumpling a layer into ever more faces.
     pub new_faces_per_stroke: usize,
+    /// The longest (× L) a stroke may stretch an edge before remeshing refines it, or the
+    /// longest edge the mesh had when the stroke began where that is more: the step that
+    /// stretches one past it is the stroke's last, and what it did is kept
+    /// ([`StrokeReport::stopped_stretched`]). Collision searches cost more the longer the
+    /// faces: a sweep twelve times the size of a 52K-face sphere smeared it into slivers of
+    /// 100 edge lengths, and ran for 25 minutes.
+    pub max_stretch: f32,
     /// Skip the collision searches that provably find nothing: within a layer where it is a
     /// sheet that cannot touch itself, against other layers where none is near
     /// (`collide::sheet`). The result is the same, bit for bit; off only to compare
     /// (`slayer bench --no-cull`).
     pub cull: bool,
 }
+
+/// [`PipelineSettings::max_stretch`] by default: 32 edge lengths (that sweep stretched edges by
+/// 0.77 L a step; stopped at 32 L it takes 26 s; no stroke of `slayer bench`'s scenes comes
+/// near it).
+pub const MAX_STRETCH: f32 = 32.0;
 
 /// [`PipelineSettings::new_faces_per_stroke`] by default: 2¹⁶ faces (a crease over the whole of
 /// a 53K-face plaster crumpled its paint layer to 159K faces in one stroke, 2 minutes).
@@ -138,6 +150,7 @@ impl Default for PipelineSettings {
             remeshing: Remeshing::AfterStroke,
             max_dabs_per_stroke: crate::brush::MAX_DABS_PER_STROKE,
             new_faces_per_stroke: NEW_FACES_PER_STROKE,
+            max_stretch: MAX_STRETCH,
             cull: true,
         }
     }
@@ -204,6 +217,9 @@ pub struct StrokeReport {
     /// The faces the stroke's remeshing was allowed to create
     /// ([`PipelineSettings::new_faces_bound`] of the mesh it began on).
     pub new_faces_bound: usize,
+    /// The stroke stopped early: a step stretched an edge to this length (× L), past
+    /// [`PipelineSettings::max_stretch`]; the samples after it were not run.
+    pub stopped_stretched: Option<f32>,
     /// Joins and splits of fuse layers after the stroke (`crate::topology`).
     pub topology: TopologyReport,
     pub phases: PhaseTimes,
@@ -224,6 +240,7 @@ impl StrokeReport {
         self.reverted += call.reverted;
         self.capped_samples += call.capped_samples;
         self.culled_steps += call.culled_steps;
+        self.stopped_stretched = self.stopped_stretched.or(call.stopped_stretched);
         self.phases.add(&call.phases);
     }
 }

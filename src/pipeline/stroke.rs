@@ -49,6 +49,10 @@ pub struct SamplesReport {
     /// Steps whose collision searches within a layer were skipped, the layer being a sheet
     /// that cannot touch itself there ([`PipelineSettings::cull`](super::PipelineSettings::cull)).
     pub culled_steps: usize,
+    /// The stroke stopped in this call: a step stretched an edge to this length (× L), past
+    /// [`PipelineSettings::max_stretch`](super::PipelineSettings::max_stretch); the samples
+    /// after it were not run, nor will any later call's be.
+    pub stopped_stretched: Option<f32>,
     /// Vertices whose position, normal, BRDF or mask changed in this call (ascending): what a
     /// viewer uploads again. Vertices remeshing added are among them.
     pub changed: Vec<u32>,
@@ -94,6 +98,9 @@ struct Active {
     /// Splits the stroke's remeshing may still make (each creates up to two faces:
     /// [`PipelineSettings::new_faces_per_stroke`]).
     splits_left: usize,
+    /// A step stretched an edge past [`Lengths::stretch_limit`]: to this length (× L). The
+    /// stroke runs nothing more.
+    stopped_stretched: Option<f32>,
     report: StrokeReport,
 }
 
@@ -103,6 +110,9 @@ struct Lengths {
     edge: f32,
     collision_distance: f32,
     step_limit: f32,
+    /// [`PipelineSettings::max_stretch`] edge lengths, or the mesh's longest edge when the
+    /// stroke began where that is more.
+    stretch_limit: f32,
 }
 
 /// The start of one sample: what it selected and where the brush frame is.
@@ -155,6 +165,7 @@ impl<'a> StrokeInProgress<'a> {
                     edge,
                     collision_distance: settings.collision_distance * edge,
                     step_limit: settings.max_step * edge,
+                    stretch_limit: (settings.max_stretch * edge).max(edge_bound_at_start),
                 },
                 previous: None,
                 samples_run: 0,
@@ -167,6 +178,7 @@ impl<'a> StrokeInProgress<'a> {
                 remeshed: Vec::new(),
                 edge_bound_at_start,
                 splits_left: new_faces / 2,
+                stopped_stretched: None,
                 report: StrokeReport {
                     phases,
                     new_faces_bound: new_faces,
@@ -246,6 +258,9 @@ impl<'a> StrokeInProgress<'a> {
         let remeshing = pipeline.settings.remeshing;
         let drags = active.stroke.brush.kind.drags();
         for sample in samples {
+            if active.stopped_stretched.is_some() {
+                break;
+            }
             let Some(moved) = active.run_sample(kernels, self.mesh, sample, &mut call) else {
                 continue;
             };
@@ -577,6 +592,9 @@ impl Active {
             };
             let moved = self.take_step(kernels, mesh, (&selection, &targets), call);
             moved_in_sample.extend(moved);
+            if self.stopped_stretched.is_some() {
+                break;
+            }
         }
         moved_in_sample
     }
@@ -641,8 +659,14 @@ impl Active {
             .collect();
         let selected: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         kernels.moved(mesh, &selected, largest_move(&before, &outcome.positions));
+        let longest = longest_edge_at(mesh, &moved);
         let prepared = &mut self.prepared;
-        prepared.max_edge = prepared.max_edge.max(longest_edge_at(mesh, &moved));
+        prepared.max_edge = prepared.max_edge.max(longest);
+        if longest > self.lengths.stretch_limit && self.stopped_stretched.is_none() {
+            let stretched = longest / self.lengths.edge;
+            self.stopped_stretched = Some(stretched);
+            call.stopped_stretched = Some(stretched);
+        }
         call.phases.collision += millis(started);
 
         let started = Instant::now();

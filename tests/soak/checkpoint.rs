@@ -27,6 +27,10 @@ pub struct Progress {
     pub undone: usize,
     /// History entries dropped for the memory cap (the history saved holds the rest).
     pub dropped: usize,
+    /// Strokes that stopped where they stretched an edge past their bound (a checkpoint saved
+    /// before they were counted reads 0).
+    #[serde(default)]
+    pub stopped: usize,
     pub slowest_seconds: f64,
     pub slowest: String,
     /// Seconds the strokes took in the sittings before this one.

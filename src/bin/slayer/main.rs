@@ -119,6 +119,11 @@ enum Command {
         /// that is more); past it, long edges are left unsplit and `sculpt` warns.
         #[arg(long, default_value_t = slayer::pipeline::NEW_FACES_PER_STROKE, value_name = "N")]
         max_new_faces: usize,
+        /// The longest, in edge lengths, a stroke may stretch an edge before remeshing refines
+        /// it (or the mesh's longest edge, where that is more); the step that stretches one
+        /// past it is the stroke's last, what it did is kept, and `sculpt` warns.
+        #[arg(long, default_value_t = slayer::pipeline::MAX_STRETCH, value_name = "L")]
+        max_stretch: f32,
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
@@ -410,6 +415,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             in_place,
             max_dabs,
             max_new_faces,
+            max_stretch,
             stats,
             symmetry,
             remesh,
@@ -423,6 +429,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             in_place,
             max_dabs,
             max_new_faces,
+            max_stretch,
             stats: stats.as_deref(),
             symmetry: symmetry.as_deref(),
             remeshing: remesh,

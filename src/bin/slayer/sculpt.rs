@@ -20,6 +20,8 @@ pub struct Args<'a> {
     /// The most dabs one stroke may make.
     pub max_dabs: usize,
     pub max_new_faces: usize,
+    /// Edge lengths a stroke may stretch an edge to (`PipelineSettings::max_stretch`).
+    pub max_stretch: f32,
     pub stats: Option<&'a Path>,
     /// `x`, `y` or `z`: the mirror of strokes that name none.
     pub symmetry: Option<&'a str>,
@@ -80,6 +82,13 @@ fn find_layer(mesh: &slayer::mesh::Mesh, name: &str) -> anyhow::Result<u32> {
 /// unit; the input is never touched unless `--in-place` names it as the output. Each stroke is
 /// one history entry of the session a `.slayer` output keeps.
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
+    // From 2: remeshing itself leaves edges up to 4/3 L.
+    if !(2.0..=1e6).contains(&args.max_stretch) {
+        bail!(
+            "--max-stretch {}: the bound is a number of edge lengths from 2 to 1000000",
+            args.max_stretch
+        );
+    }
     slayer::session::check_save_path(args.output)?;
     refuse_overwriting_input(args)?;
     // A mesh file keeps no history: the session need not keep a copy of the mesh to undo to.
@@ -115,6 +124,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
             remeshing: args.remeshing,
             max_dabs_per_stroke: args.max_dabs,
             new_faces_per_stroke: args.max_new_faces,
+            max_stretch: args.max_stretch,
             cull: args.cull,
             ..PipelineSettings::default()
         },
@@ -144,6 +154,12 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
             bar.println(&format!(
                 "warning: strokes[{i}]: {} samples moved farther than {MAX_STEPS_PER_SAMPLE} steps allow and were cut short (a runaway brush: lower its strength or radius)",
                 report.capped_samples
+            ));
+        }
+        if let Some(stretched) = report.stopped_stretched {
+            bar.println(&format!(
+                "warning: strokes[{i}]: stopped after {} of its samples, where it stretched an edge to {stretched:.1} edge lengths, past the bound of {} (what it did is kept; a smaller radius or strength stretches less; raise the bound with --max-stretch)",
+                report.samples, args.max_stretch
             ));
         }
         if report.remesh.growth_capped > 0 {

@@ -153,6 +153,9 @@ impl Active {
                 }
             };
             moved.extend(self.take_step(kernels, mesh, (&selection, &targets), call));
+            if self.stopped_stretched.is_some() {
+                break;
+            }
         }
         moved
     }
