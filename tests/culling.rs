@@ -93,6 +93,35 @@ fn assert_culling_changes_nothing(
     culled
 }
 
+/// A draw stroke on layer 0 of `(radius, strength)` through `positions` at full pressure,
+/// pushing along `normal` (or the brush frame's).
+fn draw(
+    (radius, strength): (f32, f32),
+    positions: impl Iterator<Item = Vec3>,
+    normal: Option<Vec3>,
+) -> Stroke {
+    Stroke {
+        paint: None,
+        brush: Brush {
+            kind: BrushKind::Draw,
+            radius,
+            strength,
+            falloff: Falloff::Smooth,
+            invert: false,
+        },
+        layers: vec![0],
+        spacing: 0.25,
+        symmetry: None,
+        samples: positions
+            .map(|position| Sample {
+                position,
+                pressure: 1.0,
+                normal,
+            })
+            .collect(),
+    }
+}
+
 /// Moves every vertex of `mesh` by `shape`, given its position in the unit square.
 fn reshaped(mut mesh: Mesh, shape: impl Fn(f32, f32) -> Vec3) -> Mesh {
     let (lo, hi) = mesh.bounds().unwrap();
@@ -143,25 +172,9 @@ fn a_sheet_folded_onto_itself_collides_the_same() {
     });
     // Narrower than the gap, so that the brush moves the upper half only, back and forth
     // over the same stretch until it meets the lower one.
-    let draw_down = |y: f32| Stroke {
-        paint: None,
-        brush: Brush {
-            kind: BrushKind::Draw,
-            radius: 0.8 * gap,
-            strength: 1.0,
-            falloff: Falloff::Smooth,
-            invert: false,
-        },
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
-        samples: (0..40)
-            .map(|k| Sample {
-                position: Vec3::new(0.2 + 0.1 * ((k % 8) as f32 / 7.0), y, gap),
-                pressure: 1.0,
-                normal: Some(-Vec3::Z),
-            })
-            .collect(),
+    let draw_down = |y: f32| {
+        let to = |k: usize| Vec3::new(0.2 + 0.1 * ((k % 8) as f32 / 7.0), y, gap);
+        draw((0.8 * gap, 1.0), (0..40).map(to), Some(-Vec3::Z))
     };
     let strokes: Vec<Stroke> = [0.3, 0.5, 0.7].map(draw_down).into();
     let run = assert_culling_changes_nothing("folded sheet", &mesh, &strokes, Remeshing::Off);
@@ -183,25 +196,9 @@ fn a_steep_ridge_is_a_sheet_whose_crossings_are_not_searched() {
         let across = (u - 0.5) / 0.1;
         Vec3::new(u, v, 0.17 * (-across * across).exp())
     });
-    let along_the_crest = |x: f32| Stroke {
-        paint: None,
-        brush: Brush {
-            kind: BrushKind::Draw,
-            radius: 0.15,
-            strength: 0.3,
-            falloff: Falloff::Smooth,
-            invert: false,
-        },
-        layers: vec![0],
-        spacing: 0.25,
-        symmetry: None,
-        samples: (0..12)
-            .map(|k| Sample {
-                position: Vec3::new(x, 0.3 + 0.4 * k as f32 / 11.0, 0.17),
-                pressure: 1.0,
-                normal: None,
-            })
-            .collect(),
+    let along_the_crest = |x: f32| {
+        let to = |k: usize| Vec3::new(x, 0.3 + 0.4 * k as f32 / 11.0, 0.17);
+        draw((0.15, 0.3), (0..12).map(to), None)
     };
     let strokes: Vec<Stroke> = [0.5, 0.47, 0.53].map(along_the_crest).into();
     let run = assert_culling_changes_nothing("steep ridge", &mesh, &strokes, Remeshing::Off);
