@@ -505,6 +505,46 @@ fn a_stroke_that_stretches_past_its_bound_stops_and_is_warned_of() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `--edge-length` sets the `L` the strokes work at: the mesh's own mean edge length gives the
+/// same mesh, byte for byte, as leaving it out; a coarser one another mesh; zero is refused.
+#[test]
+fn sculpt_works_at_the_edge_length_it_is_given() {
+    let dir = scratch("edge_length");
+    let input = dir.join("in.ply");
+    write_scene("sphere", 2_000, &[], &input);
+    let strokes = stroke_file(
+        &dir,
+        "draw.json",
+        r#"{"brush": "draw", "radius": 0.3, "strength": 0.5, "layers": [0],
+            "samples": [{"position": [0.5, 0, 0]}, {"position": [0.4, 0.2, 0]}]}"#,
+    );
+    let options = slayer::io::ImportOptions::default();
+    let mean = slayer::io::load_mesh(&input, &options)
+        .unwrap()
+        .0
+        .mean_edge_length();
+    let sculpt = |edge: Option<String>| {
+        let output = dir.join("out.ply");
+        let mut args = vec!["sculpt", "--input", arg(&input), "--strokes", arg(&strokes)];
+        args.extend(["--output", arg(&output)]);
+        let edge_arg = edge.unwrap_or_default();
+        if !edge_arg.is_empty() {
+            args.extend(["--edge-length", &edge_arg]);
+        }
+        let out = slayer(&args);
+        (out, std::fs::read(&output).unwrap_or_default())
+    };
+    let (plain, by_default) = sculpt(None);
+    assert!(plain.status.success(), "{}", text(&plain.stderr));
+    let (_, at_mean) = sculpt(Some(format!("{mean}")));
+    assert!(at_mean == by_default, "the mean edge length is the default");
+    let (_, coarser) = sculpt(Some(format!("{}", 2.0 * mean)));
+    assert!(!coarser.is_empty() && coarser != by_default);
+    let (refused, _) = sculpt(Some("0".into()));
+    assert_one_line_error(&refused, &["--edge-length 0", "positive"]);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// `slayer sculpt` killed with SIGKILL while it writes a 1M-face output: the previous output is
 /// byte-identical, and the temporary file the killed run left is swept by the next write into
 /// that folder.

@@ -124,6 +124,11 @@ enum Command {
         /// past it is the stroke's last, what it did is kept, and `sculpt` warns.
         #[arg(long, default_value_t = slayer::pipeline::MAX_STRETCH, value_name = "L")]
         max_stretch: f32,
+        /// The edge length `L` the strokes work at (collision distance, step, remeshing
+        /// target), in world units; by default the mesh's mean edge length before the first
+        /// stroke. Give the one a session ran at to replay its strokes as they ran.
+        #[arg(long, value_name = "L")]
+        edge_length: Option<f32>,
         /// Write per-stroke phase timings and counts as JSON.
         #[arg(long)]
         stats: Option<PathBuf>,
@@ -416,6 +421,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             max_dabs,
             max_new_faces,
             max_stretch,
+            edge_length,
             stats,
             symmetry,
             remesh,
@@ -430,6 +436,7 @@ fn dispatch(command: Command, strict: bool) -> anyhow::Result<ExitCode> {
             max_dabs,
             max_new_faces,
             max_stretch,
+            edge_length,
             stats: stats.as_deref(),
             symmetry: symmetry.as_deref(),
             remeshing: remesh,

@@ -22,6 +22,8 @@ pub struct Args<'a> {
     pub max_new_faces: usize,
     /// Edge lengths a stroke may stretch an edge to (`PipelineSettings::max_stretch`).
     pub max_stretch: f32,
+    /// The pipeline's edge length `L`, when given (else the mesh's mean edge length).
+    pub edge_length: Option<f32>,
     pub stats: Option<&'a Path>,
     /// `x`, `y` or `z`: the mirror of strokes that name none.
     pub symmetry: Option<&'a str>,
@@ -82,6 +84,11 @@ fn find_layer(mesh: &slayer::mesh::Mesh, name: &str) -> anyhow::Result<u32> {
 /// unit; the input is never touched unless `--in-place` names it as the output. Each stroke is
 /// one history entry of the session a `.slayer` output keeps.
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
+    if let Some(edge) = args.edge_length
+        && !(edge.is_finite() && edge > 0.0)
+    {
+        bail!("--edge-length {edge}: the edge length must be a positive number of world units");
+    }
     // From 2: remeshing itself leaves edges up to 4/3 L.
     if !(2.0..=1e6).contains(&args.max_stretch) {
         bail!(
@@ -125,6 +132,7 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
             max_dabs_per_stroke: args.max_dabs,
             new_faces_per_stroke: args.max_new_faces,
             max_stretch: args.max_stretch,
+            edge_length: args.edge_length,
             cull: args.cull,
             ..PipelineSettings::default()
         },
