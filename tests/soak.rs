@@ -11,7 +11,7 @@
 //! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --nocapture`. Times are
 //! printed, never asserted. `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke;
 //! `SLAYER_SOAK_TRACE=1` prints each stroke (as a stroke file) before it runs;
-//! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N` and the stroke into `DIR`
+//! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N`, the stroke and `L` into `DIR`
 //! (`SLAYER_SOAK_DUMP=each:DIR` before every stroke, over the last, to catch one that never ends).
 //! `SLAYER_SOAK_CHECKPOINT=DIR` saves each scene's run at every check and takes it up from
 //! there the next time (`checkpoint`): the full soak over several sittings. A run taken up
@@ -239,7 +239,7 @@ fn run_stroke(
     if std::env::var("SLAYER_SOAK_TRACE").is_ok() {
         eprintln!("stroke {i}: {as_json}");
     }
-    dump_before(i, session.mesh(), as_json);
+    dump_before(i, session.mesh(), as_json, pipeline.edge_length());
     let started = Instant::now();
     let faces_before = session.mesh().live_face_count();
     let phases = match session.apply_stroke(pipeline, &strokes[0]) {
@@ -374,10 +374,11 @@ fn undo_growth(session: &mut Session, faces_at_start: usize) -> usize {
     undone
 }
 
-/// With `SLAYER_SOAK_DUMP=N:DIR`, writes the mesh before stroke `N` to `DIR/before.ply` and
-/// the stroke to `DIR/stroke.json`, for `slayer sculpt` to replay it alone; with `each:DIR`,
+/// With `SLAYER_SOAK_DUMP=N:DIR`, writes the mesh before stroke `N` to `DIR/before.ply`, the
+/// stroke to `DIR/stroke.json` and the pipeline's edge length to `DIR/edge_length`, for
+/// `slayer sculpt --edge-length` to replay it alone; with `each:DIR`,
 /// before every stroke (each over the last: what is there when a stroke never ends is its own).
-fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
+fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str, edge_length: Option<f32>) {
     let Ok(spec) = std::env::var("SLAYER_SOAK_DUMP") else {
         return;
     };
@@ -388,6 +389,9 @@ fn dump_before(stroke: usize, mesh: &Mesh, stroke_json: &str) {
         let dir = std::path::Path::new(dir);
         slayer::io::write_mesh(mesh, &dir.join("before.ply")).unwrap();
         std::fs::write(dir.join("stroke.json"), stroke_json).unwrap();
+        // The L the soak's pipeline holds: `slayer sculpt --edge-length` replays at it.
+        let edge = edge_length.map_or(String::new(), |l| format!("{l}\n"));
+        std::fs::write(dir.join("edge_length"), edge).unwrap();
     }
 }
 
