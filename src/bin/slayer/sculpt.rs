@@ -84,18 +84,7 @@ fn find_layer(mesh: &slayer::mesh::Mesh, name: &str) -> anyhow::Result<u32> {
 /// unit; the input is never touched unless `--in-place` names it as the output. Each stroke is
 /// one history entry of the session a `.slayer` output keeps.
 pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
-    if let Some(edge) = args.edge_length
-        && !(edge.is_finite() && edge > 0.0)
-    {
-        bail!("--edge-length {edge}: the edge length must be a positive number of world units");
-    }
-    // From 2: remeshing itself leaves edges up to 4/3 L.
-    if !(2.0..=1e6).contains(&args.max_stretch) {
-        bail!(
-            "--max-stretch {}: the bound is a number of edge lengths from 2 to 1000000",
-            args.max_stretch
-        );
-    }
+    check_lengths(args)?;
     slayer::session::check_save_path(args.output)?;
     refuse_overwriting_input(args)?;
     // A mesh file keeps no history: the session need not keep a copy of the mesh to undo to.
@@ -158,23 +147,8 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
                 recorded.dropped
             ));
         }
-        if report.capped_samples > 0 {
-            bar.println(&format!(
-                "warning: strokes[{i}]: {} samples moved farther than {MAX_STEPS_PER_SAMPLE} steps allow and were cut short (a runaway brush: lower its strength or radius)",
-                report.capped_samples
-            ));
-        }
-        if let Some(stretched) = report.stopped_stretched {
-            bar.println(&format!(
-                "warning: strokes[{i}]: stopped after {} of its samples, where it stretched an edge to {stretched:.1} edge lengths, past the bound of {} (what it did is kept; a smaller radius or strength stretches less; raise the bound with --max-stretch)",
-                report.samples, args.max_stretch
-            ));
-        }
-        if report.remesh.growth_capped > 0 {
-            bar.println(&format!(
-                "warning: strokes[{i}]: remeshing stopped splitting at {} new faces, the bound for one stroke (edges were left long; raise it with --max-new-faces)",
-                report.new_faces_bound
-            ));
+        for warning in bounds_met(i, &report, args.max_stretch) {
+            bar.println(&warning);
         }
         reports.push(report);
         bar.inc();
@@ -232,6 +206,48 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
 }
 
 /// The output (or the stats) naming the input file itself is refused without `--in-place`.
+/// `--edge-length` positive, `--max-stretch` from 2 (remeshing itself leaves edges up to
+/// 4/3 L) to 10⁶.
+fn check_lengths(args: &Args<'_>) -> anyhow::Result<()> {
+    if let Some(edge) = args.edge_length
+        && !(edge.is_finite() && edge > 0.0)
+    {
+        bail!("--edge-length {edge}: the edge length must be a positive number of world units");
+    }
+    if !(2.0..=1e6).contains(&args.max_stretch) {
+        bail!(
+            "--max-stretch {}: the bound is a number of edge lengths from 2 to 1000000",
+            args.max_stretch
+        );
+    }
+    Ok(())
+}
+
+/// A warning for each bound stroke `i` met: samples cut short, the stroke stopped where it
+/// stretched an edge past `max_stretch`, remeshing stopped at its new faces.
+fn bounds_met(i: usize, report: &StrokeReport, max_stretch: f32) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if report.capped_samples > 0 {
+        warnings.push(format!(
+            "warning: strokes[{i}]: {} samples moved farther than {MAX_STEPS_PER_SAMPLE} steps allow and were cut short (a runaway brush: lower its strength or radius)",
+            report.capped_samples
+        ));
+    }
+    if let Some(stretched) = report.stopped_stretched {
+        warnings.push(format!(
+            "warning: strokes[{i}]: stopped after {} of its samples, where it stretched an edge to {stretched:.1} edge lengths, past the bound of {max_stretch} (what it did is kept; a smaller radius or strength stretches less; raise the bound with --max-stretch)",
+            report.samples
+        ));
+    }
+    if report.remesh.growth_capped > 0 {
+        warnings.push(format!(
+            "warning: strokes[{i}]: remeshing stopped splitting at {} new faces, the bound for one stroke (edges were left long; raise it with --max-new-faces)",
+            report.new_faces_bound
+        ));
+    }
+    warnings
+}
+
 fn refuse_overwriting_input(args: &Args<'_>) -> anyhow::Result<()> {
     if args.in_place {
         return Ok(());
