@@ -523,24 +523,21 @@ fn sculpt_works_at_the_edge_length_it_is_given() {
         .unwrap()
         .0
         .mean_edge_length();
-    let sculpt = |edge: Option<String>| {
+    let sculpt = |extra: &[&str]| {
         let output = dir.join("out.ply");
         let mut args = vec!["sculpt", "--input", arg(&input), "--strokes", arg(&strokes)];
         args.extend(["--output", arg(&output)]);
-        let edge_arg = edge.unwrap_or_default();
-        if !edge_arg.is_empty() {
-            args.extend(["--edge-length", &edge_arg]);
-        }
+        args.extend(extra);
         let out = slayer(&args);
         (out, std::fs::read(&output).unwrap_or_default())
     };
-    let (plain, by_default) = sculpt(None);
+    let (plain, by_default) = sculpt(&[]);
     assert!(plain.status.success(), "{}", text(&plain.stderr));
-    let (_, at_mean) = sculpt(Some(format!("{mean}")));
+    let (_, at_mean) = sculpt(&["--edge-length", &format!("{mean}")]);
     assert!(at_mean == by_default, "the mean edge length is the default");
-    let (_, coarser) = sculpt(Some(format!("{}", 2.0 * mean)));
+    let (_, coarser) = sculpt(&["--edge-length", &format!("{}", 2.0 * mean)]);
     assert!(!coarser.is_empty() && coarser != by_default);
-    let (refused, _) = sculpt(Some("0".into()));
+    let (refused, _) = sculpt(&["--edge-length", "0"]);
     assert_one_line_error(&refused, &["--edge-length 0", "positive"]);
     std::fs::remove_dir_all(dir).unwrap();
 }
