@@ -168,6 +168,8 @@ fn samples_of_several_steps_run_their_steps_ahead_and_match_the_cpu_pipeline() {
     let report = check_run_ahead(&start, &strokes);
     assert!(report.steps > report.samples, "{report:?}");
     assert!(report.uploads.gated_ahead > 0, "{report:?}");
+    // Those stops are the samples of several steps, and are counted as such.
+    assert!(report.uploads.gate_stops.several_steps > 0, "{report:?}");
     assert!(report.uploads.steps_ahead > 0, "{report:?}");
     assert!(report.uploads.read_backs < report.samples, "{report:?}");
 }

@@ -13,7 +13,8 @@ use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::find_intersections;
 use crate::mesh::Mesh;
 use crate::pipeline::{
-    BackstopFilter, GpuMemory, PhaseTimes, Pipeline, PipelineError, StrokeReport, Uploads,
+    BackstopFilter, GateStops, GpuMemory, PhaseTimes, Pipeline, PipelineError, StrokeReport,
+    Uploads,
 };
 use crate::remesh::RemeshReport;
 pub use crate::remesh::{AngleSummary, smallest_angle_degrees};
@@ -128,6 +129,8 @@ pub struct GpuCalls {
     /// samples that is.
     pub gate_stops: usize,
     pub gate_stops_per_sample: f64,
+    /// Why the gate stopped them, per reason.
+    pub gate_stops_by: GateStops,
     /// Samples and steps taken from runs ahead.
     pub samples_ahead: usize,
     pub steps_ahead: usize,
@@ -155,6 +158,7 @@ impl GpuCalls {
             read_backs_per_call: per(read_backs, calls),
             gate_stops,
             gate_stops_per_sample: per(gate_stops, samples),
+            gate_stops_by: after.gate_stops.since(before.gate_stops),
             samples_ahead: after.samples_ahead - before.samples_ahead,
             steps_ahead: after.steps_ahead - before.steps_ahead,
         }

@@ -3,6 +3,7 @@
 use std::fmt::Write;
 
 use super::{ScalingRow, SceneResult};
+use crate::pipeline::GateStops;
 
 /// Lines per scene run on the GPU: the most GPU memory it held after any stroke, as the
 /// allocator reports it and as the budget counts the mesh's copy; its submissions and
@@ -57,7 +58,7 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
                 out,
                 "gpu calls {}: {:.2} submissions and {:.2} blocking read-backs per sample, \
                  {:.2} read-backs per stroke, {:.2} per call ({feed} per call); {} samples and \
-                 {} steps taken from runs ahead, the gate stopped {} ({:.1}% of samples)",
+                 {} steps taken from runs ahead, the gate stopped {} ({:.1}% of samples: {})",
                 r.name,
                 c.submissions_per_sample,
                 c.read_backs_per_sample,
@@ -66,7 +67,8 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
                 c.samples_ahead,
                 c.steps_ahead,
                 c.gate_stops,
-                100.0 * c.gate_stops_per_sample
+                100.0 * c.gate_stops_per_sample,
+                stop_reasons(&c.gate_stops_by)
             );
         }
     }
@@ -305,4 +307,25 @@ pub fn scaling_svg(rows: &[ScalingRow], title: &str) -> String {
     }
     let _ = writeln!(svg, "</svg>");
     svg
+}
+
+/// The gate's stops by reason, in words: "2 for several steps, 1 for the selection", or "none".
+fn stop_reasons(by: &GateStops) -> String {
+    let reasons = [
+        (by.several_steps, "for several steps"),
+        (by.move_grew, "for a longer move"),
+        (by.selection, "for the selection"),
+        (by.rings, "for a ring"),
+        (by.edges, "for the edges"),
+    ];
+    let named: Vec<String> = reasons
+        .iter()
+        .filter(|(count, _)| *count > 0)
+        .map(|(count, why)| format!("{count} {why}"))
+        .collect();
+    if named.is_empty() {
+        "none".to_string()
+    } else {
+        named.join(", ")
+    }
 }

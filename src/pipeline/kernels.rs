@@ -10,6 +10,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::step::{brush_frame, deform, select};
+use crate::abi::GateStatus;
 use crate::brush::{Dab, DabFrame};
 use crate::collide::{Backstop, Region, StepMoves, StrokeState, clamp_in_region};
 use crate::mesh::{Mesh, MeshVersion};
@@ -226,12 +227,58 @@ pub struct Uploads {
     /// (`sample_gate`; a run stops there): their selection outgrew its room, a ring its room, a
     /// vertex moved farther or an edge grew longer than the passes were sized for.
     pub gated_ahead: usize,
+    /// Why the gate stopped them, per reason.
+    pub gate_stops: GateStops,
     /// Submissions that ran several given samples of a stroke ([`StepKernels::given`]), and
     /// the samples taken from them.
     pub batches: usize,
     pub samples_ahead: usize,
     /// Steps of samples of several steps taken from such submissions.
     pub steps_ahead: usize,
+}
+
+/// Why the GPU's gate stopped steps run ahead ([`Uploads::gated_ahead`]): a count per reason,
+/// a stop counted under each of its reasons. What a hardware-independent measure of the GPU
+/// path needs to say where its extra blocking read-backs come from.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct GateStops {
+    /// The selection outgrew the list's room.
+    pub selection: usize,
+    /// An exclusion ring outgrew its room.
+    pub rings: usize,
+    /// A vertex moved farther than the passes were sized for, still within one step.
+    pub move_grew: usize,
+    /// The sample moves farther than one step: it takes several, recorded after the stop.
+    pub several_steps: usize,
+    /// The samples before left an edge longer than the passes were sized for.
+    pub edges: usize,
+}
+
+impl GateStops {
+    /// Counts a stop the gate reported as `stopped` (`GateStatus` bits), its sample's longest
+    /// move `longest` against the step `limit`.
+    pub fn count(&mut self, stopped: u32, longest: f32, limit: f32) {
+        let has = |bit: u32| usize::from(stopped & bit != 0);
+        self.selection += has(GateStatus::SELECTION);
+        self.rings += has(GateStatus::RINGS);
+        let moved = has(GateStatus::MOVE);
+        // A NaN move is not within the limit either.
+        let one_step = usize::from(longest <= limit);
+        self.move_grew += moved * one_step;
+        self.several_steps += moved * (1 - one_step);
+        self.edges += has(GateStatus::EDGES);
+    }
+
+    /// The stops counted since `before`.
+    pub fn since(self, before: GateStops) -> GateStops {
+        GateStops {
+            selection: self.selection - before.selection,
+            rings: self.rings - before.rings,
+            move_grew: self.move_grew - before.move_grew,
+            several_steps: self.several_steps - before.several_steps,
+            edges: self.edges - before.edges,
+        }
+    }
 }
 
 /// GPU memory held by kernels that keep the mesh there: as the wgpu backend's allocator reports

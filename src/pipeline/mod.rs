@@ -48,8 +48,8 @@ mod stroke;
 
 pub use engine::Pipeline;
 pub use kernels::{
-    BackstopFilter, CallAt, CpuKernels, Deformed, EngineVertices, FrameSource, GpuMemory,
-    SampleProbe, StepKernels, Uploads,
+    BackstopFilter, CallAt, CpuKernels, Deformed, EngineVertices, FrameSource, GateStops,
+    GpuMemory, SampleProbe, StepKernels, Uploads,
 };
 pub use stroke::{SamplesReport, StrokeInProgress};
 

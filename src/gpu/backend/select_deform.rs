@@ -141,10 +141,12 @@ impl GpuKernels {
         if let Some(longest) = longest {
             self.last_move = longest;
         }
-        if let (Some(assumed), Some(clamp_read)) = (assumed_move, layout.clamp) {
+        if let (Some(assumed), Some(clamp_read), Some(limit)) =
+            (assumed_move, layout.clamp, clamp_within)
+        {
             let moved = (targets.as_ref(), longest);
             let read = (guess, assumed, clamp_read);
-            self.keep_ahead(mesh, (&selection, &order), moved, &parts, read);
+            self.keep_ahead(mesh, (&selection, &order), moved, &parts, read, limit);
         }
         let targets = match (deforms && count > 0, targets) {
             (true, None) => {
@@ -242,6 +244,7 @@ impl GpuKernels {
         (targets, longest): (Option<&Vec<Vec3>>, Option<f32>),
         parts: &SampleBytes<'_>,
         (guess, assumed, clamp_read): (usize, f32, ClampRead),
+        limit: f32,
     ) {
         let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         // Within the assumed move, which is within the step limit: one step, which moves
@@ -263,7 +266,14 @@ impl GpuKernels {
             // Nothing selected: nothing moved, nothing to drop.
             None if vertices.is_empty() => {}
             // Stopped by the gate before they moved anything.
-            None if stopped => self.uploads.gated_ahead += 1,
+            None if stopped => {
+                self.uploads.gated_ahead += 1;
+                let status = parts.gate.expect("stopped by the gate");
+                let longest = longest.unwrap_or(status.longest_move());
+                self.uploads
+                    .gate_stops
+                    .count(status.stopped, longest, limit);
+            }
             // The passes moved what they were wrong about.
             None => put_back(
                 &self.gpu,
