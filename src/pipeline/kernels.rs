@@ -237,6 +237,15 @@ pub struct Uploads {
     pub steps_ahead: usize,
 }
 
+impl Uploads {
+    /// Counts a step the GPU's gate stopped, under each of its reasons (`stopped`:
+    /// `GateStatus` bits; `longest`: its sample's longest move; `limit`: the step limit).
+    pub fn count_gate_stop(&mut self, stopped: u32, longest: f32, limit: f32) {
+        self.gated_ahead += 1;
+        self.gate_stops.count(stopped, longest, limit);
+    }
+}
+
 /// Why the GPU's gate stopped steps run ahead ([`Uploads::gated_ahead`]): a count per reason,
 /// a stop counted under each of its reasons. What a hardware-independent measure of the GPU
 /// path needs to say where its extra blocking read-backs come from.
@@ -257,7 +266,7 @@ pub struct GateStops {
 impl GateStops {
     /// Counts a stop the gate reported as `stopped` (`GateStatus` bits), its sample's longest
     /// move `longest` against the step `limit`.
-    pub fn count(&mut self, stopped: u32, longest: f32, limit: f32) {
+    fn count(&mut self, stopped: u32, longest: f32, limit: f32) {
         let has = |bit: u32| usize::from(stopped & bit != 0);
         self.selection += has(GateStatus::SELECTION);
         self.rings += has(GateStatus::RINGS);

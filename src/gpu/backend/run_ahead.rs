@@ -308,11 +308,8 @@ impl GpuKernels {
             if status.stopped != 0 {
                 // The gate stopped the run here, before this call moved anything, and the
                 // calls after it selected nothing: there is nothing to put back.
-                self.uploads.gated_ahead += 1;
                 let longest = status.longest_move();
-                self.uploads
-                    .gate_stops
-                    .count(status.stopped, longest, limit);
+                self.uploads.count_gate_stop(status.stopped, longest, limit);
                 if let RunCall::Start(index) = call
                     && self.after_stop(index, status, limit)
                 {

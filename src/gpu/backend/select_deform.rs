@@ -249,9 +249,11 @@ impl GpuKernels {
         let vertices: Vec<u32> = selection.iter().map(|&(v, _)| v).collect();
         // Within the assumed move, which is within the step limit: one step, which moves
         // the selection to exactly these targets. The gate checked the same on the GPU.
-        let stopped = parts.gate.is_some_and(|g| g.stopped != 0);
+        let stop = parts.gate.filter(|g| g.stopped != 0);
         let kept = targets.filter(|_| {
-            !stopped && parts.ring_overflows == Some(0) && longest.is_some_and(|l| l <= assumed)
+            stop.is_none()
+                && parts.ring_overflows == Some(0)
+                && longest.is_some_and(|l| l <= assumed)
         });
         match kept {
             Some(targets) => {
@@ -265,23 +267,21 @@ impl GpuKernels {
             }
             // Nothing selected: nothing moved, nothing to drop.
             None if vertices.is_empty() => {}
-            // Stopped by the gate before they moved anything.
-            None if stopped => {
-                self.uploads.gated_ahead += 1;
-                let status = parts.gate.expect("stopped by the gate");
-                let longest = longest.unwrap_or(status.longest_move());
-                self.uploads
-                    .gate_stops
-                    .count(status.stopped, longest, limit);
-            }
-            // The passes moved what they were wrong about.
-            None => put_back(
-                &self.gpu,
-                self.resident.as_ref(),
-                &mut self.uploads,
-                mesh,
-                &vertices,
-            ),
+            None => match stop {
+                // Stopped by the gate before they moved anything.
+                Some(status) => {
+                    let longest = longest.unwrap_or(status.longest_move());
+                    self.uploads.count_gate_stop(status.stopped, longest, limit);
+                }
+                // The passes moved what they were wrong about.
+                None => put_back(
+                    &self.gpu,
+                    self.resident.as_ref(),
+                    &mut self.uploads,
+                    mesh,
+                    &vertices,
+                ),
+            },
         }
     }
 }
