@@ -9,9 +9,10 @@
 //! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 15 s
 //! on two cores). The full one, 10⁴ strokes on ~20K faces:
 //! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --nocapture`. Times are
-//! printed, never asserted. `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke;
-//! `SLAYER_SOAK_TRACE=1` prints each stroke (as a stroke file) before it runs;
-//! `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N`, the stroke and `L` into `DIR`
+//! printed, never asserted: wall-clock and processor time (all threads; the scenes run one at a
+//! time), the second the one to trust when anything else ran beside the soak or paused it.
+//! `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke; `SLAYER_SOAK_TRACE=1` prints each
+//! stroke (as a stroke file) before it runs; `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N`, the stroke and `L` into `DIR`
 //! (`SLAYER_SOAK_DUMP=each:DIR` before every stroke, over the last, to catch one that never ends).
 //! `SLAYER_SOAK_CHECKPOINT=DIR` saves each scene's run at every check and takes it up from
 //! there the next time (`checkpoint`): the full soak over several sittings. A run taken up
@@ -114,9 +115,17 @@ fn random_stroke(mesh: &Mesh, rng: &mut ChaCha8Rng) -> StrokeSpec {
     }
 }
 
+/// The scenes run one at a time, so that the process's processor time over a stroke is that
+/// stroke's alone (the test harness runs tests side by side).
+static ONE_SCENE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Runs half of [`size`]'s strokes, drawn from `seed`, on the scene `kind` at its faces (the
 /// scene's own seed 9), and checks it every [`check_every`] strokes.
 fn soak(kind: SceneKind, seed: u64) {
+    // A scene that failed poisons the lock; the other still runs.
+    let _alone = ONE_SCENE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
     let (strokes, faces) = size();
     let count = strokes / 2;
     let input = generate(&SceneSpec {
@@ -241,6 +250,7 @@ fn run_stroke(
     }
     dump_before(i, session.mesh(), as_json, pipeline.edge_length());
     let started = Instant::now();
+    let cpu_started = process_cpu_seconds();
     let faces_before = session.mesh().live_face_count();
     let phases = match session.apply_stroke(pipeline, &strokes[0]) {
         Ok((report, _)) => {
@@ -263,10 +273,11 @@ fn run_stroke(
         }
     };
     let seconds = started.elapsed().as_secs_f64();
+    let cpu_seconds = process_cpu_seconds() - cpu_started;
     if seconds > 2.0 {
         let (collision, remesh) = phases.map_or((0.0, 0.0), |p| (p.collision, p.remesh));
         eprintln!(
-            "{kind:?} stroke {i}: {seconds:.1} s (collision {:.1} s, remesh {:.1} s), {}",
+            "{kind:?} stroke {i}: {seconds:.1} s, processor {cpu_seconds:.1} s (collision {:.1} s, remesh {:.1} s), {}",
             collision / 1e3,
             remesh / 1e3,
             describe(&strokes[0])
@@ -275,6 +286,10 @@ fn run_stroke(
     if seconds > progress.slowest_seconds {
         progress.slowest_seconds = seconds;
         progress.slowest = describe(&strokes[0]);
+    }
+    if cpu_seconds > progress.slowest_cpu_seconds {
+        progress.slowest_cpu_seconds = cpu_seconds;
+        progress.slowest_cpu = describe(&strokes[0]);
     }
 }
 
@@ -288,7 +303,7 @@ fn print_summary(
 ) {
     let peak = slayer::memory::peak_resident_bytes();
     eprintln!(
-        "{kind:?}: {count} strokes in {:.0} s, {} refused, {} collisions, {} stopped for stretching an edge past its bound, {} undone to keep the size, slowest {:.2} s ({}), {} → {} faces (digest {}), history {:.1} MiB, {} entries dropped, peak memory of the test process {}",
+        "{kind:?}: {count} strokes in {:.0} s, {} refused, {} collisions, {} stopped for stretching an edge past its bound, {} undone to keep the size, slowest {:.2} s ({}), slowest in processor time {:.2} s ({}), {} → {} faces (digest {}), history {:.1} MiB, {} entries dropped, peak memory of the test process {}",
         progress.seconds,
         progress.refused,
         progress.collisions,
@@ -296,6 +311,8 @@ fn print_summary(
         progress.undone,
         progress.slowest_seconds,
         progress.slowest,
+        progress.slowest_cpu_seconds,
+        progress.slowest_cpu,
         faces_at_start,
         session.mesh().live_face_count(),
         &session.mesh().digest()[..16],
@@ -306,6 +323,24 @@ fn print_summary(
             b as f64 / 1048576.0
         ))
     );
+}
+
+/// Processor seconds this process has used, all threads (`/proc/self/stat`'s user and system
+/// times, in the kernel's fixed 100 ticks a second); 0 where that cannot be read.
+fn process_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // The fields after the command name (which may hold spaces) start at the third:
+    // user time is the 14th, system time the 15th.
+    let after_name = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
+    let ticks: u64 = after_name
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .filter_map(|t| t.parse::<u64>().ok())
+        .sum();
+    ticks as f64 / 100.0
 }
 
 /// A stroke in a few words, for the printout of slow strokes.

@@ -33,6 +33,13 @@ pub struct Progress {
     pub stopped: usize,
     pub slowest_seconds: f64,
     pub slowest: String,
+    /// The stroke that took the most processor time (all threads), and that time: unlike the
+    /// wall-clock figure, not inflated by whatever else runs beside the soak or by pausing it
+    /// (a checkpoint saved before it was counted reads 0).
+    #[serde(default)]
+    pub slowest_cpu_seconds: f64,
+    #[serde(default)]
+    pub slowest_cpu: String,
     /// Seconds the strokes took in the sittings before this one.
     pub seconds: f64,
 }
