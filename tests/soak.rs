@@ -6,7 +6,7 @@
 //! undone at the end back to the input (and, where strokes grew the mesh past four times its
 //! faces, undone on the way back to twice).
 //!
-//! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 15 s
+//! The short version, in `tools/test.sh`: 200 strokes in all on ~2K faces (about 25 s
 //! on two cores). The full one, 10⁴ strokes on ~20K faces:
 //! `SLAYER_SOAK_STROKES=10000 cargo test --release --test soak -- --nocapture`. Times are
 //! printed, never asserted: wall-clock and processor time (all threads; the scenes run one at a
