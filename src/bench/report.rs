@@ -329,3 +329,22 @@ fn stop_reasons(by: &GateStops) -> String {
         named.join(", ")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stop_reasons_name_each_reason_counted_and_none_without() {
+        assert_eq!(stop_reasons(&GateStops::default()), "none");
+        let by = GateStops {
+            several_steps: 5,
+            selection: 2,
+            ..GateStops::default()
+        };
+        assert_eq!(
+            stop_reasons(&by),
+            "5 for several steps, 2 for the selection"
+        );
+    }
+}

@@ -247,8 +247,8 @@ impl Uploads {
 }
 
 /// Why the GPU's gate stopped steps run ahead ([`Uploads::gated_ahead`]): a count per reason,
-/// a stop counted under each of its reasons. What a hardware-independent measure of the GPU
-/// path needs to say where its extra blocking read-backs come from.
+/// a stop counted under each of its reasons: where the GPU path's extra blocking read-backs
+/// come from, whatever the adapter.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct GateStops {
     /// The selection outgrew the list's room.
@@ -270,12 +270,15 @@ impl GateStops {
         let has = |bit: u32| usize::from(stopped & bit != 0);
         self.selection += has(GateStatus::SELECTION);
         self.rings += has(GateStatus::RINGS);
-        let moved = has(GateStatus::MOVE);
-        // A NaN move is not within the limit either.
-        let one_step = usize::from(longest <= limit);
-        self.move_grew += moved * one_step;
-        self.several_steps += moved * (1 - one_step);
         self.edges += has(GateStatus::EDGES);
+        if stopped & GateStatus::MOVE != 0 {
+            // A NaN move is not within the limit either.
+            if longest <= limit {
+                self.move_grew += 1;
+            } else {
+                self.several_steps += 1;
+            }
+        }
     }
 
     /// The stops counted since `before`.
@@ -348,5 +351,30 @@ impl StepKernels for CpuKernels {
         _at: Option<CallAt>,
     ) -> Vec<Vec3> {
         deform(state, mesh, dab, selection)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gate_stop_is_counted_under_each_of_its_reasons() {
+        let mut uploads = Uploads::default();
+        let limit = 1.0;
+        uploads.count_gate_stop(GateStatus::SELECTION | GateStatus::MOVE, 0.5, limit);
+        uploads.count_gate_stop(GateStatus::MOVE, 2.5, limit);
+        uploads.count_gate_stop(GateStatus::MOVE | GateStatus::EDGES, f32::NAN, limit);
+        uploads.count_gate_stop(GateStatus::RINGS, 0.0, limit);
+        assert_eq!(uploads.gated_ahead, 4);
+        let expected = GateStops {
+            selection: 1,
+            rings: 1,
+            move_grew: 1,
+            several_steps: 2,
+            edges: 1,
+        };
+        assert_eq!(uploads.gate_stops, expected);
+        assert_eq!(expected.since(expected), GateStops::default());
     }
 }
