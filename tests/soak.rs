@@ -12,8 +12,9 @@
 //! printed, never asserted: wall-clock and processor time (all threads; the scenes run one at a
 //! time), the second the one to trust when anything else ran beside the soak or paused it.
 //! `SLAYER_SOAK_CHECK_EVERY=1` checks after every stroke; `SLAYER_SOAK_TRACE=1` prints each
-//! stroke (as a stroke file) before it runs; `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before stroke `N`, the stroke and `L` into `DIR`
-//! (`SLAYER_SOAK_DUMP=each:DIR` before every stroke, over the last, to catch one that never ends).
+//! stroke (as a stroke file) before it runs; `SLAYER_SOAK_DUMP=N:DIR` writes the mesh before
+//! stroke `N`, the stroke and `L` into `DIR` (`SLAYER_SOAK_DUMP=each:DIR` before every stroke,
+//! over the last, to catch one that never ends).
 //! `SLAYER_SOAK_CHECKPOINT=DIR` saves each scene's run at every check and takes it up from
 //! there the next time (`checkpoint`): the full soak over several sittings. A run taken up
 //! goes on with the same random stream on the saved session, history included, but with its

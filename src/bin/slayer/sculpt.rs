@@ -205,7 +205,6 @@ pub fn run(args: &Args<'_>) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The output (or the stats) naming the input file itself is refused without `--in-place`.
 /// `--edge-length` positive, `--max-stretch` from 2 (remeshing itself leaves edges up to
 /// 4/3 L) to 10⁶.
 fn check_lengths(args: &Args<'_>) -> anyhow::Result<()> {
@@ -248,6 +247,7 @@ fn bounds_met(i: usize, report: &StrokeReport, max_stretch: f32) -> Vec<String> 
     warnings
 }
 
+/// The output (or the stats) naming the input file itself is refused without `--in-place`.
 fn refuse_overwriting_input(args: &Args<'_>) -> anyhow::Result<()> {
     if args.in_place {
         return Ok(());
