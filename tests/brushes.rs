@@ -471,3 +471,50 @@ fn bad_stroke_files_name_the_problem_and_where() {
         assert!(!e.contains('\n'));
     }
 }
+
+/// The longest move a dab's settings allow (`move_bound`, which decides where a GPU run records
+/// a sample's two steps ahead) bounds every brush's displacement of any vertex within its
+/// radius, at any weight, pressure, share, normal and flatten plane point under the brush.
+#[test]
+fn no_brush_moves_a_vertex_farther_than_its_settings_allow() {
+    use proptest::prelude::*;
+    use slayer::brush::{Dab, DabFrame, displacement, move_bound};
+    let unit = || (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0);
+    let settings = (
+        0usize..BrushKind::ALL.len(),
+        0.01f32..5.0,
+        0.0f32..=1.0,
+        any::<bool>(),
+    );
+    let dab = (0.0f32..=1.0, 0.0f32..=1.0, unit(), unit(), unit(), unit());
+    let at = (unit(), unit(), 0.0f32..=1.0);
+    proptest!(|((kind, radius, strength, invert) in settings,
+                 (pressure, share, normal, plane, motion, center) in dab,
+                 (offset, ring, weight) in at)| {
+        let v = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z);
+        let normal = v(normal).try_normalize().unwrap_or(Vec3::Z);
+        let center = v(center) * 3.0;
+        // Within the radius: the vertex and the flatten's plane point (a centroid under it).
+        let inside = |p: Vec3| center + p.clamp_length_max(1.0) * radius;
+        let brush = Brush {
+            kind: BrushKind::ALL[kind],
+            radius,
+            strength,
+            falloff: Falloff::Smooth,
+            invert,
+        };
+        let dab = Dab {
+            brush,
+            frame: DabFrame { center, normal, plane_point: inside(v(plane)), motion: v(motion) },
+            pressure,
+            share: share.max(1e-3),
+        };
+        let position = inside(v(offset));
+        let moved = displacement(&dab, position, normal, position + v(ring), weight).length();
+        match move_bound(&dab) {
+            Some(bound) => prop_assert!(moved <= bound * (1.0 + 1e-5) + 1e-6,
+                "{:?}: {moved} > {bound}", brush.kind),
+            None => prop_assert_eq!(brush.kind, BrushKind::Smooth),
+        }
+    });
+}

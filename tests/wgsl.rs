@@ -690,7 +690,11 @@ fn proximity_and_normal_structs_match_naga_layout() {
                 capacity,
                 stage,
                 assumed_move,
-                max_edge
+                max_edge,
+                defer_over,
+                if_deferred,
+                _pad0,
+                _pad1
             }
         );
         assert_layout!(
@@ -699,7 +703,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
                 stopped,
                 longest,
                 edge,
-                _pad
+                deferred
             }
         );
     }
@@ -709,7 +713,7 @@ fn proximity_and_normal_structs_match_naga_layout() {
             stopped,
             longest,
             edge,
-            _pad
+            deferred
         }
     );
     assert_layout!(

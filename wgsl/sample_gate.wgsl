@@ -29,7 +29,10 @@ fn main(
         case GATE_OPEN: {
             if i == 0u {
                 atomicStore(&status.longest, 0u);
-                if status.stopped != 0u {
+                if params.if_deferred == 0u {
+                    status.deferred = 0u;
+                }
+                if status.stopped != 0u || status.deferred != params.if_deferred {
                     selection_count = 0u;
                 }
             }
@@ -46,17 +49,27 @@ fn main(
                 if ring_overflows != 0u {
                     why |= STOPPED_RINGS;
                 }
-                if atomicLoad(&status.longest) > bitcast<u32>(params.assumed_move) {
+                let longest = atomicLoad(&status.longest);
+                // Over the step limit by at most twice, where the sample's two steps follow.
+                let defers = params.defer_over > 0.0
+                    && longest > bitcast<u32>(params.defer_over)
+                    && longest <= bitcast<u32>(2.0 * params.defer_over);
+                if longest > bitcast<u32>(params.assumed_move) && !defers {
                     why |= STOPPED_MOVE;
                 }
                 if atomicLoad(&status.edge) > bitcast<u32>(params.max_edge) {
                     why |= STOPPED_EDGES;
                 }
                 status.stopped = why;
+                if params.defer_over > 0.0 {
+                    status.deferred = select(0u, 1u, defers && why == 0u);
+                }
             }
         }
         default: {
-            if i < params.capacity && status.stopped != 0u {
+            // A start that deferred moves nothing, nor does a step whose sample did not.
+            let idle = status.stopped != 0u || status.deferred != params.if_deferred;
+            if i < params.capacity && idle {
                 moving[i].vertex = INVALID;
             }
         }

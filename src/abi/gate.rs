@@ -15,6 +15,13 @@ pub struct GateParams {
     pub assumed_move: f32,
     /// The bound on edge lengths at the sample's start the passes were sized for.
     pub max_edge: f32,
+    /// A sample's start whose move is longer than this, and at most twice it, defers its move
+    /// to its two steps recorded after it instead of stopping the run; zero: no such steps.
+    pub defer_over: f32,
+    /// Nonzero: a step of a sample that may defer, which runs only when that sample deferred.
+    pub if_deferred: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 
 impl GateParams {
@@ -26,19 +33,47 @@ impl GateParams {
             stage: stage as u32,
             assumed_move,
             max_edge,
+            defer_over: 0.0,
+            if_deferred: 0,
+            _pad0: 0,
+            _pad1: 0,
         }
     }
+
+    /// The stage for a call that stands as `split` says to a sample that may defer its move.
+    pub fn split(self, split: GateSplit) -> Self {
+        GateParams {
+            defer_over: split.defer_over,
+            if_deferred: u32::from(split.if_deferred),
+            ..self
+        }
+    }
+}
+
+/// How a call recorded in a run stands to a sample that may take two steps: a sample's
+/// move that is over the step limit, by at most twice, need not stop the run when its two
+/// steps are recorded after its start. Its start then moves nothing, and its steps run.
+/// The default: an ordinary call, which runs unless the run stopped.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GateSplit {
+    /// At a sample's start: the step limit, over which (by at most twice) its move defers to
+    /// its two steps; zero where none were recorded.
+    pub defer_over: f32,
+    /// One of those two steps: it runs only when the start deferred.
+    pub if_deferred: bool,
 }
 
 /// The `GATE_*` stages of `wgsl/sample_gate.wgsl`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
 pub enum GateStage {
-    /// After `select`: the longest move reset; a stopped run's selection emptied.
+    /// After `select`: the longest move reset (and, at an ordinary call, the deferral); the
+    /// selection emptied in a stopped run, and at a step whose sample did not defer.
     Open = 0,
     /// After `longest_move` (and the samples before's `moved_edges`): the sample's verdict.
     Decide = 1,
-    /// Per slot of the moving list: vacated when the run has stopped.
+    /// Per slot of the moving list: vacated when the run has stopped, at a start that
+    /// deferred, and at a step whose sample did not.
     Vacate = 2,
 }
 
@@ -55,7 +90,9 @@ pub struct GateStatus {
     /// The run's bound on edge lengths, as `f32` bits: the host's at the run's start, grown by
     /// `moved_edges` after every sample.
     pub edge: u32,
-    pub _pad: u32,
+    /// 1 from the verdict of a sample's start that deferred its move to its two steps until
+    /// the next ordinary call opens; else 0.
+    pub deferred: u32,
 }
 
 impl GateStatus {

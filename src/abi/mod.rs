@@ -22,7 +22,7 @@ pub use dispatch::{
     FRAME_WORKGROUP_SIZE, GATE_WORKGROUP_SIZE, PAGE_COUNT, PAGE_SHIFT_CONSTANT,
     PROXIMITY_WORKGROUP_SIZE, WORKGROUP_SIZE,
 };
-pub use gate::{GateParams, GateStage, GateStatus};
+pub use gate::{GateParams, GateSplit, GateStage, GateStatus};
 pub use hash::{CellKeyParams, CountParams, CsrTable, OverlayParams, SCAN_BLOCK};
 pub use moves::{
     ApplyMode, ApplyParams, BACKSTOP_MARGIN, BackstopParams, CLAMP_SLACK, EntryParams, FACE_WORDS,

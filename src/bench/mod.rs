@@ -134,6 +134,9 @@ pub struct GpuCalls {
     /// Samples and steps taken from runs ahead.
     pub samples_ahead: usize,
     pub steps_ahead: usize,
+    /// Samples of two steps whose steps a run recorded after their start, so that the gate
+    /// did not stop it there.
+    pub split_ahead: usize,
 }
 
 impl GpuCalls {
@@ -161,6 +164,7 @@ impl GpuCalls {
             gate_stops_by: after.gate_stops.since(before.gate_stops),
             samples_ahead: after.samples_ahead - before.samples_ahead,
             steps_ahead: after.steps_ahead - before.steps_ahead,
+            split_ahead: after.split_ahead - before.split_ahead,
         }
     }
 }

@@ -58,7 +58,8 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
                 out,
                 "gpu calls {}: {:.2} submissions and {:.2} blocking read-backs per sample, \
                  {:.2} read-backs per stroke, {:.2} per call ({feed} per call); {} samples and \
-                 {} steps taken from runs ahead, the gate stopped {} ({:.1}% of samples: {})",
+                 {} steps taken from runs ahead ({} samples split in two there), the gate \
+                 stopped {} ({:.1}% of samples: {})",
                 r.name,
                 c.submissions_per_sample,
                 c.read_backs_per_sample,
@@ -66,6 +67,7 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
                 c.read_backs_per_call,
                 c.samples_ahead,
                 c.steps_ahead,
+                c.split_ahead,
                 c.gate_stops,
                 100.0 * c.gate_stops_per_sample,
                 stop_reasons(&c.gate_stops_by)

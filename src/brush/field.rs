@@ -34,6 +34,30 @@ pub struct Dab {
     pub share: f32,
 }
 
+/// The longest move any vertex can make under `dab`, where the brush's settings bound it: every
+/// weight is at most 1, and every vertex it moves lies within its radius (a flatten's plane
+/// point too, so no vertex stands farther than twice the radius from the plane). `None` for
+/// smooth, whose move is the surface's (the distance to a one-ring's centroid).
+pub fn move_bound(dab: &Dab) -> Option<f32> {
+    let brush = &dab.brush;
+    let amount = (brush.strength * dab.pressure * dab.share).abs();
+    let radius = brush.radius;
+    let bound = match brush.kind {
+        BrushKind::Draw | BrushKind::Inflate | BrushKind::Deflate => amount * DRAW_RATE * radius,
+        BrushKind::Grab | BrushKind::Sweep | BrushKind::SweepVolume => {
+            dab.frame.motion.length() * dab.share
+        }
+        BrushKind::Flatten | BrushKind::Trim => 2.0 * radius * amount.min(1.0),
+        BrushKind::Pinch => amount * PINCH_RATE * radius,
+        BrushKind::Crease => amount * (DRAW_RATE + PINCH_RATE) * radius,
+        // A turn by an angle moves a point by at most the angle times its distance to the axis.
+        BrushKind::Twist => amount * TWIST_RATE * radius,
+        BrushKind::Paint | BrushKind::Mask => 0.0,
+        BrushKind::Smooth => return None,
+    };
+    Some(bound)
+}
+
 /// Displacement of a vertex at `position` with normal `vertex_normal`, weight `weight` (the
 /// falloff at its distance, or its captured weight for grab) and `ring_centroid` (centroid of
 /// its one-ring, for smooth).

@@ -12,7 +12,7 @@ mod stroke;
 
 pub use decode::{MAX_SAMPLES_PER_FILE, MAX_SAMPLES_PER_STROKE, MAX_STROKES};
 pub use falloff::Falloff;
-pub use field::{Dab, DabFrame, displacement};
+pub use field::{Dab, DabFrame, displacement, move_bound};
 pub use mirror::{Mirror, SymmetrySpec};
 pub use paint::{Paint, paint_share};
 pub use resample::{DabLimit, MAX_DABS_PER_STROKE, Resampler, dabs_for, resample};

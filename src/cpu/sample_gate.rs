@@ -12,10 +12,12 @@ pub struct GateState<'a> {
     pub status: &'a mut GateStatus,
 }
 
-/// Runs the stage `params.stage` names: [`GateStage::Open`] resets the longest move and
-/// empties a stopped run's selection; [`GateStage::Decide`] records why the sample stops the
-/// run (nothing when it holds); [`GateStage::Vacate`] vacates the first `params.capacity`
-/// moving entries of a stopped run. `ring_overflows` counts the rings `moving_entries` cut.
+/// Runs the stage `params.stage` names: [`GateStage::Open`] resets the longest move (and at an
+/// ordinary call the deferral) and empties the selection of a stopped run or of a step whose
+/// sample did not defer; [`GateStage::Decide`] records why the sample stops the run (nothing
+/// when it holds) and, at a start that may defer, whether it did; [`GateStage::Vacate`]
+/// vacates the first `params.capacity` moving entries where the call moves nothing.
+/// `ring_overflows` counts the rings `moving_entries` cut.
 pub fn sample_gate(params: &GateParams, ring_overflows: u32, gate: GateState<'_>) {
     let GateState {
         selection_count,
@@ -25,7 +27,10 @@ pub fn sample_gate(params: &GateParams, ring_overflows: u32, gate: GateState<'_>
     if params.stage == GateStage::Open as u32 {
         for _ in invocations(1) {
             status.longest = 0;
-            if status.stopped != 0 {
+            if params.if_deferred == 0 {
+                status.deferred = 0;
+            }
+            if status.stopped != 0 || status.deferred != params.if_deferred {
                 *selection_count = 0;
             }
         }
@@ -41,17 +46,26 @@ pub fn sample_gate(params: &GateParams, ring_overflows: u32, gate: GateState<'_>
             if ring_overflows != 0 {
                 why |= GateStatus::RINGS;
             }
-            if status.longest > params.assumed_move.to_bits() {
+            // Over the step limit by at most twice, where the sample's two steps follow.
+            let defers = params.defer_over > 0.0
+                && status.longest > params.defer_over.to_bits()
+                && status.longest <= (2.0 * params.defer_over).to_bits();
+            if status.longest > params.assumed_move.to_bits() && !defers {
                 why |= GateStatus::MOVE;
             }
             if status.edge > params.max_edge.to_bits() {
                 why |= GateStatus::EDGES;
             }
             status.stopped = why;
+            if params.defer_over > 0.0 {
+                status.deferred = u32::from(defers && why == 0);
+            }
         }
     } else {
+        // A start that deferred moves nothing, nor does a step whose sample did not.
+        let idle = status.stopped != 0 || status.deferred != params.if_deferred;
         for i in invocations(params.capacity) {
-            if status.stopped != 0 {
+            if idle {
                 moving[i as usize].vertex = INVALID;
             }
         }

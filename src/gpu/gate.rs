@@ -8,7 +8,7 @@ use glam::Vec3;
 use super::vertex_normals::MovedPass;
 use super::{GpuContext, GpuError};
 use crate::abi::{
-    GATE_WORKGROUP_SIZE, GateParams, GateStage, GateStatus, MovingVertex, SelectedVertex,
+    GATE_WORKGROUP_SIZE, GateParams, GateSplit, GateStage, GateStatus, MovingVertex, SelectedVertex,
 };
 use crate::mesh::Mesh;
 
@@ -61,32 +61,33 @@ fn record_stage(
     Ok(())
 }
 
-/// Records the gate's opening, right after the sample's `select`: the longest move reset, and
-/// the selection emptied when an earlier sample stopped the run.
+/// Records the gate's opening, right after the call's `select`: the longest move reset, and
+/// the selection emptied when an earlier sample stopped the run (or, at a step of a sample
+/// that may defer, as `split` says, when it did not).
 pub fn record_gate_open(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     gate: &GateBuffers<'_>,
+    split: GateSplit,
 ) -> Result<(), GpuError> {
-    record_stage(
-        gpu,
-        encoder,
-        gate,
-        &GateParams::new(0, GateStage::Open, (0.0, 0.0)),
-    )
+    let params = GateParams::new(0, GateStage::Open, (0.0, 0.0)).split(split);
+    record_stage(gpu, encoder, gate, &params)
 }
 
 /// Records the sample's check, after its `moving_entries` and before anything is applied:
 /// `longest_move` over the first `capacity` selection entries, the verdict against
-/// `capacity` and the move and edge bounds the passes were sized for, and the moving list's
-/// `capacity` slots vacated if the run stopped.
+/// `capacity` and the move and edge bounds the passes were sized for (a start's move deferred
+/// to its steps where `split` says they follow), and the moving list's `capacity` slots vacated
+/// where the call moves nothing.
 pub fn record_gate_check(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     gate: &GateBuffers<'_>,
     (capacity, assumed_move, max_edge): (usize, f32, f32),
+    split: GateSplit,
 ) -> Result<(), GpuError> {
-    let params = GateParams::new(capacity, GateStage::Decide, (assumed_move, max_edge));
+    let bounds = (assumed_move, max_edge);
+    let params = GateParams::new(capacity, GateStage::Decide, bounds).split(split);
     let pipeline = gpu.compute_pipeline("longest_move")?;
     let uniform = gpu.uniform_buffer("longest_move params", &params);
     gpu.record_dispatch(
@@ -105,19 +106,20 @@ pub fn record_gate_check(
         GATE_WORKGROUP_SIZE,
     );
     record_stage(gpu, encoder, gate, &params)?;
-    record_gate_vacate(gpu, encoder, gate, capacity)
+    record_gate_vacate(gpu, encoder, gate, capacity, split)
 }
 
-/// Records the vacating of the first `capacity` slots of `gate.moving` when the run has
-/// stopped (a step's moving list before anything is applied, or the lists a sample's steps
-/// kept for its normals).
+/// Records the vacating of the first `capacity` slots of `gate.moving` where the call (as
+/// `split` stands to a sample that may defer) moves nothing: a step's moving list before
+/// anything is applied, or the lists a sample's steps kept for its normals.
 pub fn record_gate_vacate(
     gpu: &GpuContext,
     encoder: &mut wgpu::CommandEncoder,
     gate: &GateBuffers<'_>,
     capacity: usize,
+    split: GateSplit,
 ) -> Result<(), GpuError> {
-    let params = GateParams::new(capacity, GateStage::Vacate, (0.0, 0.0));
+    let params = GateParams::new(capacity, GateStage::Vacate, (0.0, 0.0)).split(split);
     record_stage(gpu, encoder, gate, &params)
 }
 

@@ -32,7 +32,7 @@ pub use crate::abi::{
     APPLY_WORKGROUP_SIZE, ApplyMode, ApplyParams, BACKSTOP_WORKGROUP_SIZE, BackstopParams,
     BrushSphere, CellKeyParams, CountParams, CsrTable, DeformParams, DispatchParams,
     ENTRIES_WORKGROUP_SIZE, EntryParams, FACE_WORDS, FRAME_WORKGROUP_SIZE, FrameParams,
-    GATE_WORKGROUP_SIZE, GateParams, GateStage, GateStatus, MovingVertex, NormalParams,
+    GATE_WORKGROUP_SIZE, GateParams, GateSplit, GateStage, GateStatus, MovingVertex, NormalParams,
     OverlayParams, PAGE_COUNT, PAGE_SHIFT_CONSTANT, PROXIMITY_WORKGROUP_SIZE, ProximityParams,
     PulledVertex, SCAN_BLOCK, SelectParams, SelectedVertex, brush_code, falloff_code,
 };

@@ -235,6 +235,9 @@ pub struct Uploads {
     pub samples_ahead: usize,
     /// Steps of samples of several steps taken from such submissions.
     pub steps_ahead: usize,
+    /// Samples whose move, over the step limit, the gate let go to their two steps recorded
+    /// after their start in such a submission instead of stopping it there.
+    pub split_ahead: usize,
 }
 
 impl Uploads {

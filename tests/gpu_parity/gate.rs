@@ -122,36 +122,41 @@ fn longest_move_matches_the_cpu_mirror_at_awkward_sizes() {
     }
 }
 
+/// One `sample_gate` stage on the GPU and in the mirror, which must agree; the GPU's result.
+fn gate_stage(
+    gpu: &GpuContext,
+    params: &slayer::gpu::GateParams,
+    overflows: u32,
+    (count, moving, status): (u32, &[slayer::gpu::MovingVertex], slayer::gpu::GateStatus),
+) -> (u32, Vec<slayer::gpu::MovingVertex>, slayer::gpu::GateStatus) {
+    let mut mirror = (count, moving.to_vec(), status);
+    slayer::cpu::sample_gate(
+        params,
+        overflows,
+        slayer::cpu::GateState {
+            selection_count: &mut mirror.0,
+            moving: &mut mirror.1,
+            status: &mut mirror.2,
+        },
+    );
+    let actual = slayer::gpu::run_sample_gate(gpu, params, overflows, (count, moving, status))
+        .expect("GPU run");
+    assert_eq!(actual, mirror, "{params:?} overflows {overflows}");
+    actual
+}
+
 #[test]
 fn sample_gate_stages_match_the_cpu_mirror() {
     use slayer::gpu::{GateParams, GateStage, GateStatus, MovingVertex};
     let mut gpu = gpu();
-    let run = |gpu: &GpuContext,
-               params: &GateParams,
-               overflows: u32,
-               (count, moving, status): (u32, &[MovingVertex], GateStatus)| {
-        let mut mirror = (count, moving.to_vec(), status);
-        slayer::cpu::sample_gate(
-            params,
-            overflows,
-            slayer::cpu::GateState {
-                selection_count: &mut mirror.0,
-                moving: &mut mirror.1,
-                status: &mut mirror.2,
-            },
-        );
-        let actual = slayer::gpu::run_sample_gate(gpu, params, overflows, (count, moving, status))
-            .expect("GPU run");
-        assert_eq!(actual, mirror, "{params:?} overflows {overflows}");
-        actual
-    };
+    let run = gate_stage;
     // Opening: the longest move reset; the selection emptied only in a stopped run.
     for stopped in [0, GateStatus::MOVE, GateStatus::EARLIER] {
         let status = GateStatus {
             stopped,
             longest: 7.5f32.to_bits(),
             edge: 2.0f32.to_bits(),
-            _pad: 0,
+            deferred: 0,
         };
         let open = GateParams::new(0, GateStage::Open, (0.0, 0.0));
         let (count, _, after) = run(&gpu, &open, 0, (77, &[], status));
@@ -181,7 +186,7 @@ fn sample_gate_stages_match_the_cpu_mirror() {
                         stopped: stopped_before,
                         longest: longest.to_bits(),
                         edge: edge.to_bits(),
-                        _pad: 0,
+                        deferred: 0,
                     };
                     let decide = GateParams::new(capacity, GateStage::Decide, (assumed, max_edge));
                     let (after_count, _, after) =
@@ -311,6 +316,83 @@ fn check_moved_edges(binding: Binding) {
             deviation <= 1e-6 * expected,
             "size {size}: GPU {} mirror {expected}",
             actual.edge_bound()
+        );
+    }
+}
+
+/// A start whose split steps follow defers a move over the step limit, by at most twice, to
+/// them instead of stopping the run: it moves nothing, they run; a start that does not defer
+/// leaves them empty and vacated; the next ordinary call clears the deferral. The GPU and the
+/// mirror agree at every stage, and on the bounds (the limit, twice it, the floats beside,
+/// NaN).
+#[test]
+fn a_start_defers_a_move_of_two_steps_to_its_split_steps_as_the_mirror_does() {
+    use slayer::gpu::{GateParams, GateSplit, GateStage, GateStatus, MovingVertex};
+    let gpu = gpu();
+    let (limit, assumed, max_edge) = (0.5f32, 0.25f32, 1.5f32);
+    let start = GateSplit {
+        defer_over: limit,
+        if_deferred: false,
+    };
+    let split = GateSplit {
+        defer_over: 0.0,
+        if_deferred: true,
+    };
+    let beside = |x: f32| {
+        [
+            f32::from_bits(x.to_bits() - 1),
+            x,
+            f32::from_bits(x.to_bits() + 1),
+        ]
+    };
+    let moves = [0.1, assumed, 0.4, 0.75, f32::NAN]
+        .into_iter()
+        .chain(beside(limit))
+        .chain(beside(2.0 * limit));
+    let moving: Vec<MovingVertex> = (0..10u32)
+        .map(|i| MovingVertex {
+            start: [i as f32, 0.0, 0.0],
+            vertex: 2 * i,
+            layer: 0,
+            ring_start: i,
+            ring_end: i + 1,
+            _pad: 0,
+        })
+        .collect();
+    let capacity = moving.len();
+    for longest in moves {
+        let status = GateStatus {
+            longest: longest.to_bits(),
+            ..GateStatus::starting(max_edge)
+        };
+        let decide = GateParams::new(capacity, GateStage::Decide, (assumed, max_edge));
+        let (_, _, decided) = gate_stage(&gpu, &decide.split(start), 0, (7, &[], status));
+        let defers = longest > limit && longest <= 2.0 * limit;
+        let held = longest <= assumed;
+        assert_eq!(decided.deferred, u32::from(defers), "move {longest}");
+        let stopped = if defers || held { 0 } else { GateStatus::MOVE };
+        assert_eq!(decided.stopped, stopped, "move {longest}");
+        // The start's own moves are vacated when it deferred (or stopped).
+        let vacate = GateParams::new(capacity, GateStage::Vacate, (0.0, 0.0));
+        let (_, after, _) = gate_stage(&gpu, &vacate.split(start), 0, (7, &moving, decided));
+        let vacated = after.iter().filter(|m| m.vertex == INVALID).count();
+        assert_eq!(vacated, if held { 0 } else { capacity }, "move {longest}");
+        // Each split step selects, and keeps its moves, only after a start that deferred.
+        let open = GateParams::new(0, GateStage::Open, (0.0, 0.0)).split(split);
+        let (count, _, opened) = gate_stage(&gpu, &open, 0, (7, &[], decided));
+        assert_eq!(count, if defers { 7 } else { 0 }, "move {longest}");
+        let step_decide = GateParams::new(capacity, GateStage::Decide, (limit, max_edge));
+        let (_, _, step) = gate_stage(&gpu, &step_decide.split(split), 0, (count, &[], opened));
+        assert_eq!(step.deferred, decided.deferred, "a step keeps the deferral");
+        let (_, after, _) = gate_stage(&gpu, &vacate.split(split), 0, (count, &moving, step));
+        let vacated = after.iter().filter(|m| m.vertex == INVALID).count();
+        assert_eq!(vacated, if defers { 0 } else { capacity }, "move {longest}");
+        // The next ordinary call opens as in a run that never deferred.
+        let ordinary = GateParams::new(0, GateStage::Open, (0.0, 0.0));
+        let (count, _, next) = gate_stage(&gpu, &ordinary, 0, (7, &[], step));
+        assert_eq!(
+            (count, next.deferred),
+            (if step.stopped == 0 { 7 } else { 0 }, 0)
         );
     }
 }

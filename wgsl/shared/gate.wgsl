@@ -16,6 +16,13 @@ struct GateParams {
     assumed_move: f32,
     // The bound on edge lengths at the sample's start the passes were sized for.
     max_edge: f32,
+    // At a sample's start whose two steps are recorded after it: the step limit. A move over
+    // it, by at most twice, defers to those steps instead of stopping the run. Zero: none.
+    defer_over: f32,
+    // Nonzero at one of those two steps: it runs only when its sample's start deferred.
+    if_deferred: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Host struct: `GateStatus`. One per run, read back after every sample's decision.
@@ -29,15 +36,19 @@ struct GateStatus {
     // The run's bound on edge lengths, as f32 bits: the host's at the run's start, grown by
     // `moved_edges` after every sample.
     edge: atomic<u32>,
-    _pad: u32,
+    // 1 from the verdict of a start that deferred its move to its two steps until the next
+    // ordinary call opens.
+    deferred: u32,
 }
 
-// At the sample's start, after `select`: the longest move reset, and a stopped run's selection
-// emptied, so that nothing after it in the sample does any work.
+// At the call's start, after `select`: the longest move reset (the deferral too, at an
+// ordinary call), and the selection emptied in a stopped run or at a step whose sample did not
+// defer, so that nothing after it in the call does any work.
 const GATE_OPEN: u32 = 0u;
 // After `deform`, `moving_entries` and `longest_move`: the sample's verdict.
 const GATE_DECIDE: u32 = 1u;
-// Per slot of the moving list: vacated when the run has stopped, so no pass moves anything.
+// Per slot of the moving list: vacated when the run has stopped, at a start that deferred and
+// at a step whose sample did not, so no pass moves anything.
 const GATE_VACATE: u32 = 2u;
 
 const STOPPED_EARLIER: u32 = 1u;

@@ -65,6 +65,9 @@ impl GpuKernels {
             return Ok((Vec::new(), Backstop::Undecided(Vec::new())));
         }
         self.check_injected_failure()?;
+        // Calls still queued were recorded on positions before moves that were not theirs (a
+        // start that deferred to steps the pipeline did not take): the passes read the mesh's.
+        self.drop_queued(mesh);
         let filter = self.backstop_on_gpu;
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(

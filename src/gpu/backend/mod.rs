@@ -33,6 +33,7 @@ mod clamp;
 mod hashed;
 mod resident;
 mod run_ahead;
+mod run_record;
 mod select_deform;
 mod step_buffers;
 
@@ -86,6 +87,10 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
+    /// How much a run's later samples assume the edges grow per sample before them, as a
+    /// share of the assumed move: raised by runs that measured more on this mesh
+    /// (`RunShape::next_edge_growth`).
+    edge_growth: f32,
     /// The step limit of the stroke, and the last sample start: the pipeline deforms its
     /// selection again at the first step of a sample of several, which then records the
     /// sample's steps and the samples after it in one run (`deform`).
@@ -156,6 +161,7 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
+            edge_growth: run_record::EDGE_GROWTH_LEAST,
             step_limit: None,
             opened: None,
             no_run_at: None,
@@ -360,10 +366,10 @@ impl StepKernels for GpuKernels {
         at: Option<CallAt>,
     ) -> Vec<Vec3> {
         // The first step of a sample of several: the selection its start found, under the same
-        // brush (a share of the move). Its steps and the samples after it run ahead in one
-        // submission; or, when they do not, the step is selected again with the deformation
-        // and its passes in one submission, as a later step is, when the selection comes out
-        // the same.
+        // brush (a share of the move). A run may have recorded it after the start (a split
+        // step); else its steps and the samples after it run ahead in one submission; or, when
+        // they do not, the step is selected again with the deformation and its passes in one
+        // submission, as a later step is, when the selection comes out the same.
         let opened = self.opened.take();
         let first_step = match (opened, at) {
             (
@@ -379,6 +385,19 @@ impl StepKernels for GpuKernels {
         if let (Some((opened, steps)), Some(limit)) = (first_step, self.step_limit)
             && self.failed.is_none()
         {
+            let first = CallAt::Step {
+                sample: opened.sample,
+                k: 0,
+                steps,
+            };
+            let queued = self.take_queued_step(mesh, (first, Some(selection)), state.max_edge);
+            if let Some(Deformed {
+                targets: Some(targets),
+                ..
+            }) = queued
+            {
+                return targets;
+            }
             let sample = (opened.sample, steps);
             if let Some(targets) = self.run_steps_ahead(
                 state,
@@ -499,6 +518,7 @@ impl StepKernels for GpuKernels {
         // Sized for the last mesh's brushes.
         self.last_selection = 0;
         self.last_move = 0.0;
+        self.edge_growth = run_record::EDGE_GROWTH_LEAST;
     }
 
     fn vertex_buffers(&mut self, mesh: &Mesh) -> Option<EngineVertices> {

@@ -24,12 +24,16 @@
 //! and the normals around them).
 //!
 //! A sample that moves farther than a step takes several, each a share of its move, and the
-//! step count is known only from its whole move. The gate stops a run at the start of such a
-//! sample; what that start read (its selection, frame and whole move: nothing moved since)
-//! answers the pipeline's call for it, and the pipeline's call for its first step records its
-//! steps and the samples after it in the next run ([`RunCall::Step`]). Each step deforms on the
-//! normals from before the sample, as the pipeline's do; the normals its moves turned are
-//! recomputed after its last step.
+//! step count is known only from its whole move. Where a sample's settings do not rule that
+//! out, the run records after its start the two steps of a move over the step limit by at most
+//! twice ([`RunCall::SplitStep`]: under half the move, the frame read from the sums the start
+//! left): the gate lets such a start defer its move to them — it moves nothing, they run — and
+//! empties them otherwise. Any other sample of several steps stops the run at its start; what
+//! that start read (its selection, frame and whole move: nothing moved since) answers the
+//! pipeline's call for it, and the pipeline's call for its first step records its steps and the
+//! samples after it in the next run ([`RunCall::Step`]). Each step deforms on the normals from
+//! before the sample, as the pipeline's do; the normals its moves turned are recomputed after
+//! its last step.
 //!
 //! [`StepKernels::given`]: crate::pipeline::StepKernels::given
 
@@ -40,27 +44,19 @@ use glam::Vec3;
 use super::GpuKernels;
 use super::clamp::ClampedAhead;
 use super::hashed::{TableUse, cell_size};
-use super::resident::{Resident, put_back_rows};
-use super::select_deform::{
-    AheadBounds, RecordedSample, SampleLayout, in_vertex_order, permuted, record_sample,
-    selection_guess,
-};
-use super::step_buffers::StepBuffers;
-use crate::brush::Dab;
-use crate::collide::StrokeState;
-use crate::cpu::FRAME_SUM_WORDS;
-use crate::gpu::reusable::ReusableBuffer;
-use crate::gpu::{
-    GateBuffers, GateStatus, GpuContext, GpuError, MovingVertex, SelectedVertex,
-    record_gate_vacate, record_moved_edges, record_moved_normals, ring_bytes,
-};
+use super::resident::put_back_rows;
+use super::run_record::{RunCall, RunShape, SPLIT_STEPS, may_take_steps, record_run};
+use super::select_deform::{AheadBounds, SampleLayout, in_vertex_order, permuted, selection_guess};
+use crate::brush::{Dab, DabFrame};
+use crate::collide::{Backstop, StrokeState};
+use crate::gpu::{GateSplit, GateStatus, GpuError, MovingVertex, SelectedVertex, ring_bytes};
 use crate::mesh::Mesh;
 use crate::pipeline::step::longest_move;
-use crate::pipeline::{CallAt, Deformed, FrameSource, SampleProbe};
+use crate::pipeline::{CallAt, Deformed};
 
 /// At most this many samples in one submission: the read-back grows with each, and each later
-/// sample's passes are sized for edges grown by [`EDGE_GROWTH_AHEAD`] per sample before it, so
-/// their reach grows with the run. A run records every sample given from where it starts, up
+/// sample's passes are sized for edges grown by a share of the move per sample before it
+/// ([`RunShape::edge_bound`]), so their reach grows with the run. A run records every sample given from where it starts, up
 /// to this many: a stroke given whole costs one blocking read-back per run, one more per gate
 /// stop. A run the gate stops still has the GPU go through the recorded passes of every sample
 /// after the stop, emptied but dispatched (a fixed cost per dispatch on a hardware GPU); runs
@@ -71,49 +67,6 @@ pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 /// A sample of at most this many steps has them recorded in a run (each step's moving list
 /// is kept until the sample's last, for the normals): the bench strokes took at most 3.
 pub(super) const MAX_STEPS_AHEAD: usize = 8;
-
-/// A run's later samples assume the mesh's longest edge grows by at most this share of the
-/// assumed move per sample before them; the gate stops the run at the first whose edges, as
-/// `moved_edges` measured them, say otherwise (and the host drops it should the pipeline's own
-/// bound disagree). A step lengthens an edge by at most twice its longest move, but the
-/// passes' reach grows with the edge bound (their work with its cube): plaster at 2K faces,
-/// steps of a cell, grew its longest edge by 0 to 0.32 of the step limit a sample; assuming the
-/// worst case (2) made a run of four samples cost three times one assuming this share. With the
-/// gate, 0.25 stopped the run-ahead test's runs once more for the same lavapipe time.
-const EDGE_GROWTH_AHEAD: f32 = 0.5;
-
-/// What a run records at one place, and what the pipeline's call for it must be.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum RunCall {
-    /// Planned sample `index` from its start: its selection, brush frame and whole
-    /// deformation (`select_deform_and_clamp` with the sample's probe), and the passes of its
-    /// one step.
-    Start(usize),
-    /// Step `k` of the `steps` of the stroke's sample numbered `sample`, each under `dab` (the
-    /// sample's frame, a share of its move): selected again and deformed, with the step's
-    /// passes. The pipeline asks for step 0 with `deform` on the sample's selection, and for
-    /// the later ones with `select_deform_and_clamp` under the dab.
-    Step {
-        sample: usize,
-        dab: Dab,
-        k: usize,
-        steps: usize,
-    },
-}
-
-impl RunCall {
-    /// The dab the call is recorded under, and where its frame comes from (`plan`: the
-    /// stroke's planned samples).
-    fn dab_and_source(self, plan: &[SampleProbe]) -> (Dab, FrameSource) {
-        match self {
-            RunCall::Start(index) => {
-                let (dab, normal) = plan[index];
-                (dab, FrameSource::Selection { normal })
-            }
-            RunCall::Step { dab, .. } => (dab, FrameSource::Dab),
-        }
-    }
-}
 
 /// A sample start or step recorded ahead, waiting for the pipeline to reach it.
 pub(super) struct QueuedCall {
@@ -162,10 +115,11 @@ impl GpuKernels {
     }
 
     /// Records in one submission the `steps` of a sample of several (all under its dab) when
-    /// given, then the given samples from `from` (at most [`MAX_SAMPLES_AHEAD`]), and queues what each left for the pipeline; nothing when that
-    /// is fewer than two. The passes are sized as a single step's would be (`assumed_move`:
-    /// twice the last move, within `limit`), each later call's from edges grown by
-    /// [`EDGE_GROWTH_AHEAD`] of that move per call before it.
+    /// given, then the given samples from `from` (at most [`MAX_SAMPLES_AHEAD`]), and queues
+    /// what each left for the pipeline; nothing when that is fewer than two. The passes are
+    /// sized as a single step's would be (`assumed_move`: a multiple of the last move, within
+    /// `limit`; a split step's for the limit), each later call's from edges grown by a share
+    /// of that move per call before it ([`RunShape::edge_bound`]).
     pub(super) fn gpu_run_ahead(
         &mut self,
         state: &StrokeState<'_>,
@@ -176,7 +130,7 @@ impl GpuKernels {
         self.check_injected_failure()?;
         self.check_gpu_filing(mesh);
         self.drop_all_ahead(mesh);
-        let (calls, step_count) = self.run_calls(steps, from);
+        let (calls, held_lists) = self.run_calls(steps, from, limit);
         let count = calls.len();
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
@@ -197,12 +151,12 @@ impl GpuKernels {
         // The rings of the guessed slots, and the moving lists the steps keep, must each fit
         // one binding.
         let binding = gpu.limits.max_storage_buffer_binding_size;
-        if count < 2 || ring_bytes(guess) > binding || step_count as u64 * moving_bytes > binding {
+        if count < 2 || ring_bytes(guess) > binding || held_lists as u64 * moving_bytes > binding {
             return Ok(());
         }
         step.reserve_sample(gpu, (r, mesh), guess, true, true, filter)?;
         step.held_moving
-            .reserve(gpu, step_count as u64 * moving_bytes)?;
+            .reserve(gpu, held_lists as u64 * moving_bytes)?;
         // Room for the overlay's members and for every slot of the moving lists of the calls
         // that file theirs (all but the last); no more than the vertices there are.
         let room = (r.hashed().overlay.as_ref().map_or(0, |o| o.members.len())
@@ -218,23 +172,29 @@ impl GpuKernels {
             ahead: AheadBounds {
                 assumed_move,
                 drift,
+                split: GateSplit::default(),
             },
             filter,
+            limit,
+            edge_growth: self.edge_growth,
         };
         let run = (calls.as_slice(), self.plan.as_slice());
         let (data, layouts, stride) = record_run(gpu, (&*r, step, readback), state, run, &shape)?;
         self.uploads.batches += 1;
         let read = (data.as_slice(), layouts.as_slice(), stride);
-        self.queue_run(read, &calls, state.max_edge, &shape, (capacity, limit));
+        self.queue_run(read, &calls, state.max_edge, &shape, capacity);
         Ok(())
     }
 
     /// The calls of a run: the `steps` of a sample of several when given, then the given
-    /// samples from `from` (at most [`MAX_SAMPLES_AHEAD`]); and how many of them are steps.
+    /// samples from `from` (at most [`MAX_SAMPLES_AHEAD`]), each followed by its split steps
+    /// where its move may be over the step `limit`; and how many moving lists the steps of
+    /// one sample keep at most.
     fn run_calls(
         &self,
         steps: Option<(usize, Dab, usize)>,
         from: Option<usize>,
+        limit: f32,
     ) -> (Vec<RunCall>, usize) {
         let mut calls: Vec<RunCall> = steps
             .into_iter()
@@ -247,95 +207,110 @@ impl GpuKernels {
                 })
             })
             .collect();
-        let step_count = calls.len();
+        let mut held_lists = calls.len();
         if let Some(from) = from {
             let samples = (self.plan.len() - from).min(MAX_SAMPLES_AHEAD);
-            calls.extend((from..from + samples).map(RunCall::Start));
+            for index in from..from + samples {
+                calls.push(RunCall::Start(index));
+                if may_take_steps(&self.plan[index].0, limit) {
+                    calls.extend((0..SPLIT_STEPS).map(|k| RunCall::SplitStep { index, k }));
+                    held_lists = held_lists.max(SPLIT_STEPS);
+                }
+            }
         }
-        (calls, step_count)
+        (calls, held_lists)
     }
 
     /// Queues what each of a run's `calls` left for the pipeline — `data`, `stride` bytes a
     /// call, split as `layouts` — up to the call where the gate stopped the run (that one too
     /// when the pipeline's call for it is answered from here, [`GpuKernels::after_stop`]), and
     /// notes what the GPU filed for the host's next filing. `max_edge`: the pipeline's bound
-    /// on the edges at the run's start; `capacity`: the selection list's; `limit`: the step
-    /// limit.
+    /// on the edges at the run's start; `capacity`: the selection list's. A start that
+    /// deferred its move is answered as a stopped one is, and its split steps are queued as
+    /// the steps the pipeline will ask for; the split steps of one that did not moved nothing.
     fn queue_run(
         &mut self,
         (data, layouts, stride): (&[u8], &[SampleLayout], u64),
         calls: &[RunCall],
         max_edge: f32,
         shape: &RunShape,
-        (capacity, limit): (usize, f32),
+        capacity: usize,
     ) {
-        let (count, guess) = (shape.count, shape.guess);
-        let assumed_move = shape.ahead.assumed_move;
-        let list_bytes = shape.list_bytes();
+        let count = shape.count;
         // What the GPU filed, for the host's next filing to hold too.
         let mut filed_on_gpu = Vec::new();
+        // The frame of the last start, when it deferred its move to its split steps.
+        let mut deferred: Option<DabFrame> = None;
         for (j, bytes) in data.chunks_exact(stride as usize).enumerate() {
-            let found = (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize)
-                .min(capacity);
-            self.last_selection = self.last_selection.max(found);
-            let head = found.min(guess);
-            let list: Vec<SelectedVertex> = bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * head]);
-            let call = calls[j];
-            let (dab, _) = call.dab_and_source(&self.plan);
-            let layout = layouts[j];
-            let parts = layout.split(&bytes[4 + list_bytes as usize..], &dab);
-            let status = parts.gate.expect("runs go through the gate");
-            let (order, selection) = in_vertex_order(&list);
-            let targets = |found: usize| -> Vec<Vec3> {
-                permuted(
-                    &order,
-                    &bytemuck::pod_collect_to_vec(&parts.targets[..found * 12]),
-                )
-            };
+            let mut call = calls[j];
+            let (mut dab, _) = call.dab_and_frame(&self.plan);
+            if let RunCall::SplitStep { index, k } = call {
+                let Some(frame) = deferred else {
+                    continue;
+                };
+                dab.frame = frame;
+                call = RunCall::Step {
+                    sample: self.plan_first + index,
+                    dab,
+                    k,
+                    steps: SPLIT_STEPS,
+                };
+            }
+            let read = self.read_call(bytes, (layouts[j], &dab), shape.guess, capacity);
+            let assumed_move = call.assumed_move(shape.ahead.assumed_move, shape.limit);
             let mut queued = QueuedCall {
                 call,
                 deformed: Deformed {
                     targets: None,
-                    selection,
-                    frame: parts.frame,
+                    selection: read.selection,
+                    frame: read.frame,
                     deform_millis: 0.0,
                 },
                 ahead: None,
                 assumed_move,
-                max_edge: edge_bound(max_edge, assumed_move, j),
+                max_edge: shape.edge_bound(max_edge, (calls, j)),
                 filed: j + 1 < count,
             };
+            let status = read.status;
+            self.edge_growth = shape.next_edge_growth((max_edge, status.edge_bound()), (calls, j));
+            if let RunCall::Start(_) = call {
+                deferred = (status.stopped == 0 && status.deferred != 0).then_some(read.frame);
+            }
             if status.stopped != 0 {
                 // The gate stopped the run here, before this call moved anything, and the
                 // calls after it selected nothing: there is nothing to put back.
                 let longest = status.longest_move();
-                self.uploads.count_gate_stop(status.stopped, longest, limit);
+                self.uploads
+                    .count_gate_stop(status.stopped, longest, shape.limit);
                 if let RunCall::Start(index) = call
-                    && self.after_stop(index, status, limit)
+                    && self.after_stop(index, status, shape.limit)
                 {
                     // Its selection and whole move hold (nothing moved since): the pipeline's
                     // call for it is answered from here, and its steps recorded when it asks
                     // for the first.
-                    queued.deformed.targets = Some(targets(found));
+                    queued.deformed.targets = Some(read.targets);
                     queued.filed = false;
                     self.queued.push_back(queued);
                 }
                 break;
             }
-            if j + 1 < count {
-                filed_on_gpu.extend(list.iter().map(|s| s.vertex));
+            if deferred.is_some() && matches!(call, RunCall::Start(_)) {
+                // Its move went to its split steps, which follow: nothing moved.
+                self.uploads.split_ahead += 1;
+                queued.deformed.targets = Some(read.targets);
+                queued.filed = false;
+                self.queued.push_back(queued);
+                continue;
             }
-            // The gate stops a run on a cut list or cut rings (the same count and buffer).
-            debug_assert!(found <= guess && parts.ring_overflows == Some(0));
-            if !queued.deformed.selection.is_empty() {
-                let targets = targets(found);
-                let clamp = layout.clamp.expect("passes recorded");
-                let (finals, backstop) = self.step.parse_clamp(parts.clamp, guess, clamp);
-                queued.deformed.targets = Some(targets.clone());
+            if j + 1 < count {
+                filed_on_gpu.extend(queued.deformed.selection.iter().map(|&(v, _)| v));
+            }
+            if let Some((finals, backstop)) = read.clamped {
+                queued.deformed.targets = Some(read.targets.clone());
                 queued.ahead = Some(ClampedAhead {
                     vertices: queued.deformed.selection.iter().map(|&(v, _)| v).collect(),
-                    targets,
-                    finals: permuted(&order, &finals),
+                    targets: read.targets,
+                    finals,
                     backstop,
                 });
             }
@@ -343,6 +318,44 @@ impl GpuKernels {
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
+        }
+    }
+
+    /// What one call of a run left, `bytes` from its count on, laid out as `layout` under
+    /// `dab`; `guess`: the slots of the list its passes ran over, `capacity`: the list's.
+    fn read_call(
+        &mut self,
+        bytes: &[u8],
+        (layout, dab): (SampleLayout, &Dab),
+        guess: usize,
+        capacity: usize,
+    ) -> CallRead {
+        let found =
+            (u32::from_le_bytes(bytes[..4].try_into().expect("four bytes")) as usize).min(capacity);
+        self.last_selection = self.last_selection.max(found);
+        let list_bytes = guess * std::mem::size_of::<SelectedVertex>();
+        let list: Vec<SelectedVertex> =
+            bytemuck::pod_collect_to_vec(&bytes[4..4 + 8 * found.min(guess)]);
+        let parts = layout.split(&bytes[4 + list_bytes..], dab);
+        let status = parts.gate.expect("runs go through the gate");
+        let (order, selection) = in_vertex_order(&list);
+        let targets = permuted(
+            &order,
+            &bytemuck::pod_collect_to_vec(&parts.targets[..list.len() * 12]),
+        );
+        // The gate stops a run on a cut list or cut rings (the same count and buffer).
+        debug_assert!(status.stopped != 0 || (found <= guess && parts.ring_overflows == Some(0)));
+        let clamped = (status.stopped == 0 && !selection.is_empty()).then(|| {
+            let clamp = layout.clamp.expect("passes recorded");
+            let (finals, backstop) = self.step.parse_clamp(parts.clamp, guess, clamp);
+            (permuted(&order, &finals), backstop)
+        });
+        CallRead {
+            selection,
+            frame: parts.frame,
+            targets,
+            status,
+            clamped,
         }
     }
 
@@ -429,7 +442,8 @@ impl GpuKernels {
                 at == CallAt::Step { sample, k, steps }
                     && selection.is_none_or(|selection| head.deformed.selection == selection)
             }
-            RunCall::Start(_) => false,
+            // Split steps are queued as the steps they turned out to be.
+            RunCall::Start(_) | RunCall::SplitStep { .. } => false,
         });
         self.take_queued(mesh, is_step, max_edge)
     }
@@ -469,7 +483,7 @@ impl GpuKernels {
         let queued = self.queued.pop_front()?;
         match queued.call {
             RunCall::Start(_) => self.uploads.samples_ahead += 1,
-            RunCall::Step { .. } => {
+            RunCall::Step { .. } | RunCall::SplitStep { .. } => {
                 self.uploads.steps_ahead += 1;
                 self.steps_taken.extend_from_slice(moved_by(&queued));
             }
@@ -530,171 +544,14 @@ impl GpuKernels {
     }
 }
 
-/// How a run is recorded: `count` calls, each over `guess` slots of the selection list, their
-/// passes sized by `ahead` (`filter`: with the backstop filter).
-struct RunShape {
-    count: usize,
-    guess: usize,
-    ahead: AheadBounds,
-    filter: bool,
-}
-
-impl RunShape {
-    /// The bytes of a call's head of the selection list.
-    fn list_bytes(&self) -> u64 {
-        (self.guess * std::mem::size_of::<SelectedVertex>()) as u64
-    }
-
-    /// The bytes of a call's moving list.
-    fn moving_bytes(&self) -> u64 {
-        (self.guess * std::mem::size_of::<MovingVertex>()) as u64
-    }
-}
-
-/// The edges as the calls of a run before call `j` may have lengthened them, from the
-/// pipeline's bound `max_edge` at its start and the `assumed_move` of each (checked by the
-/// gate, and by the host when the pipeline reaches it).
-fn edge_bound(max_edge: f32, assumed_move: f32, j: usize) -> f32 {
-    max_edge + EDGE_GROWTH_AHEAD * j as f32 * assumed_move
-}
-
-/// Records a run's `calls` (see [`GpuKernels::gpu_run_ahead`]) in one submission — the
-/// overlay table rebuilt from its slots first, the gate started, each call's results copied
-/// aside — submits it and maps them all. Returns the bytes, each call's layout, and the stride
-/// between calls.
-fn record_run(
-    gpu: &GpuContext,
-    (r, step, readback): (&Resident, &StepBuffers, &mut ReusableBuffer),
-    state: &StrokeState<'_>,
-    (calls, plan): (&[RunCall], &[SampleProbe]),
-    shape: &RunShape,
-) -> Result<(Vec<u8>, Vec<SampleLayout>, u64), GpuError> {
-    let count = shape.count;
-    let list_bytes = shape.list_bytes();
-    let mut encoder = gpu.encoder("samples ahead");
-    r.hashed().record_gpu_table(gpu, &mut encoder)?;
-    // The gate's edge bound starts at the pipeline's; each call but the last grows it by
-    // the faces it turned (`moved_edges`) for the next one's verdict.
-    step.start_gate(gpu, state.max_edge);
-    let mut layouts = Vec::with_capacity(count);
-    let mut stride = 0;
-    for (j, &call) in calls.iter().enumerate() {
-        let (dab, source) = call.dab_and_source(plan);
-        let state = StrokeState {
-            max_edge: edge_bound(state.max_edge, shape.ahead.assumed_move, j),
-            ..*state
-        };
-        let recorded = record_call(
-            gpu,
-            &mut encoder,
-            (r, step),
-            &state,
-            (j, call, &dab, source),
-            shape,
-        )?;
-        let mut parts = vec![(&r.selection.count, 4), (&r.selection.selected, list_bytes)];
-        parts.extend_from_slice(&recorded.parts);
-        if j == 0 {
-            // Every call leaves the same parts, but for the brush frame's sums a step
-            // (whose frame is its dab's) leaves out: room for the largest.
-            let frame_bytes = match recorded.layout.frame_from_selection {
-                Some(_) => 0,
-                None => (FRAME_SUM_WORDS * 4) as u64,
-            };
-            stride = parts.iter().map(|&(_, bytes)| bytes).sum::<u64>() + frame_bytes;
-            readback.reserve(gpu, stride * count as u64)?;
-        }
-        layouts.push(recorded.layout);
-        readback.record_copies(&mut encoder, &parts, j as u64 * stride);
-    }
-    let data = readback.submit_and_map(gpu, encoder, stride * count as u64)?;
-    Ok((data, layouts, stride))
-}
-
-/// Records call `j` of a run under `dab`: its step ([`record_sample`]); the normals its moves
-/// turned (for a step of a sample of several, those of all its steps after the last); and, but
-/// for the run's last call, the edges it lengthened (`moved_edges`, for the next call's gate)
-/// and the filing of its moved vertices in the overlay.
-fn record_call<'b>(
-    gpu: &GpuContext,
-    encoder: &mut wgpu::CommandEncoder,
-    (r, step): (&'b Resident, &'b StepBuffers),
-    state: &StrokeState<'_>,
-    (j, call, dab, source): (usize, RunCall, &Dab, FrameSource),
-    shape: &RunShape,
-) -> Result<RecordedSample<'b>, GpuError> {
-    let Some(topology) = &r.topology else {
-        unreachable!("reserve_sample made the topology resident");
-    };
-    let (guess, moving_bytes) = (shape.guess, shape.moving_bytes());
-    let recorded = record_sample(
-        gpu,
-        encoder,
-        (r, step),
-        state,
-        dab,
-        (source, true),
-        guess,
-        Some(shape.ahead),
-        shape.filter,
-    )?;
-    let normals_of = match call {
-        RunCall::Start(_) => Some((step.moving.buffer(), guess)),
-        // The pipeline recomputes normals after a sample's last step: every step
-        // deforms on the normals from before the sample. Each step's moving list is
-        // kept until then, and vacated if the run stopped at one of them: the steps
-        // taken before the stop leave their normals to the pipeline.
-        RunCall::Step { k, steps, .. } => {
-            let held = step.held_moving.buffer();
-            encoder.copy_buffer_to_buffer(
-                step.moving.buffer(),
-                0,
-                held,
-                k as u64 * moving_bytes,
-                moving_bytes,
-            );
-            let last = k + 1 == steps;
-            if last {
-                record_gate_vacate(
-                    gpu,
-                    encoder,
-                    &GateBuffers {
-                        moving: held,
-                        ..step.gate(r)
-                    },
-                    steps * guess,
-                )?;
-            }
-            last.then_some((held, steps * guess))
-        }
-    };
-    if let Some(moving) = normals_of {
-        record_moved_normals(
-            gpu,
-            encoder,
-            (&r.vertices.positions, &topology.buffer),
-            topology.layout.vertex_rows_base,
-            moving,
-            &r.normals,
-        )?;
-    }
-    if j + 1 < shape.count {
-        record_moved_edges(
-            gpu,
-            encoder,
-            (&r.vertices.positions, &topology.buffer),
-            topology.layout.vertex_rows_base,
-            (step.moving.buffer(), guess),
-            &step.gate_status,
-        )?;
-        r.hashed().record_gpu_filing(
-            gpu,
-            encoder,
-            &r.vertices.positions,
-            (step.moving.buffer(), guess),
-        )?;
-    }
-    Ok(recorded)
+/// What one call of a run read back, in vertex order: its selection, frame and targets, the
+/// gate's verdict, and where its passes ran the moves' final positions and the backstop's.
+struct CallRead {
+    selection: Vec<(u32, f32)>,
+    frame: DabFrame,
+    targets: Vec<Vec3>,
+    status: GateStatus,
+    clamped: Option<(Vec<Vec3>, Backstop)>,
 }
 
 /// The queue of samples recorded ahead, oldest first.

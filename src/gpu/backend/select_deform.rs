@@ -17,11 +17,11 @@ use crate::brush::{Dab, DabFrame};
 use crate::collide::StrokeState;
 use crate::cpu::FRAME_SUM_WORDS;
 use crate::gpu::{
-    BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FRAME_WORKGROUP_SIZE, GateStatus,
-    GpuContext, GpuError, HashedVertices, SELECTION_GUESS, SelectedVertex, SelectionBuffers,
-    SelectionRead, Workgroups, deform_params, entry_params, record_brush_frame, record_deform,
-    record_dispatch_args, record_gate_check, record_gate_open, record_moving_entries,
-    record_select, ring_bytes,
+    BrushSphere, BuiltEntryBuffers, DeformBuffers, EntryBuffers, FRAME_WORKGROUP_SIZE, GateSplit,
+    GateStatus, GpuContext, GpuError, HashedVertices, SELECTION_GUESS, SelectedVertex,
+    SelectionBuffers, SelectionRead, Workgroups, deform_params, entry_params, record_brush_frame,
+    record_deform, record_dispatch_args, record_gate_check, record_gate_open,
+    record_moving_entries, record_select, ring_bytes,
 };
 use crate::mesh::Mesh;
 use crate::pipeline::step::{frame_flags, frame_of_sums, longest_move};
@@ -207,6 +207,7 @@ impl GpuKernels {
         let ahead = assumed_move.map(|assumed_move| AheadBounds {
             assumed_move,
             drift: r.hashed().drift,
+            split: GateSplit::default(),
         });
         if ahead.is_some() {
             step.start_gate(gpu, state.max_edge);
@@ -217,7 +218,7 @@ impl GpuKernels {
             (r, step),
             state,
             dab,
-            (source, deforms),
+            (source.into(), deforms),
             guess,
             ahead,
             filter,
@@ -304,11 +305,34 @@ pub(super) fn selection_guess(last: usize, capacity: usize) -> usize {
 /// How a sample's passes, recorded before its moves are known, are sized: for moves up to
 /// `assumed_move`, over a table whose vertices may have drifted `drift` from where they were
 /// filed. Such passes go through the gate (`sample_gate`, started by
-/// [`StepBuffers::start_gate`]): where those assumptions fail they move nothing.
+/// [`StepBuffers::start_gate`]): where those assumptions fail they move nothing. `split`: how
+/// the call stands to a sample of a run that may defer its move to two steps.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct AheadBounds {
     pub(super) assumed_move: f32,
     pub(super) drift: f32,
+    pub(super) split: GateSplit,
+}
+
+/// Where a recorded call's brush frame comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum CallFrame {
+    /// Summed from the call's selection (a sample's start; `normal`: the sample's own).
+    Summed { normal: Option<Vec3> },
+    /// From the sums the sample's start left, recorded before it in the same submission (a
+    /// step of a sample that may defer its move).
+    SummedAtStart { normal: Option<Vec3> },
+    /// The dab's, as given.
+    Dab,
+}
+
+impl From<FrameSource> for CallFrame {
+    fn from(source: FrameSource) -> Self {
+        match source {
+            FrameSource::Selection { normal } => CallFrame::Summed { normal },
+            FrameSource::Dab => CallFrame::Dab,
+        }
+    }
 }
 
 /// What [`record_sample`] leaves to read back after the selection's count and list: `parts`,
@@ -374,10 +398,10 @@ impl SampleLayout {
 }
 
 /// Records one sample's step into `encoder`: selection under `dab` (into the resident list),
-/// at a sample's start the brush frame summed from it, with `deforms` the deformation of the
-/// first `guess` entries, and with `ahead` `moving_entries` and the step's proximity passes
-/// and filter over those slots. `state.max_edge` bounds the edges at the step's start. The
-/// buffers are reserved beforehand.
+/// the brush frame as `frame` says (at a sample's start summed from it), with `deforms` the
+/// deformation of the first `guess` entries, and with `ahead` `moving_entries` and the step's
+/// proximity passes and filter over those slots. `state.max_edge` bounds the edges at the
+/// step's start. The buffers are reserved beforehand.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn record_sample<'b>(
     gpu: &GpuContext,
@@ -385,15 +409,15 @@ pub(super) fn record_sample<'b>(
     (r, step): (&'b Resident, &'b StepBuffers),
     state: &StrokeState<'_>,
     dab: &Dab,
-    (source, deforms): (FrameSource, bool),
+    (frame, deforms): (CallFrame, bool),
     guess: usize,
     ahead: Option<AheadBounds>,
     filter: bool,
 ) -> Result<RecordedSample<'b>, GpuError> {
     let drift = ahead.map_or(r.hashed().drift, |a| a.drift);
     record_brush_selection(gpu, encoder, r, state.active, dab, drift)?;
-    if ahead.is_some() {
-        record_gate_open(gpu, encoder, &step.gate(r))?;
+    if let Some(ahead) = ahead {
+        record_gate_open(gpu, encoder, &step.gate(r), ahead.split)?;
     }
     let inputs = SelectionBuffers {
         positions: &r.vertices.positions,
@@ -403,13 +427,17 @@ pub(super) fn record_sample<'b>(
     };
     let mut params = deform_params(dab, guess);
     let mut parts = Vec::new();
-    let frame_from_selection = match source {
-        FrameSource::Selection { normal } => {
+    let frame_from_selection = match frame {
+        CallFrame::Summed { normal } => {
             record_frame_sums(gpu, encoder, (r, step), &inputs, dab, normal, &mut params)?;
             parts.push((&step.frame_sums, (FRAME_SUM_WORDS * 4) as u64));
             Some(normal)
         }
-        FrameSource::Dab => None,
+        CallFrame::SummedAtStart { normal } => {
+            frame_from_sums(&mut params, normal);
+            None
+        }
+        CallFrame::Dab => None,
     };
     let target_bytes = if deforms {
         (guess * std::mem::size_of::<Vec3>()) as u64
@@ -460,8 +488,7 @@ fn record_frame_sums(
     params: &mut DeformParams,
 ) -> Result<(), GpuError> {
     let capacity = r.selection.capacity;
-    params.frame = frame_flags(normal);
-    params.normal = normal.unwrap_or(Vec3::Z).to_array();
+    frame_from_sums(params, normal);
     record_dispatch_args(
         gpu,
         encoder,
@@ -480,6 +507,13 @@ fn record_frame_sums(
     )
 }
 
+/// Sets `params` to take the brush frame from `brush_frame`'s sums (`normal`: the sample's
+/// own, if it brings one).
+fn frame_from_sums(params: &mut DeformParams, normal: Option<Vec3>) {
+    params.frame = frame_flags(normal);
+    params.normal = normal.unwrap_or(Vec3::Z).to_array();
+}
+
 /// [`record_sample`]'s passes, run ahead of the moves: `moving_entries` over the first `guess`
 /// slots of the selection list, the gate's check of the sample, and the step's proximity
 /// passes and filter over those slots ([`record_clamp`]), sized by `ahead`. What they leave
@@ -496,6 +530,7 @@ fn record_ahead_passes<'b>(
     let AheadBounds {
         assumed_move,
         drift,
+        split,
     } = ahead;
     let Some(topology) = &r.topology else {
         unreachable!("the caller made the topology resident");
@@ -523,6 +558,7 @@ fn record_ahead_passes<'b>(
         encoder,
         &step.gate(r),
         (guess, assumed_move, state.max_edge),
+        split,
     )?;
     // No vertex moves farther than assumed, so no edge grows by more than twice that.
     let bounds = PassBounds {
