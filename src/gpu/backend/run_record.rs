@@ -1,8 +1,9 @@
 //! How a run of samples recorded ahead is laid out and recorded (`super::run_ahead` queues
 //! what it leaves): the calls it records ([`RunCall`]) — samples' starts, the steps of a sample
 //! of several, and the split steps a start may defer its move to — how each call's passes are
-//! sized ([`RunShape`]: the assumed move, the edges' growth learnt from the run before), and
-//! the one submission that records them all and reads their results back ([`record_run`]).
+//! sized ([`RunShape`]: the assumed move, and the edges' growth, raised by the runs before on
+//! the same mesh that measured more), and the one submission that records them all and reads
+//! their results back ([`record_run`]).
 
 use super::resident::Resident;
 use super::select_deform::{AheadBounds, CallFrame, RecordedSample, SampleLayout, record_sample};
