@@ -149,7 +149,6 @@ fn gate_stage(
 fn sample_gate_stages_match_the_cpu_mirror() {
     use slayer::gpu::{GateParams, GateStage, GateStatus, MovingVertex};
     let mut gpu = gpu();
-    let run = gate_stage;
     // Opening: the longest move reset; the selection emptied only in a stopped run.
     for stopped in [0, GateStatus::MOVE, GateStatus::EARLIER] {
         let status = GateStatus {
@@ -159,7 +158,7 @@ fn sample_gate_stages_match_the_cpu_mirror() {
             deferred: 0,
         };
         let open = GateParams::new(0, GateStage::Open, (0.0, 0.0));
-        let (count, _, after) = run(&gpu, &open, 0, (77, &[], status));
+        let (count, _, after) = gate_stage(&gpu, &open, 0, (77, &[], status));
         assert_eq!(
             after,
             GateStatus {
@@ -190,7 +189,7 @@ fn sample_gate_stages_match_the_cpu_mirror() {
                     };
                     let decide = GateParams::new(capacity, GateStage::Decide, (assumed, max_edge));
                     let (after_count, _, after) =
-                        run(&gpu, &decide, overflows, (count, &[], status));
+                        gate_stage(&gpu, &decide, overflows, (count, &[], status));
                     let mut expected = 0;
                     if stopped_before != 0 {
                         expected |= GateStatus::EARLIER;
@@ -242,7 +241,7 @@ fn sample_gate_stages_match_the_cpu_mirror() {
                 stopped,
                 ..Default::default()
             };
-            let (_, after, _) = run(&gpu, &vacate, 0, (size as u32, &moving, status));
+            let (_, after, _) = gate_stage(&gpu, &vacate, 0, (size as u32, &moving, status));
             for (i, (a, m)) in after.iter().zip(&moving).enumerate() {
                 let vacated = stopped != 0 && i < capacity;
                 let expected = MovingVertex {

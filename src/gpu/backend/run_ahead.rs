@@ -85,6 +85,17 @@ pub(super) struct QueuedCall {
     filed: bool,
 }
 
+impl QueuedCall {
+    /// A start whose run did not make its move (the gate stopped the run there, or the start
+    /// deferred its move to its split steps): its selection and whole move hold, since nothing
+    /// moved, and answer the pipeline's call for it; it filed nothing.
+    fn answered_with(mut self, targets: Vec<Vec3>) -> Self {
+        self.deformed.targets = Some(targets);
+        self.filed = false;
+        self
+    }
+}
+
 /// The vertices a queued call's passes may have moved.
 fn moved_by(queued: &QueuedCall) -> &[u32] {
     queued.ahead.as_ref().map_or(&[], |a| a.vertices.as_slice())
@@ -241,6 +252,8 @@ impl GpuKernels {
         let mut filed_on_gpu = Vec::new();
         // The frame of the last start, when it deferred its move to its split steps.
         let mut deferred: Option<DabFrame> = None;
+        // The last call read and the gate's bound on the edges before it.
+        let mut last_edge = None;
         for (j, bytes) in data.chunks_exact(stride as usize).enumerate() {
             let mut call = calls[j];
             let (mut dab, _) = call.dab_and_frame(&self.plan);
@@ -272,9 +285,11 @@ impl GpuKernels {
                 filed: j + 1 < count,
             };
             let status = read.status;
-            self.edge_growth = shape.next_edge_growth((max_edge, status.edge_bound()), (calls, j));
-            if let RunCall::Start(_) = call {
-                deferred = (status.stopped == 0 && status.deferred != 0).then_some(read.frame);
+            last_edge = Some((j, status.edge_bound()));
+            let is_start = matches!(call, RunCall::Start(_));
+            let defers = is_start && status.stopped == 0 && status.deferred != 0;
+            if is_start {
+                deferred = defers.then_some(read.frame);
             }
             if status.stopped != 0 {
                 // The gate stopped the run here, before this call moved anything, and the
@@ -285,21 +300,15 @@ impl GpuKernels {
                 if let RunCall::Start(index) = call
                     && self.after_stop(index, status, shape.limit)
                 {
-                    // Its selection and whole move hold (nothing moved since): the pipeline's
-                    // call for it is answered from here, and its steps recorded when it asks
-                    // for the first.
-                    queued.deformed.targets = Some(read.targets);
-                    queued.filed = false;
-                    self.queued.push_back(queued);
+                    // Its steps are recorded when the pipeline asks for the first.
+                    self.queued.push_back(queued.answered_with(read.targets));
                 }
                 break;
             }
-            if deferred.is_some() && matches!(call, RunCall::Start(_)) {
-                // Its move went to its split steps, which follow: nothing moved.
+            if defers {
+                // Its move went to its split steps, which follow.
                 self.uploads.split_ahead += 1;
-                queued.deformed.targets = Some(read.targets);
-                queued.filed = false;
-                self.queued.push_back(queued);
+                self.queued.push_back(queued.answered_with(read.targets));
                 continue;
             }
             if j + 1 < count {
@@ -318,6 +327,9 @@ impl GpuKernels {
         }
         if let Some(hashed) = self.resident.as_mut().and_then(|r| r.hashed.as_mut()) {
             hashed.moved.extend_from_slice(&filed_on_gpu);
+        }
+        if let Some((j, edge)) = last_edge {
+            self.edge_growth = shape.next_edge_growth((max_edge, edge), (calls, j));
         }
     }
 
