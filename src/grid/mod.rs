@@ -10,8 +10,11 @@
 //! move are O(1) without allocating — the paper's "list of vertex-to-cell correspondences" with
 //! reference swapping. Cells that hash to the same bucket share its list; queries filter by the
 //! stored cell. The table has at least twice as many buckets as vertices and grows when needed.
+//! Beside it the grid keeps which cells hold a vertex (`occupancy`): a box query probes only
+//! those, in the order a walk over every cell would meet them.
 
 mod hash;
+mod occupancy;
 mod query;
 
 pub use hash::{CellKey, hash_cell};
@@ -22,6 +25,7 @@ use rayon::prelude::*;
 
 use crate::geom::Aabb;
 use crate::mesh::{INVALID, Mesh};
+use occupancy::Occupancy;
 
 /// Cell coordinate of a vertex that is not in the grid.
 const ABSENT: IVec3 = IVec3::new(i32::MIN, i32::MIN, i32::MIN);
@@ -42,6 +46,8 @@ pub struct SpatialHash {
     len: usize,
     /// Bounds of every position ever inserted (never shrinks: a safe box for ray walks).
     bounds: Aabb,
+    /// The cells holding a vertex, so that box queries skip the empty ones.
+    occupied: Occupancy,
 }
 
 impl SpatialHash {
@@ -59,6 +65,7 @@ impl SpatialHash {
             prev: vec![INVALID; vertex_capacity],
             len: 0,
             bounds: Aabb::EMPTY,
+            occupied: Occupancy::default(),
         })
     }
 
@@ -93,6 +100,8 @@ impl SpatialHash {
                     max: a.max.max(b.max),
                 },
             );
+        let filed: Vec<IVec3> = cells.par_iter().copied().filter(|&c| c != ABSENT).collect();
+        grid.occupied = Occupancy::of_cells(&filed);
         for (v, cell) in cells.into_iter().enumerate() {
             if cell != ABSENT {
                 grid.link(v as u32, cell);
@@ -159,10 +168,12 @@ impl SpatialHash {
         counts
     }
 
-    /// Heap bytes held: the bucket table and the per-vertex links.
+    /// Heap bytes held: the bucket table, the per-vertex links and the occupied cells.
     pub fn memory_bytes(&self) -> usize {
         let per_vertex = std::mem::size_of::<IVec3>() + 2 * std::mem::size_of::<u32>();
-        self.heads.capacity() * std::mem::size_of::<u32>() + self.cell_of.capacity() * per_vertex
+        self.heads.capacity() * std::mem::size_of::<u32>()
+            + self.cell_of.capacity() * per_vertex
+            + self.occupied.memory_bytes()
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -201,7 +212,9 @@ impl SpatialHash {
         if 2 * (self.len + 1) > self.heads.len() {
             self.grow();
         }
-        self.link(vertex, self.cell_of_point(p));
+        let cell = self.cell_of_point(p);
+        self.link(vertex, cell);
+        self.occupied.set(cell);
         self.len += 1;
         self.bounds = self.bounds.including(p);
     }
@@ -211,7 +224,7 @@ impl SpatialHash {
         if !self.contains(vertex) {
             return;
         }
-        self.unlink(vertex);
+        self.unfile(vertex);
         self.cell_of[vertex as usize] = ABSENT;
         self.len -= 1;
     }
@@ -227,8 +240,19 @@ impl SpatialHash {
         if cell == old {
             return;
         }
-        self.unlink(vertex);
+        self.unfile(vertex);
         self.link(vertex, cell);
+        self.occupied.set(cell);
+    }
+
+    /// Takes `vertex` out of its bucket's list, and its cell out of the occupied ones if it
+    /// was the cell's last vertex.
+    fn unfile(&mut self, vertex: u32) {
+        self.unlink(vertex);
+        let cell = self.cell_of[vertex as usize];
+        if self.cell_vertices(cell).next().is_none() {
+            self.occupied.clear(cell);
+        }
     }
 
     /// Vertices filed in one cell.
@@ -313,6 +337,19 @@ impl SpatialHash {
         }
         if seen != self.len {
             return Err(format!("{seen} vertices listed, {} counted", self.len));
+        }
+        let cells = self.cell_counts();
+        if let Some((cell, _)) = cells.iter().find(|(c, _)| !self.occupied.is_set(*c)) {
+            return Err(format!(
+                "cell {cell} holds a vertex but is not marked occupied"
+            ));
+        }
+        if self.occupied.count() != cells.len() {
+            return Err(format!(
+                "{} cells marked occupied, {} hold a vertex",
+                self.occupied.count(),
+                cells.len()
+            ));
         }
         Ok(())
     }

@@ -40,13 +40,8 @@ impl SpatialHash {
             }
             return;
         }
-        for z in a.z..=b.z {
-            for y in a.y..=b.y {
-                for x in a.x..=b.x {
-                    self.cell_vertices(IVec3::new(x, y, z)).for_each(&mut f);
-                }
-            }
-        }
+        self.occupied
+            .for_each_occupied(a, b, |cell| self.cell_vertices(cell).for_each(&mut f));
     }
 
     /// Brush selection: every vertex with `|p - center| ≤ radius`, appended to `out`.
