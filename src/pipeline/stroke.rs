@@ -690,8 +690,6 @@ impl Active {
     }
 }
 
-/// What a step reads that lasts for the stroke (a free function so that a step can borrow the
-/// stroke's scratch beside it).
 /// Recomputes the normals of the moved vertices and of their neighbours, whose faces also
 /// turned, and tells the kernels; booked under deformation.
 fn refresh_normals(
@@ -721,6 +719,8 @@ fn refresh_normals(
     call.phases.deformation += millis(started);
 }
 
+/// What a step reads that lasts for the stroke (a free function so that a step can borrow the
+/// stroke's scratch beside it).
 fn stroke_state<'s>(
     prepared: &'s Prepared,
     active: &'s [bool],

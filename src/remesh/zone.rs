@@ -140,7 +140,7 @@ impl Zone {
         boundary: &[u32],
         (inner, target_edge): (Option<Aabb>, f32),
     ) -> Option<Zone> {
-        let cone = normal_cone(mesh, faces, |v| mesh.positions()[v as usize], false)?;
+        let cone = normal_cone(mesh, faces, |v| mesh.positions()[v as usize])?;
         // The axis in f32 differs from the f64 one by far less than the margin asked here.
         let sheet = cone.cos >= f64::from(MIN_COS) + 0.01
             && projected_loop_is_simple(mesh, boundary, cone.axis);
