@@ -230,7 +230,8 @@ fn strokes_then_sculpt_round_trip_with_stats() {
         arg(&input),
         "--strokes",
         arg(&strokes),
-        "--output",
+        // `-o`, as every command that writes a file takes it.
+        "-o",
         arg(&output),
         "--stats",
         arg(&stats),

@@ -106,7 +106,7 @@ enum Command {
         #[arg(long)]
         strokes: PathBuf,
         /// Mesh (.obj, .ply, .stl, .glb, .gltf) or session (.slayer, with the history).
-        #[arg(long)]
+        #[arg(short, long)]
         output: PathBuf,
         /// Allow the output to be the input file itself (it is replaced only once the whole
         /// result is written).
