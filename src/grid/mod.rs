@@ -100,8 +100,7 @@ impl SpatialHash {
                     max: a.max.max(b.max),
                 },
             );
-        let filed: Vec<IVec3> = cells.par_iter().copied().filter(|&c| c != ABSENT).collect();
-        grid.occupied = Occupancy::of_cells(&filed);
+        grid.occupied = Occupancy::of_cells(&cells, |c| c != ABSENT);
         for (v, cell) in cells.into_iter().enumerate() {
             if cell != ABSENT {
                 grid.link(v as u32, cell);

@@ -31,24 +31,32 @@ fn block_and_bit(cell: IVec3) -> (IVec3, u64) {
 }
 
 impl Occupancy {
-    /// The occupancy of `cells` (every one holding a vertex): their bits sorted by block in
-    /// parallel, then each block's mask filed once, instead of a table update per vertex
-    /// (a grid's set-up at millions of vertices).
-    pub(super) fn of_cells(cells: &[IVec3]) -> Occupancy {
-        let mut bits: Vec<([i32; 3], u64)> = cells
-            .par_iter()
-            .map(|&cell| {
+    /// The occupancy of the `cells` that `filed` accepts (a grid's set-up, at millions of
+    /// vertices): a chunk at a time, its bits sorted by block in parallel and each block's
+    /// mask filed once, instead of a table update per vertex; the chunks bound what the sort
+    /// holds to a few megabytes whatever the mesh.
+    pub(super) fn of_cells(cells: &[IVec3], filed: impl Fn(IVec3) -> bool + Sync) -> Occupancy {
+        Occupancy::of_cells_in_chunks(cells, filed, 1 << 20)
+    }
+
+    fn of_cells_in_chunks(
+        cells: &[IVec3],
+        filed: impl Fn(IVec3) -> bool + Sync,
+        chunk_len: usize,
+    ) -> Occupancy {
+        let mut blocks = FxHashMap::default();
+        let mut bits: Vec<([i32; 3], u64)> = Vec::new();
+        for chunk in cells.chunks(chunk_len) {
+            bits.clear();
+            bits.par_extend(chunk.par_iter().filter(|&&c| filed(c)).map(|&cell| {
                 let (block, bit) = block_and_bit(cell);
                 (block.to_array(), bit)
-            })
-            .collect();
-        bits.par_sort_unstable_by_key(|&(block, _)| block);
-        let runs = bits.chunk_by(|a, b| a.0 == b.0);
-        let mut blocks =
-            FxHashMap::with_capacity_and_hasher(runs.clone().count(), Default::default());
-        for run in runs {
-            let mask = run.iter().fold(0, |mask, &(_, bit)| mask | bit);
-            blocks.insert(IVec3::from_array(run[0].0), mask);
+            }));
+            bits.par_sort_unstable_by_key(|&(block, _)| block);
+            for run in bits.chunk_by(|a, b| a.0 == b.0) {
+                let mask = run.iter().fold(0, |mask, &(_, bit)| mask | bit);
+                *blocks.entry(IVec3::from_array(run[0].0)).or_insert(0) |= mask;
+            }
         }
         Occupancy { blocks }
     }
@@ -138,5 +146,57 @@ impl Occupancy {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Cells in and around a few blocks, negative coordinates and repeats included.
+    fn cells() -> Vec<IVec3> {
+        (0..500)
+            .map(|i: i32| IVec3::new(i % 11 - 5, (i * 7) % 13 - 6, (i * 3) % 9 - 4))
+            .collect()
+    }
+
+    #[test]
+    fn built_in_chunks_or_at_once_or_cell_by_cell_the_masks_agree() {
+        let cells = cells();
+        let keep = |c: IVec3| c.x != 0;
+        let whole = Occupancy::of_cells_in_chunks(&cells, keep, cells.len());
+        let chunked = Occupancy::of_cells_in_chunks(&cells, keep, 7);
+        let mut one_by_one = Occupancy::default();
+        for &c in cells.iter().filter(|&&c| keep(c)) {
+            one_by_one.set(c);
+        }
+        assert_eq!(whole.blocks, chunked.blocks);
+        assert_eq!(whole.blocks, one_by_one.blocks);
+        assert!(cells.iter().all(|&c| whole.is_set(c) == keep(c)));
+    }
+
+    #[test]
+    fn a_box_meets_its_occupied_cells_in_walk_order_and_cleared_cells_not_at_all() {
+        let cells = cells();
+        let mut occupancy = Occupancy::of_cells(&cells, |_| true);
+        // (-4, 1, -1): inside the box.
+        occupancy.clear(cells[1]);
+        let (a, b) = (IVec3::new(-6, -5, -3), IVec3::new(3, 4, 2));
+        let mut walked = Vec::new();
+        for z in a.z..=b.z {
+            for y in a.y..=b.y {
+                for x in a.x..=b.x {
+                    let cell = IVec3::new(x, y, z);
+                    if occupancy.is_set(cell) {
+                        walked.push(cell);
+                    }
+                }
+            }
+        }
+        let mut met = Vec::new();
+        occupancy.for_each_occupied(a, b, |cell| met.push(cell));
+        assert!(!met.contains(&cells[1]));
+        assert!(!walked.is_empty());
+        assert_eq!(met, walked);
     }
 }
