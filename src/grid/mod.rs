@@ -135,9 +135,9 @@ impl SpatialHash {
         self.heads.len()
     }
 
-    /// Number of non-empty cells (counted on demand; for reports, not hot paths).
+    /// Number of non-empty cells (counted from the occupancy's masks, on demand).
     pub fn occupied_cells(&self) -> usize {
-        self.cell_counts().len()
+        self.occupied.count()
     }
 
     /// The most vertices filed in one cell (counted on demand).
@@ -343,10 +343,10 @@ impl SpatialHash {
                 "cell {cell} holds a vertex but is not marked occupied"
             ));
         }
-        if self.occupied.count() != cells.len() {
+        if self.occupied_cells() != cells.len() {
             return Err(format!(
                 "{} cells marked occupied, {} hold a vertex",
-                self.occupied.count(),
+                self.occupied_cells(),
                 cells.len()
             ));
         }

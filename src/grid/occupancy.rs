@@ -110,14 +110,14 @@ impl Occupancy {
             on_heap.resize(blocks, 0);
             &mut on_heap
         };
-        for (k, mask) in masks.iter_mut().enumerate() {
-            let k = k as u32;
-            let at = IVec3::new(
-                (k % span.x) as i32,
-                ((k / span.x) % span.y) as i32,
-                (k / (span.x * span.y)) as i32,
-            );
-            *mask = self.blocks.get(&(first + at)).copied().unwrap_or(0);
+        let mut slots = masks.iter_mut();
+        for bz in first.z..=last.z {
+            for by in first.y..=last.y {
+                for bx in first.x..=last.x {
+                    let mask = self.blocks.get(&IVec3::new(bx, by, bz)).copied();
+                    *slots.next().expect("a slot per block") = mask.unwrap_or(0);
+                }
+            }
         }
         for z in a.z..=b.z {
             let (bz, lz) = ((z >> BLOCK_SHIFT) - first.z, z & (BLOCK_SIDE - 1));
