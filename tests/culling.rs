@@ -42,6 +42,7 @@ struct Run {
     clamped: usize,
     reverted: usize,
     culled_steps: usize,
+    culled_vertices: usize,
     steps: usize,
 }
 
@@ -57,6 +58,7 @@ fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run
         clamped: 0,
         reverted: 0,
         culled_steps: 0,
+        culled_vertices: 0,
         steps: 0,
     };
     for stroke in strokes {
@@ -64,6 +66,7 @@ fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run
         outcome.clamped += report.clamped;
         outcome.reverted += report.reverted;
         outcome.culled_steps += report.culled_steps;
+        outcome.culled_vertices += report.culled_vertices;
         outcome.steps += report.steps;
     }
     mesh.validate().unwrap();
@@ -80,15 +83,19 @@ fn assert_culling_changes_nothing(
 ) -> Run {
     let culled = run(mesh, strokes, remeshing, true);
     let searched = run(mesh, strokes, remeshing, false);
-    assert_eq!(searched.culled_steps, 0, "{name}: culling off still culled");
+    assert_eq!(
+        (searched.culled_steps, searched.culled_vertices),
+        (0, 0),
+        "{name}: culling off still culled"
+    );
     assert_eq!(
         (&culled.digest, culled.clamped, culled.reverted),
         (&searched.digest, searched.clamped, searched.reverted),
         "{name}: culling changed the result"
     );
     eprintln!(
-        "{name}: {} steps, {} culled, {} clamped, {} undone",
-        culled.steps, culled.culled_steps, culled.clamped, culled.reverted
+        "{name}: {} steps, {} culled, {} vertex searches culled, {} clamped, {} undone",
+        culled.steps, culled.culled_steps, culled.culled_vertices, culled.clamped, culled.reverted
     );
     culled
 }
@@ -185,12 +192,13 @@ fn a_sheet_folded_onto_itself_collides_the_same() {
 }
 
 #[test]
-fn a_steep_ridge_is_a_sheet_whose_crossings_are_not_searched() {
+fn a_steep_ridge_is_a_sheet_searched_only_where_its_vertices_need_it() {
     // A ridge across the sheet with flanks at up to 58°: its normals fit in a cone well
     // under 90°, so it projects one-to-one (a sheet), but too wide a cone for the bound
-    // that clears the proximity clamp's search (cos θ·(r + 1)·ρ ≥ d). Draws along its crest
-    // (the bench's plane after a few passes over the same rows) then skip the backstop's
-    // search and still run the clamp's.
+    // that clears the proximity clamp's search of the whole region (cos θ·(r + 1)·ρ ≥ d).
+    // Draws along its crest (the bench's plane after a few passes over the same rows) then
+    // skip the backstop's search, and the clamp's where a vertex's own neighbourhood
+    // clears it.
     let flat = scene(SceneKind::Plane, 6_000);
     let mesh = reshaped(flat, |u, v| {
         let across = (u - 0.5) / 0.1;
@@ -205,6 +213,37 @@ fn a_steep_ridge_is_a_sheet_whose_crossings_are_not_searched() {
     assert!(
         run.culled_steps * 2 > run.steps,
         "a ridge is a sheet: {run:?}"
+    );
+    assert!(
+        run.culled_vertices > 0,
+        "the ridge's vertices clear by their neighbourhood: {run:?}"
+    );
+}
+
+#[test]
+fn a_narrow_groove_is_searched_where_its_walls_come_close() {
+    // A V-shaped groove with walls at 79° in a flat sheet: still one-to-one along the
+    // vertical, so a sheet, but too steep to be clear as a whole. Draws pushing its left wall
+    // sideways into the right one must be clamped exactly as unculled ones, where the wall's
+    // vertices come within the collision distance of the other wall's faces beyond their
+    // exclusion ring, while the flat sheet beside the groove clears by its neighbourhood.
+    let flat = scene(SceneKind::Plane, 6_000);
+    let mesh = reshaped(flat, |u, v| {
+        let across = ((u - 0.5) / 0.04).abs();
+        Vec3::new(u, v, -0.2 * (1.0 - across).max(0.0))
+    });
+    // Down the left wall, where it is as deep as the groove is narrow, back and forth.
+    let into_the_far_wall = |depth: f32| {
+        let along = |k: usize| 0.4 + 0.2 * ((k % 8) as f32 / 7.0);
+        let to = |k: usize| Vec3::new(0.485, along(k), depth);
+        draw((0.03, 1.0), (0..32).map(to), Some(Vec3::X))
+    };
+    let strokes: Vec<Stroke> = [-0.13, -0.12, -0.14].map(into_the_far_wall).into();
+    let run = assert_culling_changes_nothing("narrow groove", &mesh, &strokes, Remeshing::Off);
+    assert!(run.clamped > 0, "the groove's walls must meet: {run:?}");
+    assert!(
+        run.culled_vertices > 0,
+        "the flat sheet around the groove clears by its neighbourhood: {run:?}"
     );
 }
 

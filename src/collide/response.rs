@@ -15,6 +15,7 @@ use super::backstop::{Backstop, undo_crossings};
 use super::gap_guard::undo_gap_violations;
 use super::neighbourhood::{in_ring, ring_vertices};
 use super::region::{Region, Scratch, StepMoves, map_with_scratch, triangle};
+use super::sheet::clear_around;
 use super::state::StrokeState;
 // The slack a vertex already within the collision distance is allowed (see its doc): the GPU's
 // `wgsl/proximity.wgsl` has the same.
@@ -42,9 +43,15 @@ pub fn pull_back(
     let query = Aabb::of_points(&[start, x]).expanded(d);
     let own_layer = mesh.vertex_layers()[v as usize];
     let layers = mesh.face_layers();
-    // Within a clear sheet nothing outside the ring is within d (`super::sheet`).
+    // Within a clear sheet nothing outside the ring is within d (`super::sheet`); nor, in
+    // a sheet not clear as a whole, where the vertex's own neighbourhood clears it. That walk
+    // pays where it spares a whole search: the region is one layer, and the vertex is tested
+    // against every face, not only the few the last pass changed.
     let own_clear = region.is_clear(own_layer);
-    if own_clear && region.single_layer() {
+    let whole_search = changed.is_none();
+    if region.single_layer()
+        && (own_clear || whole_search && clears_by_its_ring(state, region, mesh, v, scratch))
+    {
         return None;
     }
     let kept_ring = region.rings.get(mesh, v, state.ring);
@@ -113,6 +120,32 @@ pub fn pull_back(
     (t < 1.0).then(|| start + (x - start) * t)
 }
 
+/// Whether `v`'s own neighbourhood clears it of the faces of its layer, a sheet that is not
+/// clear as a whole (`super::sheet::clear_around`); counted in the region when it does.
+fn clears_by_its_ring(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    v: u32,
+    scratch: &mut Scratch,
+) -> bool {
+    let Some(sheet) = region.sheet(mesh.vertex_layers()[v as usize]) else {
+        return false;
+    };
+    let ring = match region.rings.get(mesh, v, state.ring) {
+        Some(kept) => kept,
+        None => {
+            ring_vertices(mesh, v, state.ring, &mut scratch.ring);
+            &scratch.ring
+        }
+    };
+    let clear = clear_around(mesh, region, sheet, (v, ring), state.collision_distance);
+    if clear {
+        region.count_clear_vertex();
+    }
+    clear
+}
+
 /// What the collision phase did.
 #[derive(Debug, Default)]
 pub struct CollisionOutcome {
@@ -122,6 +155,9 @@ pub struct CollisionOutcome {
     pub reverted: usize,
     /// Searches within a layer were skipped: it was a sheet in the step's region.
     pub culled: bool,
+    /// Searches of a moving vertex's own layer skipped by its own neighbourhood, on a sheet
+    /// not clear as a whole (`super::sheet::clear_around`), summed over the Jacobi passes.
+    pub culled_vertices: usize,
 }
 
 /// Passes of the proximity test before giving up on converging (each pass only re-tests against
@@ -210,6 +246,7 @@ pub fn collide_with(
         clamped: clamped_count,
         reverted,
         culled,
+        culled_vertices: region.clear_vertices(),
     }
 }
 

@@ -11,7 +11,9 @@
 //! beyond what they share, so the backstop's pair tests within it are skipped; a sheet that
 //! also passes the bound below is *clear*: no vertex of it comes within `d` of its own faces
 //! outside the exclusion ring, so the proximity clamp's searches within it are skipped too.
-//! A ridge drawn over and over is a sheet whose flanks are too steep to be clear.
+//! A ridge drawn over and over is a sheet whose flanks are too steep to be clear; there a
+//! moving vertex may still be clear by its own neighbourhood ([`clear_around`]), a bound on
+//! the vertex's distance to its sheet taken from the projection of its exclusion ring alone.
 //!
 //! **Why no vertex of a clear sheet comes within `d` of a face of it outside its exclusion
 //! ring.** Let `S` be the region's faces of one layer, every unit normal `n` with
@@ -42,6 +44,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
+use super::neighbourhood::in_ring;
 use super::region::Region;
 use super::state::StrokeState;
 use crate::geom::Aabb;
@@ -73,6 +76,8 @@ pub(crate) struct Sheet {
     /// No vertex of the sheet comes within the collision distance of a face of it outside
     /// its exclusion ring (the module's bound).
     pub(crate) clear: bool,
+    /// Two unit vectors across the axis the sheet projects one-to-one along.
+    frame: [DVec3; 2],
 }
 
 /// The region's faces of `layer`, in the region's order.
@@ -111,7 +116,73 @@ fn sheet_of(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]
     let closing = (boundary[boundary.len() - 1], boundary[0]);
     let clear = cone.cos * (state.ring + 1) as f64 * cone.min_altitude >= d
         && ends.chain(std::iter::once(closing)).all(edge_far);
-    Some(Sheet { clear })
+    let (u, w) = cone.axis.any_orthonormal_pair();
+    Some(Sheet {
+        clear,
+        frame: [u, w],
+    })
+}
+
+/// Whether no face of `sheet` outside the exclusion ring `ring` of `v` (sorted, `v` included)
+/// comes within `d` of `v` where the mesh is now, by `v`'s own neighbourhood: the module's
+/// per-vertex bound, which holds on a sheet that is not clear as a whole (a ridge's flat
+/// foot beside its steep flanks). The sheet must be the region's faces of `v`'s layer.
+///
+/// **Why.** Let `star` be the faces with a vertex in the ring (those the clamp skips as `v`'s
+/// neighbourhood), all in the sheet, and `P` the projection along the sheet's axis. `v` is not
+/// on the rim and its faces keep their orientation in `P`, so `P(v)` lies inside `P(star)`. A
+/// point `q` of a sheet face outside `star` projects outside the inside of `P(star)` (the
+/// projection is one-to-one), so the segment from `P(v)` to `P(q)` crosses the boundary of
+/// `P(star)` and `|v − q| ≥ |P(v) − P(q)|` is at least `P(v)`'s distance to it. That boundary
+/// is the projection of `star`'s edges with no `star` face across them: both their ends lie
+/// outside the ring (a face across an edge shares its ends), so each has one face with a ring
+/// vertex, and it is met once, from that vertex. Every face within `d` of a moving vertex is
+/// in the region, so a distance of `d` or more settles it.
+pub(super) fn clear_around(
+    mesh: &Mesh,
+    region: &Region,
+    sheet: &Sheet,
+    (v, ring): (u32, &[u32]),
+    d: f32,
+) -> bool {
+    if mesh.is_boundary_vertex(v) {
+        return false;
+    }
+    let [u, w] = sheet.frame;
+    let flat = |a: u32| {
+        let p = mesh.positions()[a as usize].as_dvec3();
+        DVec2::new(p.dot(u), p.dot(w))
+    };
+    let here = mesh.positions()[v as usize];
+    // f32 rounding in the clamp's distances, relative to d and to the coordinates.
+    let rounding = 16.0 * f32::EPSILON as f64 * here.abs().max_element() as f64;
+    let needed = d as f64 * (1.0 + MARGIN) + rounding;
+    let x = flat(v);
+    let outside = |a: u32| !in_ring(ring, a);
+    let table = mesh.adjacency();
+    for &a in ring {
+        if mesh.is_boundary_vertex(a) {
+            return false;
+        }
+        for c in table.corners_around(a) {
+            // Around a, corner c's face holds the edge (next, prev) opposite a.
+            if region.local(face_of(c)).is_none() {
+                return false;
+            }
+            let (b0, b1) = (mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c)));
+            if !(outside(b0) && outside(b1)) {
+                continue;
+            }
+            let o = table.opposite[c as usize];
+            if o != INVALID && !outside(mesh.corner_vertex(o)) {
+                continue;
+            }
+            if squared_distance_to_segment(x, (flat(b0), flat(b1))) < needed * needed {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -293,14 +364,15 @@ fn segments_apart((a, b): (DVec2, DVec2), (c, d): (DVec2, DVec2), hair: f64) -> 
     if crossing {
         return false;
     }
-    let to_segment = |p: DVec2, (s, t): (DVec2, DVec2)| {
-        let st = t - s;
-        let k = ((p - s).dot(st) / st.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-        p.distance(s + st * k)
-    };
-    to_segment(a, (c, d))
-        .min(to_segment(b, (c, d)))
-        .min(to_segment(c, (a, b)))
-        .min(to_segment(d, (a, b)))
-        > hair
+    squared_distance_to_segment(a, (c, d))
+        .min(squared_distance_to_segment(b, (c, d)))
+        .min(squared_distance_to_segment(c, (a, b)))
+        .min(squared_distance_to_segment(d, (a, b)))
+        > hair * hair
+}
+
+fn squared_distance_to_segment(p: DVec2, (s, t): (DVec2, DVec2)) -> f64 {
+    let st = t - s;
+    let k = ((p - s).dot(st) / st.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    p.distance_squared(s + st * k)
 }

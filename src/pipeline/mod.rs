@@ -210,6 +210,9 @@ pub struct StrokeReport {
     /// Steps whose collision searches within a layer were skipped, the layer being a sheet
     /// that cannot touch itself there ([`PipelineSettings::cull`]).
     pub culled_steps: usize,
+    /// Searches of a moving vertex's own layer skipped by the vertex's own neighbourhood
+    /// ([`SamplesReport::culled_vertices`]).
+    pub culled_vertices: usize,
     /// Distinct vertices the stroke moved.
     pub touched: usize,
     /// What remeshing did, summed over the stroke's remeshing passes.
@@ -240,6 +243,7 @@ impl StrokeReport {
         self.reverted += call.reverted;
         self.capped_samples += call.capped_samples;
         self.culled_steps += call.culled_steps;
+        self.culled_vertices += call.culled_vertices;
         self.stopped_stretched = self.stopped_stretched.or(call.stopped_stretched);
         self.phases.add(&call.phases);
     }

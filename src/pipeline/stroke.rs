@@ -49,6 +49,9 @@ pub struct SamplesReport {
     /// Steps whose collision searches within a layer were skipped, the layer being a sheet
     /// that cannot touch itself there ([`PipelineSettings::cull`](super::PipelineSettings::cull)).
     pub culled_steps: usize,
+    /// Searches of a moving vertex's own layer skipped by the vertex's own neighbourhood,
+    /// where the layer is a sheet that could touch itself elsewhere in the step.
+    pub culled_vertices: usize,
     /// The stroke stopped in this call: a step stretched an edge to this length (× L), past
     /// [`PipelineSettings::max_stretch`](super::PipelineSettings::max_stretch); the samples
     /// after it were not run, nor will any later call's be.
@@ -680,6 +683,7 @@ impl Active {
         call.clamped += outcome.clamped;
         call.reverted += outcome.reverted;
         call.culled_steps += usize::from(outcome.culled);
+        call.culled_vertices += outcome.culled_vertices;
         for &v in &moved {
             if !self.scratch.touched[v as usize] {
                 self.scratch.touched[v as usize] = true;
