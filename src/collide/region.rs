@@ -3,8 +3,6 @@
 //! the collision response stand on (the proximity clamp, `super::response`; the exact
 //! backstop, `super::backstop`).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -86,9 +84,9 @@ pub struct Region {
     pub(super) rings: RingCache,
     /// The faces the last Jacobi pass changed, filed apart ([`Region::file_changed`]).
     changed: ChangedFaces,
-    /// Searches of their own layer the step's moving vertices skipped by their own
-    /// neighbourhood (`super::sheet::clear_around`), counted from the searches' threads.
-    clear_vertices: AtomicUsize,
+    /// Moving vertices whose own neighbourhood cleared them of a search this step
+    /// (`super::sheet::clear_around`).
+    pub(super) cleared_vertices: usize,
 }
 
 /// The local faces a Jacobi pass of the clamp changed (around the vertices it pulled back),
@@ -251,17 +249,7 @@ impl Region {
         self.ready = false;
         self.sheets = None;
         self.no_sheet_this_step = false;
-        *self.clear_vertices.get_mut() = 0;
-    }
-
-    /// A moving vertex skipped its search of its own layer by its own neighbourhood.
-    pub(super) fn count_clear_vertex(&self) {
-        self.clear_vertices.fetch_add(1, Ordering::Relaxed);
-    }
-
-    /// The searches [`Region::count_clear_vertex`] counted this step.
-    pub(super) fn clear_vertices(&self) -> usize {
-        self.clear_vertices.load(Ordering::Relaxed)
+        self.cleared_vertices = 0;
     }
 
     /// Finds which layers are sheets where the mesh is now (`super::sheet`), unless known

@@ -43,15 +43,9 @@ pub fn pull_back(
     let query = Aabb::of_points(&[start, x]).expanded(d);
     let own_layer = mesh.vertex_layers()[v as usize];
     let layers = mesh.face_layers();
-    // Within a clear sheet nothing outside the ring is within d (`super::sheet`); nor, in
-    // a sheet not clear as a whole, where the vertex's own neighbourhood clears it. That walk
-    // pays where it spares a whole search: the region is one layer, and the vertex is tested
-    // against every face, not only the few the last pass changed.
+    // Within a clear sheet nothing outside the ring is within d (`super::sheet`).
     let own_clear = region.is_clear(own_layer);
-    let whole_search = changed.is_none();
-    if region.single_layer()
-        && (own_clear || whole_search && clears_by_its_ring(state, region, mesh, v, scratch))
-    {
+    if own_clear && region.single_layer() {
         return None;
     }
     let kept_ring = region.rings.get(mesh, v, state.ring);
@@ -120,30 +114,40 @@ pub fn pull_back(
     (t < 1.0).then(|| start + (x - start) * t)
 }
 
-/// Whether `v`'s own neighbourhood clears it of the faces of its layer, a sheet that is not
-/// clear as a whole (`super::sheet::clear_around`); counted in the region when it does.
-fn clears_by_its_ring(
+/// The `moving` vertices (indices into `selection`) less those their own neighbourhood
+/// clears, in a region of one layer that is a sheet but not clear as a whole
+/// (`super::sheet::clear_around`): those need no search. Worth its walk where it spares a
+/// whole search, on the first pass; later passes test most vertices against the few faces
+/// the last one changed.
+fn without_cleared(
     state: &StrokeState<'_>,
-    region: &Region,
+    region: &mut Region,
     mesh: &Mesh,
-    v: u32,
-    scratch: &mut Scratch,
-) -> bool {
-    let Some(sheet) = region.sheet(mesh.vertex_layers()[v as usize]) else {
-        return false;
+    selection: &[(u32, f32)],
+    moving: Vec<usize>,
+) -> Vec<usize> {
+    let Some(&first) = moving.first().filter(|_| region.single_layer()) else {
+        return moving;
     };
-    let ring = match region.rings.get(mesh, v, state.ring) {
-        Some(kept) => kept,
-        None => {
-            ring_vertices(mesh, v, state.ring, &mut scratch.ring);
-            &scratch.ring
-        }
+    let layer = mesh.vertex_layers()[selection[first].0 as usize];
+    let Some(&sheet) = region.sheet(layer).filter(|sheet| !sheet.clear) else {
+        return moving;
     };
-    let clear = clear_around(mesh, region, sheet, (v, ring), state.collision_distance);
-    if clear {
-        region.count_clear_vertex();
-    }
-    clear
+    let view: &Region = region;
+    let cleared = map_with_scratch(state.parallel, &moving, |scratch, &i| {
+        let v = selection[i].0;
+        let ring = match view.rings.get(mesh, v, state.ring) {
+            Some(kept) => kept,
+            None => {
+                ring_vertices(mesh, v, state.ring, &mut scratch.ring);
+                &scratch.ring
+            }
+        };
+        clear_around(mesh, view, &sheet, (v, ring), state.collision_distance)
+    });
+    region.cleared_vertices += cleared.iter().filter(|&&c| c).count();
+    let kept = moving.into_iter().zip(cleared).filter(|&(_, c)| !c);
+    kept.map(|(i, _)| i).collect()
 }
 
 /// What the collision phase did.
@@ -246,7 +250,7 @@ pub fn collide_with(
         clamped: clamped_count,
         reverted,
         culled,
-        culled_vertices: region.clear_vertices(),
+        culled_vertices: region.cleared_vertices,
     }
 }
 
@@ -290,7 +294,7 @@ pub fn clamp_moves(
     // nearer a face than both ends were (the move passed by it), and that face has not changed.
     let mut pulled_last = vec![false; selection.len()];
     for pass in 0..MAX_PASSES {
-        let moving: Vec<usize> = (0..selection.len())
+        let mut moving: Vec<usize> = (0..selection.len())
             .filter(|&i| mesh.positions()[selection[i].0 as usize] != before[i])
             .collect();
         region.find_sheets(state, mesh);
@@ -301,7 +305,10 @@ pub fn clamp_moves(
         region
             .rings
             .prepare(mesh, state.ring, &unclear, state.parallel);
-        if region.worth_searching_near() {
+        if pass == 0 {
+            moving = without_cleared(state, region, mesh, selection, moving);
+        }
+        if region.worth_searching_near() && !moving.is_empty() {
             region.file_faces(mesh, moves, before);
         }
         let region_view: &Region = region;
