@@ -4,7 +4,8 @@
 //! a sheet folded back onto itself, a crumpled one, pinched, twisted and creased ones, a closed
 //! sphere and a layered material with remeshing on — and must end bit-identical, with the same
 //! clamps and undos. The flat sheet shows the culling acts at all, the steep ridge that it
-//! acts where a sheet's bound on proximity fails.
+//! acts where a sheet's bound on proximity fails, vertex by vertex, and the narrow groove
+//! that a vertex's own bound still lets its sheet's other wall be found.
 
 use glam::Vec3;
 use slayer::bench::{BrushMix, ScriptSpec, generate_script};

@@ -159,8 +159,9 @@ pub struct CollisionOutcome {
     pub reverted: usize,
     /// Searches within a layer were skipped: it was a sheet in the step's region.
     pub culled: bool,
-    /// Searches of a moving vertex's own layer skipped by its own neighbourhood, on a sheet
-    /// not clear as a whole (`super::sheet::clear_around`), summed over the Jacobi passes.
+    /// Moving vertices the clamp's first pass did not search, their own neighbourhood clearing
+    /// them where their layer, alone in the region, is a sheet not clear as a whole
+    /// (`super::sheet::clear_around`).
     pub culled_vertices: usize,
 }
 

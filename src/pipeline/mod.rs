@@ -210,8 +210,8 @@ pub struct StrokeReport {
     /// Steps whose collision searches within a layer were skipped, the layer being a sheet
     /// that cannot touch itself there ([`PipelineSettings::cull`]).
     pub culled_steps: usize,
-    /// Searches of a moving vertex's own layer skipped by the vertex's own neighbourhood
-    /// ([`SamplesReport::culled_vertices`]).
+    /// Moving vertices the collision response did not search, their own neighbourhood
+    /// clearing them ([`SamplesReport::culled_vertices`]).
     pub culled_vertices: usize,
     /// Distinct vertices the stroke moved.
     pub touched: usize,

@@ -49,8 +49,8 @@ pub struct SamplesReport {
     /// Steps whose collision searches within a layer were skipped, the layer being a sheet
     /// that cannot touch itself there ([`PipelineSettings::cull`](super::PipelineSettings::cull)).
     pub culled_steps: usize,
-    /// Searches of a moving vertex's own layer skipped by the vertex's own neighbourhood,
-    /// where the layer is a sheet that could touch itself elsewhere in the step.
+    /// Moving vertices the collision response did not search, their own neighbourhood
+    /// clearing them where their layer is a sheet not clear as a whole (summed over steps).
     pub culled_vertices: usize,
     /// The stroke stopped in this call: a step stretched an edge to this length (× L), past
     /// [`PipelineSettings::max_stretch`](super::PipelineSettings::max_stretch); the samples
