@@ -161,14 +161,14 @@ pub(super) fn clear_around(
     let outside = |a: u32| !in_ring(ring, a);
     let table = mesh.adjacency();
     for &a in ring {
-        if mesh.is_boundary_vertex(a) {
+        // A ring vertex where the region reaches was gathered with all its faces: it had not
+        // moved since, or it moves, and lies in the box of the moves.
+        let gathered = region.covers(&Aabb::of_points(&[mesh.positions()[a as usize]]));
+        if mesh.is_boundary_vertex(a) || !gathered {
             return false;
         }
         for c in table.corners_around(a) {
             // Around a, corner c's face holds the edge (next, prev) opposite a.
-            if region.local(face_of(c)).is_none() {
-                return false;
-            }
             let (b0, b1) = (mesh.corner_vertex(next(c)), mesh.corner_vertex(prev(c)));
             if !(outside(b0) && outside(b1)) {
                 continue;
