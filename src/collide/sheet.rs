@@ -380,3 +380,124 @@ fn squared_distance_to_segment(p: DVec2, (s, t): (DVec2, DVec2)) -> f64 {
     let k = ((p - s).dot(st) / st.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
     p.distance_squared(s + st * k)
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec2;
+
+    use super::*;
+    use crate::collide::neighbourhood::ring_vertices;
+    use crate::geom::closest_point_on_triangle;
+    use crate::grid::SpatialHash;
+    use crate::scene::shapes::stacked_sheets;
+
+    /// Side of the test sheet in cells of edge 1, and of the block of vertices tested.
+    const CELLS: u32 = 40;
+    const BLOCK: std::ops::Range<u32> = 16..25;
+
+    /// A flat sheet of `CELLS`² unit cells raised to `height` at each vertex.
+    fn sheet(height: impl Fn(Vec2) -> f32) -> Mesh {
+        let mut mesh = stacked_sheets(1, CELLS, CELLS, 1.0, 0.0);
+        for p in mesh.positions_mut() {
+            p.z = height(Vec2::new(p.x, p.y));
+        }
+        mesh.recompute_normals();
+        mesh
+    }
+
+    /// The nearest face of `v`'s layer outside its exclusion ring, by a walk over every face.
+    fn nearest_outside_ring(mesh: &Mesh, v: u32, ring: &[u32]) -> f32 {
+        let x = mesh.positions()[v as usize];
+        (0..mesh.face_count())
+            .filter(|&f| !mesh.faces()[f].iter().any(|&a| in_ring(ring, a)))
+            .map(|f| {
+                let [a, b, c] = mesh.face_positions(f);
+                closest_point_on_triangle(x, a, b, c).distance(x)
+            })
+            .fold(f32::INFINITY, f32::min)
+    }
+
+    /// Per vertex of the middle block: what `clear_around` says, and the nearest face outside
+    /// its ring; none when the block's region is not a sheet.
+    fn verdicts(mesh: &Mesh, d: f32, ring: u32) -> Option<Vec<(bool, f32)>> {
+        let grid = SpatialHash::build(mesh, 1.0).unwrap();
+        let active = [true];
+        let state = StrokeState {
+            grid: Some(&grid),
+            active: &active,
+            parallel: false,
+            collision_distance: d,
+            ring,
+            max_edge: mesh.longest_edge() * 1.01,
+            cull: true,
+        };
+        let row = CELLS + 1;
+        let block: Vec<u32> = BLOCK
+            .flat_map(|y| BLOCK.map(move |x| y * row + x))
+            .collect();
+        let selection: Vec<(u32, f32)> = block.iter().map(|&v| (v, 1.0)).collect();
+        let targets: Vec<Vec3> = block
+            .iter()
+            .map(|&v| mesh.positions()[v as usize])
+            .collect();
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        for (slot, &v) in block.iter().enumerate() {
+            target_of[v as usize] = slot as u32;
+        }
+        let mut region = Region::default();
+        region.size_for(mesh);
+        region.gather(&state, mesh, &selection, &targets, &target_of);
+        region.find_sheets(&state, mesh);
+        let sheet = *region.sheet(0)?;
+        let mut ring_of = Vec::new();
+        let verdict = |&v: &u32| {
+            ring_vertices(mesh, v, ring, &mut ring_of);
+            let clear = clear_around(mesh, &region, &sheet, (v, &ring_of), d);
+            (clear, nearest_outside_ring(mesh, v, &ring_of))
+        };
+        Some(block.iter().map(verdict).collect())
+    }
+
+    /// The bound never clears a vertex that has a face of its sheet within `d` outside its
+    /// ring, on bumps and a groove steep enough that the sheet as a whole is not clear, and
+    /// at distances where the ring's own next faces come within reach; and it clears most
+    /// vertices where nothing is near.
+    #[test]
+    fn a_vertex_is_cleared_only_where_nothing_outside_its_ring_is_within_reach() {
+        let bumps = |amplitude: f32, width: f32| {
+            move |p: Vec2| {
+                let centres = [(18.0, 19.0, 1.0), (23.0, 21.5, -0.7), (20.5, 24.0, 0.5)];
+                let bump = |&(x, y, sign): &(f32, f32, f32)| {
+                    let r2 = p.distance_squared(Vec2::new(x, y));
+                    sign * amplitude * (-r2 / (width * width)).exp()
+                };
+                centres.iter().map(bump).sum::<f32>()
+            }
+        };
+        let groove = |p: Vec2| -6.0 * (1.0 - (p.x - 20.3).abs() / 1.6).max(0.0);
+        let mut meshes: Vec<Mesh> = vec![sheet(|_| 0.0), sheet(groove)];
+        for (amplitude, width) in [(1.0, 3.0), (2.5, 2.5), (3.5, 2.0), (5.0, 3.0)] {
+            meshes.push(sheet(bumps(amplitude, width)));
+        }
+        let (mut cleared, mut kept_near, mut kept_far) = (0, 0, 0);
+        for (m, mesh) in meshes.iter().enumerate() {
+            for (d, ring) in [(0.8, 1), (1.0, 1), (1.5, 1), (2.5, 1), (2.5, 2)] {
+                let Some(verdicts) = verdicts(mesh, d, ring) else {
+                    continue;
+                };
+                for (clear, nearest) in verdicts {
+                    assert!(!clear || nearest >= d, "mesh {m}, d {d}: {nearest} cleared");
+                    match (clear, nearest < d) {
+                        (true, _) => cleared += 1,
+                        (false, true) => kept_near += 1,
+                        (false, false) => kept_far += 1,
+                    }
+                }
+            }
+        }
+        assert!(
+            cleared > 500 && kept_near > 500 && kept_far > 0,
+            "{cleared} cleared, {kept_near} kept with a face near, {kept_far} kept needlessly"
+        );
+    }
+}
