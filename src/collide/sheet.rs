@@ -145,9 +145,6 @@ pub(super) fn clear_around(
     (v, ring): (u32, &[u32]),
     d: f32,
 ) -> bool {
-    if mesh.is_boundary_vertex(v) {
-        return false;
-    }
     let [u, w] = sheet.frame;
     let flat = |a: u32| {
         let p = mesh.positions()[a as usize].as_dvec3();
@@ -157,13 +154,11 @@ pub(super) fn clear_around(
     // f32 rounding in the clamp's distances, relative to d and to the coordinates.
     let rounding = 16.0 * f32::EPSILON as f64 * here.abs().max_element() as f64;
     let needed = d as f64 * (1.0 + MARGIN) + rounding;
+    let needed_squared = needed * needed;
     let x = flat(v);
-    // A one-ring (r = 1, about 7 vertices) is scanned faster than it is bisected.
-    let outside = |a: u32| match ring.len() {
-        0..=16 => !ring.contains(&a),
-        _ => !in_ring(ring, a),
-    };
+    let outside = |a: u32| !in_ring(ring, a);
     let table = mesh.adjacency();
+    // The ring holds `v`: its rim check is `v`'s too.
     for &a in ring {
         // A ring vertex where the region reaches was gathered with all its faces: it had not
         // moved since, or it moves, and lies in the box of the moves.
@@ -181,7 +176,7 @@ pub(super) fn clear_around(
             if o != INVALID && !outside(mesh.corner_vertex(o)) {
                 continue;
             }
-            if squared_distance_to_segment(x, (flat(b0), flat(b1))) < needed * needed {
+            if squared_distance_to_segment(x, (flat(b0), flat(b1))) < needed_squared {
                 return false;
             }
         }

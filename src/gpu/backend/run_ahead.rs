@@ -58,10 +58,11 @@ use crate::pipeline::{CallAt, Deformed};
 /// sample's passes are sized for edges grown by a share of the move per sample before it
 /// ([`RunShape::edge_bound`]), so their reach grows with the run. A run records every sample
 /// given from where it starts, up to this many: a stroke given whole costs one blocking
-/// read-back per run, one more per gate stop. A run the gate stops still has the GPU go through the recorded passes of every sample
-/// after the stop, emptied but dispatched (a fixed cost per dispatch on a hardware GPU); runs
-/// that started at two samples and doubled spent fewer such dispatches but read back 4 times
-/// where this reads back once or twice (`docs/gpu.md`).
+/// read-back per run, one more per gate stop. A run the gate stops still has the GPU go
+/// through the recorded passes of every sample after the stop, emptied but dispatched (a
+/// fixed cost per dispatch on a hardware GPU); runs that started at two samples and doubled
+/// spent fewer such dispatches but read back 4 times where this reads back once or twice
+/// (`docs/gpu.md`).
 pub(super) const MAX_SAMPLES_AHEAD: usize = 32;
 
 /// A sample of at most this many steps has them recorded in a run (each step's moving list
@@ -109,9 +110,9 @@ impl GpuKernels {
     }
 
     /// Whether a run may start at planned sample `at`: runs ahead on, not the last of the plan
-    /// (a run of one sample is a single step), not one a run reached already (its queued start was dropped
-    /// for moving farther than assumed), nor one that stopped a run where the next would stop
-    /// too ([`GpuKernels::after_stop`]).
+    /// (a run of one sample is a single step), not one a run reached already (its queued start
+    /// was dropped for moving farther than assumed), nor one that stopped a run where the next
+    /// would stop too ([`GpuKernels::after_stop`]).
     pub(super) fn may_start_run(&self, at: usize) -> bool {
         self.runs_ahead()
             && at + 1 < self.plan.len()
