@@ -19,11 +19,21 @@ fn gpu() -> GpuContext {
 }
 
 /// GPU kernels with every step kernel on the GPU, proximity passes included (a software
-/// adapter leaves those on the CPU by default).
+/// adapter leaves those on the CPU by default), one submission per step: runs ahead are on by
+/// default on a hardware adapter only, so they are pinned off for every adapter to run the
+/// same path (the runs-ahead tests turn them on).
 fn all_on_gpu() -> GpuKernels {
     let mut kernels = GpuKernels::new(gpu());
     kernels.set_proximity_on_gpu(true);
+    kernels.set_run_ahead(false);
     kernels
+}
+
+/// Counts of discrete outcomes (clamps, reverted moves) on the two backends may differ by this
+/// share, and by one: a hardware GPU rounds within WGSL's bounds, not as the CPU does, and a
+/// move that ends exactly at a threshold may go either way (lavapipe rounds as the CPU does).
+fn counts_agree(cpu: usize, gpu: usize) -> bool {
+    cpu.abs_diff(gpu) <= 1 + cpu / 200
 }
 
 /// How large a test's strokes are. On lavapipe every proximity pass costs in proportion to the
@@ -78,6 +88,80 @@ fn run(pipeline: &mut Pipeline, mesh: &mut Mesh, strokes: &[slayer::brush::Strok
         .sum()
 }
 
+/// Whether the adapter rounds as the CPU does: lavapipe does (its kernels are compiled for the
+/// CPU without fusing multiply-adds); a hardware GPU rounds within WGSL's bounds instead, so a
+/// move that ends exactly at a remeshing or collision threshold may go the other way there.
+fn rounds_as_the_cpu() -> bool {
+    static SOFTWARE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *SOFTWARE.get_or_init(|| gpu().adapter.software)
+}
+
+/// Asserts that the GPU backend's mesh is the CPU pipeline's: the same vertices within 1e-4·`edge`.
+/// On a hardware GPU a threshold decided the other way can make remeshing choose differently
+/// from there on (another split, the vertices numbered otherwise), so there, failing that, the
+/// same surface: vertex counts within 1 %, each surface within 0.1·`edge` of the other.
+fn assert_matches_cpu(label: &str, on_cpu: &Mesh, on_gpu: &Mesh, edge: f32) {
+    let same_vertices = on_cpu.vertex_count() == on_gpu.vertex_count();
+    let deviation = if same_vertices {
+        largest_deviation(on_cpu, on_gpu)
+    } else {
+        f32::INFINITY
+    };
+    eprintln!("{label}: largest deviation {:.2e} L", deviation / edge);
+    if deviation <= 1e-4 * edge {
+        return;
+    }
+    assert!(
+        !rounds_as_the_cpu(),
+        "{label}: vertices {} vs {}, deviation {deviation} > 1e-4 L",
+        on_cpu.vertex_count(),
+        on_gpu.vertex_count()
+    );
+    let (c, g) = (on_cpu.live_vertex_count(), on_gpu.live_vertex_count());
+    assert!(
+        c.abs_diff(g) <= c / 100,
+        "{label}: {c} live vertices on the CPU, {g} on the GPU"
+    );
+    let apart = |a: &Mesh, b: &Mesh| slayer::remesh::Surface::of(a).distance_of(b, edge).max;
+    let apart = apart(on_cpu, on_gpu).max(apart(on_gpu, on_cpu));
+    eprintln!("{label}: remeshing chose otherwise; the surfaces lie {apart:.3} L apart");
+    assert!(apart <= 0.1, "{label}: the surfaces lie {apart} L apart");
+}
+
+/// Asserts that two selections in vertex order hold the same vertices, but for those within
+/// 1e-5 of the rim (`reach`: a vertex's distance from the centre over the radius), with weights
+/// within 1e-5: a hardware GPU's rounding (see [`rounds_as_the_cpu`]).
+fn assert_selections_agree(
+    label: &str,
+    gpu: &[(u32, f32)],
+    cpu: &[(u32, f32)],
+    reach: impl Fn(u32) -> f32,
+) {
+    let on_rim = |v: u32| (reach(v) - 1.0).abs() <= 1e-5;
+    let weights: std::collections::HashMap<u32, f32> = cpu.iter().copied().collect();
+    for &(v, w) in gpu {
+        match weights.get(&v) {
+            Some(&c) => assert!(
+                (w - c).abs() <= 1e-5,
+                "{label}: vertex {v} weighs {w} vs {c}"
+            ),
+            None => assert!(
+                on_rim(v),
+                "{label}: vertex {v} selected at {} of the radius",
+                reach(v)
+            ),
+        }
+    }
+    let selected: std::collections::HashSet<u32> = gpu.iter().map(|&(v, _)| v).collect();
+    for &(v, _) in cpu {
+        assert!(
+            selected.contains(&v) || on_rim(v),
+            "{label}: vertex {v} left out at {} of the radius",
+            reach(v)
+        );
+    }
+}
+
 /// The largest distance between the same vertex of two meshes.
 fn largest_deviation(a: &Mesh, b: &Mesh) -> f32 {
     a.positions()
@@ -111,8 +195,10 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     // Most steps ran their proximity passes in the submission that selected and deformed.
     assert!(uploads.clamped_ahead > uploads.dropped_ahead, "{uploads:?}");
     assert!(cpu_collisions > 0, "the strokes collide");
-    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
-    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
+    assert!(
+        counts_agree(cpu_collisions, gpu_collisions),
+        "{cpu_collisions} vs {gpu_collisions}"
+    );
     for mesh in [&on_cpu, &on_gpu] {
         mesh.validate().unwrap();
         assert_eq!(find_intersections(mesh).total(), 0);
@@ -246,8 +332,10 @@ fn check_run_ahead(
     assert!(uploads.read_backs < steps, "{report:?}");
     assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
     assert!(cpu_collisions > 0, "the stroke collides");
-    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
-    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
+    assert!(
+        counts_agree(cpu_collisions, gpu_collisions),
+        "{cpu_collisions} vs {gpu_collisions}"
+    );
     on_gpu.validate().unwrap();
     assert_eq!(find_intersections(&on_gpu).total(), 0);
     report
@@ -301,7 +389,10 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
         } else {
             assert_eq!(filter, None);
         }
-        assert_eq!(cpu_reverted, gpu_reverted);
+        assert!(
+            counts_agree(cpu_reverted, gpu_reverted),
+            "reverted {cpu_reverted} on the CPU, {gpu_reverted} on the GPU"
+        );
         // Sent whole once; patched after every stroke (and where a grab remeshed mid-stroke).
         assert_eq!(uploads.whole, 1, "{uploads:?}");
         assert!(uploads.patched >= strokes.len(), "{uploads:?}");
@@ -310,10 +401,12 @@ fn gpu_kernels_with_remeshing_patch_their_copy_and_keep_the_mesh_sound() {
             mesh.vertex_count() > start.vertex_count(),
             "remeshing added vertices"
         );
-        assert_eq!(mesh.vertex_count(), on_cpu.vertex_count());
-        let deviation = largest_deviation(&on_cpu, &mesh);
-        assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
-        assert_eq!(cpu_collisions, gpu_collisions);
+        let label = format!("proximity on the GPU: {proximity_on_gpu}");
+        assert_matches_cpu(&label, &on_cpu, &mesh, start.mean_edge_length());
+        assert!(
+            counts_agree(cpu_collisions, gpu_collisions),
+            "{cpu_collisions} vs {gpu_collisions}"
+        );
         mesh.validate().unwrap();
         assert_eq!(find_intersections(&mesh).total(), 0);
     }
@@ -449,9 +542,11 @@ fn arrays_past_the_binding_limit_are_split_into_pages() {
     let mut mesh = start.clone();
     let gpu_collisions = run(&mut pipeline, &mut mesh, &strokes);
     assert_eq!(pipeline.kernel_failure(), None);
-    let deviation = largest_deviation(&on_cpu, &mesh);
-    assert!(deviation <= 1e-4 * start.mean_edge_length(), "{deviation}");
-    assert_eq!(cpu_collisions, gpu_collisions);
+    assert_matches_cpu("paged", &on_cpu, &mesh, start.mean_edge_length());
+    assert!(
+        counts_agree(cpu_collisions, gpu_collisions),
+        "{cpu_collisions} vs {gpu_collisions}"
+    );
     assert!(cpu_collisions > 0, "the strokes collide");
 }
 
@@ -635,8 +730,25 @@ fn select_and_deform_is_one_read_back_and_matches_the_cpu_kernels() {
             "{label}: selects {}",
             on_cpu.selection.len()
         );
-        assert_eq!(on_gpu.selection, on_cpu.selection, "{label}: selection");
-        assert_eq!(on_gpu.frame, on_cpu.frame, "{label}: frame");
+        if rounds_as_the_cpu() {
+            assert_eq!(on_gpu.selection, on_cpu.selection, "{label}: selection");
+            assert_eq!(on_gpu.frame, on_cpu.frame, "{label}: frame");
+        } else {
+            let center = dab.frame.center;
+            let reach = |v: u32| mesh.positions()[v as usize].distance(center) / radius;
+            assert_selections_agree(&label, &on_gpu.selection, &on_cpu.selection, reach);
+            let (g, c) = (on_gpu.frame, on_cpu.frame);
+            let apart = [
+                g.center.distance(c.center),
+                g.normal.distance(c.normal) * radius,
+                g.plane_point.distance(c.plane_point),
+                g.motion.distance(c.motion),
+            ];
+            assert!(
+                apart.iter().all(|&d| d <= 1e-5 * radius),
+                "{label}: frames {g:?} and {c:?}"
+            );
+        }
         assert_eq!(on_gpu.targets.is_some(), deforms, "{label}: targets");
         if let (Some(g), Some(c)) = (&on_gpu.targets, &on_cpu.targets) {
             let worst = g
@@ -734,9 +846,7 @@ fn sculpted_on_both(start: &Mesh, sculpt: impl Fn(&mut Pipeline, &mut Mesh)) -> 
     assert_eq!(pipeline.kernel_failure(), None);
     on_gpu.validate().unwrap();
     assert_eq!(find_intersections(&on_gpu).total(), 0);
-    assert_eq!(on_gpu.vertex_count(), on_cpu.vertex_count());
-    let deviation = largest_deviation(&on_cpu, &on_gpu);
-    assert!(deviation <= 1e-4 * on_cpu.mean_edge_length(), "{deviation}");
+    assert_matches_cpu("sculpted", &on_cpu, &on_gpu, on_cpu.mean_edge_length());
     (on_gpu, pipeline)
 }
 

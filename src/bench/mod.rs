@@ -125,6 +125,9 @@ pub struct GpuCalls {
     pub read_backs_per_sample: f64,
     pub read_backs_per_stroke: f64,
     pub read_backs_per_call: f64,
+    /// Milliseconds per sample the CPU spent submitting, and blocked waiting for the GPU.
+    pub submit_ms_per_sample: f64,
+    pub waited_ms_per_sample: f64,
     /// Samples and steps recorded in runs ahead that the GPU's gate stopped, and the share of
     /// samples that is.
     pub gate_stops: usize,
@@ -147,6 +150,7 @@ impl GpuCalls {
         (samples, strokes, calls): (usize, usize, usize),
     ) -> GpuCalls {
         let per = |count: usize, over: usize| count as f64 / over.max(1) as f64;
+        let micros_per = |micros: u64, over: usize| micros as f64 / 1000.0 / over.max(1) as f64;
         let submissions = after.submissions - before.submissions;
         let read_backs = after.read_backs - before.read_backs;
         let gate_stops = after.gated_ahead - before.gated_ahead;
@@ -159,6 +163,8 @@ impl GpuCalls {
             read_backs_per_sample: per(read_backs, samples),
             read_backs_per_stroke: per(read_backs, strokes),
             read_backs_per_call: per(read_backs, calls),
+            submit_ms_per_sample: micros_per(after.submit_micros - before.submit_micros, samples),
+            waited_ms_per_sample: micros_per(after.waited_micros - before.waited_micros, samples),
             gate_stops,
             gate_stops_per_sample: per(gate_stops, samples),
             gate_stops_by: after.gate_stops.since(before.gate_stops),

@@ -56,13 +56,16 @@ pub fn gpu_memory_lines(results: &[SceneResult]) -> String {
                 .map_or("a stroke".to_string(), |n| format!("{n} samples"));
             let _ = writeln!(
                 out,
-                "gpu calls {}: {:.2} submissions and {:.2} blocking read-backs per sample, \
-                 {:.2} read-backs per stroke, {:.2} per call ({feed} per call); {} samples and \
+                "gpu calls {}: {:.2} submissions and {:.2} blocking read-backs per sample \
+                 ({:.2} ms submitting, {:.2} ms waiting), {:.2} read-backs per stroke, {:.2} per \
+                 call ({feed} per call); {} samples and \
                  {} steps taken from runs ahead ({} samples split in two there), the gate \
                  stopped {} ({:.1}% of samples: {})",
                 r.name,
                 c.submissions_per_sample,
                 c.read_backs_per_sample,
+                c.submit_ms_per_sample,
+                c.waited_ms_per_sample,
                 c.read_backs_per_stroke,
                 c.read_backs_per_call,
                 c.samples_ahead,

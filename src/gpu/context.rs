@@ -174,6 +174,10 @@ pub struct GpuContext {
     read_backs: std::sync::atomic::AtomicUsize,
     /// Submissions so far ([`GpuContext::submit`]).
     submissions: std::sync::atomic::AtomicUsize,
+    /// Microseconds the CPU spent in submissions and blocked waiting for the GPU: where a
+    /// hardware GPU's time goes when the kernels are not the cost.
+    submit_micros: std::sync::atomic::AtomicU64,
+    waited_micros: std::sync::atomic::AtomicU64,
 }
 
 impl GpuContext {
@@ -249,6 +253,8 @@ impl GpuContext {
             pipelines: Default::default(),
             read_backs: Default::default(),
             submissions: Default::default(),
+            submit_micros: Default::default(),
+            waited_micros: Default::default(),
         })
     }
 
@@ -415,7 +421,9 @@ impl GpuContext {
     pub fn submit(&self, encoder: wgpu::CommandEncoder) {
         self.submissions
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let started = std::time::Instant::now();
         self.queue.submit([encoder.finish()]);
+        add_micros(&self.submit_micros, started);
     }
 
     /// Submissions so far ([`GpuContext::submit`]).
@@ -423,19 +431,32 @@ impl GpuContext {
         self.submissions.load(std::sync::atomic::Ordering::Relaxed)
     }
 
+    /// Microseconds spent so far in submissions and in blocking waits for the GPU.
+    pub fn host_micros(&self) -> (u64, u64) {
+        let load = |m: &std::sync::atomic::AtomicU64| m.load(std::sync::atomic::Ordering::Relaxed);
+        (load(&self.submit_micros), load(&self.waited_micros))
+    }
+
     /// Waits until the GPU has done everything submitted so far.
     pub fn wait(&self) -> Result<(), GpuError> {
-        self.device
+        let started = std::time::Instant::now();
+        let waited = self
+            .device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+            .map_err(|e| GpuError::Readback(e.to_string()));
+        add_micros(&self.waited_micros, started);
+        waited
     }
 
     /// Waits for the GPU and copies a mappable (`MAP_READ`) buffer's bytes out.
     pub fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         self.read_backs
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        map_read(&self.device, buffer)
+        let started = std::time::Instant::now();
+        let bytes = map_read(&self.device, buffer);
+        add_micros(&self.waited_micros, started);
+        bytes
     }
 
     /// Blocking read-backs so far ([`GpuContext::map_read`] calls).
@@ -571,6 +592,11 @@ impl GpuContext {
             (max_x as u32, groups.div_ceil(max_x) as u32)
         }
     }
+}
+
+fn add_micros(total: &std::sync::atomic::AtomicU64, since: std::time::Instant) {
+    let micros = since.elapsed().as_micros() as u64;
+    total.fetch_add(micros, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// [`GpuContext::map_read`] on any device (a window's), uncounted.

@@ -217,6 +217,10 @@ pub struct Uploads {
     /// kernels.
     pub submissions: usize,
     pub read_backs: usize,
+    /// Microseconds the CPU spent submitting, and blocked waiting for the GPU (the read-backs
+    /// and the waits for a table build): beside the counts, where a hardware GPU's time goes.
+    pub submit_micros: u64,
+    pub waited_micros: u64,
     /// Steps whose proximity passes ran in the submission that selected and deformed
     /// ([`StepKernels::select_deform_and_clamp`]), and those whose passes so run moved vertices
     /// the pipeline did not take and were put back (the exact backstop undid a move, or the

@@ -144,10 +144,48 @@ pub fn selection_under(
         .collect()
 }
 
-/// Pulled-back positions may differ by this share of the edge length: one flipped decision in
-/// the last bisection rounds moves a result by 2⁻¹⁶ of its move, and the GPU may fuse the
-/// closest-point arithmetic's multiply-adds.
+/// Pulled-back positions may differ by this share of the edge length, beside [`rounding`]: one
+/// flipped decision in the last bisection rounds moves a result by 2⁻¹⁶ of its move.
 pub const PROXIMITY_TOLERANCE: f32 = 1e-5;
+
+/// WGSL lets an implementation fuse a multiply and an add, and round a division or a square
+/// root within a few ulps, so a hardware GPU may differ from the mirror in the last bits of
+/// whatever it computes from the coordinates (lavapipe rounds as the CPU does; an NVIDIA H200
+/// differed by up to 2 ulps of the largest coordinate). Results may differ by this many ulps
+/// of the largest coordinate.
+const ROUNDING_ULPS: f32 = 8.0;
+
+/// How far apart a GPU result and its mirror's may lie when both are computed from coordinates
+/// no larger than `extent` in magnitude.
+pub fn rounding(extent: f32) -> f32 {
+    ROUNDING_ULPS * f32::EPSILON * extent
+}
+
+/// The largest coordinate magnitude among `points`.
+pub fn extent(points: &[Vec3]) -> f32 {
+    points
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f32::max)
+}
+
+/// How far a pulled-back position may lie from the mirror's on `scene`, in edge lengths.
+pub fn proximity_tolerance(scene: &ProximityScene) -> f32 {
+    PROXIMITY_TOLERANCE + rounding(extent(scene.mesh.positions())) / scene.edge
+}
+
+/// Asserts that `actual` matches `expected` point by point, each coordinate within
+/// [`rounding`] of coordinates as large as `extent`.
+pub fn assert_close(label: &str, actual: &[Vec3], expected: &[Vec3], extent: f32) {
+    assert_eq!(actual.len(), expected.len(), "{label}: lengths");
+    let allowed = rounding(extent);
+    for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
+        assert!(
+            (*a - *e).abs().max_element() <= allowed,
+            "{label}: point {i} is {a} here, {e} in the reference (allowed {allowed:e})"
+        );
+    }
+}
 
 /// A step to test proximity on: the mesh at the step's start, its selection (a seeded shuffle
 /// of the vertices that move) and every vertex's tentative position.

@@ -6,9 +6,9 @@ use slayer::gpu::table_size_for;
 use slayer::grid::SpatialHash;
 
 use crate::common::{
-    Binding, PROXIMITY_TOLERANCE, ProximityScene, binding_limit_paging, folded_sheet,
-    gathered_region, gpu, gpu_with_binding_limit, host_moving_list, mesh_table, packed,
-    pressed_sheets,
+    Binding, ProximityScene, binding_limit_paging, folded_sheet, gathered_region, gpu,
+    gpu_with_binding_limit, host_moving_list, mesh_table, packed, pressed_sheets,
+    proximity_tolerance,
 };
 
 /// The proximity mirror's verdicts for `selection` of `scene`, with `current` positions.
@@ -85,13 +85,15 @@ fn reference_pull_back(
         .collect()
 }
 
-/// Largest distance between two verdict lists over `edge`, after checking their flags agree.
+/// Largest distance between two verdict lists on `scene`, in its edge lengths, after checking
+/// their flags agree.
 fn compare_pulled(
     label: &str,
     actual: &[slayer::gpu::PulledVertex],
     expected: &[slayer::gpu::PulledVertex],
-    edge: f32,
+    scene: &ProximityScene,
 ) -> f32 {
+    let edge = scene.edge;
     assert_eq!(actual.len(), expected.len(), "{label}");
     let mut worst = 0.0f32;
     for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
@@ -103,7 +105,7 @@ fn compare_pulled(
         worst = worst.max(off);
     }
     assert!(
-        worst <= PROXIMITY_TOLERANCE,
+        worst <= proximity_tolerance(scene),
         "{label}: off by {worst:e} edge lengths"
     );
     worst
@@ -178,14 +180,14 @@ fn check_proximity(scene: ProximityScene, binding: Binding) {
             &format!("{label}: mirror vs pull_back"),
             &mirror,
             &reference,
-            scene.edge,
+            &scene,
         ));
         let actual = slayer::gpu::run_proximity(&gpu, &query).expect("GPU run");
         worst_gpu = worst_gpu.max(compare_pulled(
             &format!("{label}: GPU vs mirror"),
             &actual,
             &mirror,
-            scene.edge,
+            &scene,
         ));
         if size >= 1000 {
             let clamped = mirror.iter().filter(|p| p.pulled == 1).count();
@@ -210,7 +212,7 @@ fn check_proximity(scene: ProximityScene, binding: Binding) {
             &format!("{label}, second pass: GPU vs mirror"),
             &actual,
             &mirror,
-            scene.edge,
+            &scene,
         ));
     }
     eprintln!(

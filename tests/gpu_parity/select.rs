@@ -32,10 +32,13 @@ fn assert_same_selection(
         s
     };
     let (actual, expected) = (sorted(actual), sorted(expected));
-    let on_rim = |v: u32| {
-        let d = positions[v as usize].distance(brush.center);
-        (d - brush.radius).abs() <= RIM_TOLERANCE * brush.radius
-    };
+    for list in [&actual, &expected] {
+        if let Some(pair) = list.windows(2).find(|pair| pair[0].0 == pair[1].0) {
+            panic!("{label}: vertex {} listed twice: {pair:?}", pair[0].0);
+        }
+    }
+    let reach = |v: u32| positions[v as usize].distance(brush.center) / brush.radius;
+    let on_rim = |v: u32| (reach(v) - 1.0).abs() <= RIM_TOLERANCE;
     let (mut i, mut j, mut worst) = (0, 0, 0.0f32);
     while i < actual.len() || j < expected.len() {
         let a = actual.get(i).copied();
@@ -53,7 +56,8 @@ fn assert_same_selection(
             (Some((va, _)), e) if e.is_none_or(|(ve, _)| va < ve) => {
                 assert!(
                     on_rim(va),
-                    "{label}: vertex {va} selected, not in the reference"
+                    "{label}: vertex {va} selected, not in the reference (at {} of the radius)",
+                    reach(va)
                 );
                 eprintln!("{label}: rim vertex {va} only in one selection");
                 i += 1;
@@ -61,7 +65,8 @@ fn assert_same_selection(
             (_, Some((ve, _))) => {
                 assert!(
                     on_rim(ve),
-                    "{label}: vertex {ve} of the reference not selected"
+                    "{label}: vertex {ve} of the reference not selected (at {} of the radius)",
+                    reach(ve)
                 );
                 eprintln!("{label}: rim vertex {ve} only in one selection");
                 j += 1;

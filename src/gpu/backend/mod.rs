@@ -491,8 +491,11 @@ impl StepKernels for GpuKernels {
     }
 
     fn uploads(&self) -> Option<Uploads> {
+        let (submit_micros, waited_micros) = self.gpu.host_micros();
         Some(Uploads {
             submissions: self.gpu.submissions(),
+            submit_micros,
+            waited_micros,
             read_backs: self.gpu.read_backs() - self.check_read_backs,
             ..self.uploads
         })
