@@ -184,6 +184,7 @@ impl Worker {
         self.rebuild_picker();
         self.send_changes();
         self.send_status();
+        self.prepare_pipeline();
         while let Some(command) = self.link.next() {
             self.serve(command);
         }
@@ -273,11 +274,19 @@ impl Worker {
                 }
                 self.link.reply(Reply::Opened(path));
                 self.after_edit(true);
+                self.prepare_pipeline();
             }
             Err(e) => self
                 .link
                 .reply(Reply::Error(format!("{}: {e}", path.display()))),
         }
+    }
+
+    /// The grid, the GPU's copy of the mesh and its compiled kernels, built now that the mesh
+    /// is on screen rather than in the first stroke (which would stall for them). A failure
+    /// here is the first stroke's too, and reported there.
+    fn prepare_pipeline(&mut self) {
+        let _ = self.pipeline.prepare(self.session.mesh());
     }
 
     fn after_edit(&mut self, changed: bool) {

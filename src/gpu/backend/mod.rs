@@ -132,7 +132,52 @@ struct OpenedSample {
     planned: Option<usize>,
 }
 
+/// The kernels every stroke on the GPU runs: the hash table and its overlay, selection, brush
+/// frame, deformation, normals.
+const STROKE_KERNELS: &[&str] = &[
+    "cell_keys",
+    "cell_counts",
+    "scan",
+    "scan_add",
+    "scatter",
+    "overlay_members",
+    "overlay_keys",
+    "overlay_entries",
+    "select",
+    "brush_frame",
+    "dispatch_args",
+    "deform",
+    "vertex_normals",
+    "moved_normals",
+];
+
+/// The kernels of the proximity passes, the backstop's filter and the gate of runs ahead.
+const PROXIMITY_KERNELS: &[&str] = &[
+    "moving_entries",
+    "proximity",
+    "apply_moves",
+    "backstop_filter",
+    "longest_move",
+    "sample_gate",
+    "moved_edges",
+];
+
 impl GpuKernels {
+    /// Compiles the kernels strokes will run with these options, so that a driver's compiler
+    /// (seconds on lavapipe with a cold shader cache, 2.5 s for the plaster's first stroke)
+    /// runs before the first stroke instead of inside it.
+    fn compile_kernels(&self) -> Result<(), GpuError> {
+        let proximity = if self.proximity_on_gpu {
+            PROXIMITY_KERNELS
+        } else {
+            &[]
+        };
+        for name in STROKE_KERNELS.iter().chain(proximity) {
+            self.gpu.compute_pipeline(name)?;
+        }
+        Ok(())
+    }
+
     /// Kernels on `gpu` with the default [`GpuOptions`].
     pub fn new(gpu: GpuContext) -> GpuKernels {
         GpuKernels::with_options(gpu, &GpuOptions::default())
@@ -300,6 +345,7 @@ impl StepKernels for GpuKernels {
         // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
+            k.compile_kernels()?;
             let tables = (&mut k.resident, &mut k.uploads);
             GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present)?;
             // Done here, not in the first call that reads something back.
@@ -545,5 +591,26 @@ impl StepKernels for GpuKernels {
             Some(_) => Err("the GPU copy is behind the mesh".into()),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{PROXIMITY_KERNELS, STROKE_KERNELS};
+
+    #[test]
+    fn the_warm_up_compiles_every_kernel_once() {
+        let mut listed: Vec<&str> = STROKE_KERNELS
+            .iter()
+            .chain(PROXIMITY_KERNELS)
+            .copied()
+            .collect();
+        listed.sort_unstable();
+        let mut kernels: Vec<&str> = crate::gpu::shaders::KERNELS
+            .iter()
+            .map(|&(name, _)| name)
+            .collect();
+        kernels.sort_unstable();
+        assert_eq!(listed, kernels);
     }
 }
