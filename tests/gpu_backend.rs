@@ -29,11 +29,11 @@ fn all_on_gpu() -> GpuKernels {
     kernels
 }
 
-/// Counts of discrete outcomes (clamps, reverted moves) on the two backends may differ by this
-/// share, and by one: a hardware GPU rounds within WGSL's bounds, not as the CPU does, and a
-/// move that ends exactly at a threshold may go either way (lavapipe rounds as the CPU does).
+/// Whether counts of discrete outcomes (clamps, reverted moves) agree between the backends:
+/// exactly on lavapipe; within 0.5 % and one on a hardware GPU, where a move that ends at a
+/// threshold may go either way ([`rounds_as_the_cpu`]).
 fn counts_agree(cpu: usize, gpu: usize) -> bool {
-    cpu.abs_diff(gpu) <= 1 + cpu / 200
+    cpu == gpu || (!rounds_as_the_cpu() && cpu.abs_diff(gpu) <= 1 + cpu / 200)
 }
 
 /// How large a test's strokes are. On lavapipe every proximity pass costs in proportion to the
@@ -195,10 +195,8 @@ fn gpu_selection_and_deformation_match_the_cpu_pipeline() {
     // Most steps ran their proximity passes in the submission that selected and deformed.
     assert!(uploads.clamped_ahead > uploads.dropped_ahead, "{uploads:?}");
     assert!(cpu_collisions > 0, "the strokes collide");
-    assert!(
-        counts_agree(cpu_collisions, gpu_collisions),
-        "{cpu_collisions} vs {gpu_collisions}"
-    );
+    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
+    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
     for mesh in [&on_cpu, &on_gpu] {
         mesh.validate().unwrap();
         assert_eq!(find_intersections(mesh).total(), 0);
@@ -332,10 +330,8 @@ fn check_run_ahead(
     assert!(uploads.read_backs < steps, "{report:?}");
     assert!(deviation <= 1e-4 * edge, "{deviation} > 1e-4 L");
     assert!(cpu_collisions > 0, "the stroke collides");
-    assert!(
-        counts_agree(cpu_collisions, gpu_collisions),
-        "{cpu_collisions} vs {gpu_collisions}"
-    );
+    let spread = (cpu_collisions as f64 - gpu_collisions as f64).abs() / cpu_collisions as f64;
+    assert!(spread <= 0.005, "{cpu_collisions} vs {gpu_collisions}");
     on_gpu.validate().unwrap();
     assert_eq!(find_intersections(&on_gpu).total(), 0);
     report

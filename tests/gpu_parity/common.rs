@@ -156,9 +156,14 @@ pub const PROXIMITY_TOLERANCE: f32 = 1e-5;
 const ROUNDING_ULPS: f32 = 8.0;
 
 /// How far apart a GPU result and its mirror's may lie when both are computed from coordinates
-/// no larger than `extent` in magnitude.
+/// no larger than `extent` in magnitude: not at all on lavapipe, which rounds as the CPU does.
 pub fn rounding(extent: f32) -> f32 {
-    ROUNDING_ULPS * f32::EPSILON * extent
+    static SOFTWARE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    if *SOFTWARE.get_or_init(|| gpu().adapter.software) {
+        0.0
+    } else {
+        ROUNDING_ULPS * f32::EPSILON * extent
+    }
 }
 
 /// The largest coordinate magnitude among `points`.

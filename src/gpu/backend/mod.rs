@@ -163,9 +163,9 @@ const PROXIMITY_KERNELS: &[&str] = &[
 ];
 
 impl GpuKernels {
-    /// Compiles the kernels strokes will run with these options, so that a driver's compiler
-    /// (seconds on lavapipe with a cold shader cache, 2.5 s for the plaster's first stroke)
-    /// runs before the first stroke instead of inside it.
+    /// Compiles the kernels strokes will run with these options, so that wgpu's translation of
+    /// them (about 80 ms in all on lavapipe) and a hardware driver's compiler run before the
+    /// first stroke instead of inside it. (Lavapipe compiles machine code at the first dispatch.)
     fn compile_kernels(&self) -> Result<(), GpuError> {
         let proximity = if self.proximity_on_gpu {
             PROXIMITY_KERNELS
