@@ -15,6 +15,15 @@ pub fn room_for<T>(values: &mut Vec<T>, more: usize) {
     }
 }
 
+/// `len` copies of `fill`, with the room of a first growth already reserved: an array of a
+/// mesh that remeshing is about to grow then grows in place instead of copying itself in the
+/// middle of the first stroke.
+pub fn filled_with_room<T: Clone>(len: usize, fill: T) -> Vec<T> {
+    let mut values = Vec::with_capacity(len + (len / GROWTH_DIVISOR).max(MIN_GROWTH));
+    values.resize(len, fill);
+    values
+}
+
 /// Resizes `values` to at least `len`, filling with `fill`; never shrinks.
 pub fn grow_to<T: Clone>(values: &mut Vec<T>, len: usize, fill: T) {
     if len > values.len() {
@@ -44,5 +53,12 @@ mod tests {
         // Never shrinks.
         grow_to(&mut values, 10, 0);
         assert_eq!(values.len(), 80_005);
+        // Room for a first growth up front: it grows in place.
+        let mut values = filled_with_room(80_000, 3u32);
+        let (before, capacity) = (values.as_ptr(), values.capacity());
+        assert_eq!(capacity, 90_000);
+        grow_to(&mut values, 85_000, 7);
+        assert_eq!((values.as_ptr(), values.capacity()), (before, capacity));
+        assert_eq!((values[79_999], values[84_999]), (3, 7));
     }
 }

@@ -110,6 +110,7 @@ impl Region {
         self.gathered.size_for(mesh.face_count());
         self.face_marks.size_for(mesh.face_count());
         crate::grow::grow_to(&mut self.local_index, mesh.face_count(), 0);
+        self.rings.size_for(mesh.vertex_count());
     }
 
     /// Collects the faces around the step's moves, ready for searching (public so that

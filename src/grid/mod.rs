@@ -60,9 +60,10 @@ impl SpatialHash {
             cell_size,
             inv_cell_size: 1.0 / cell_size,
             heads: vec![INVALID; bucket_count_for(vertex_capacity)],
-            cell_of: vec![ABSENT; vertex_capacity],
-            next: vec![INVALID; vertex_capacity],
-            prev: vec![INVALID; vertex_capacity],
+            // Room for the vertices remeshing will add (`crate::grow`).
+            cell_of: crate::grow::filled_with_room(vertex_capacity, ABSENT),
+            next: crate::grow::filled_with_room(vertex_capacity, INVALID),
+            prev: crate::grow::filled_with_room(vertex_capacity, INVALID),
             len: 0,
             bounds: Aabb::EMPTY,
             occupied: Occupancy::default(),
