@@ -56,7 +56,7 @@ mod tests {
         // Room for a first growth up front: it grows in place.
         let mut values = filled_with_room(80_000, 3u32);
         let (before, capacity) = (values.as_ptr(), values.capacity());
-        assert_eq!(capacity, 90_000);
+        assert!(capacity >= 90_000, "{capacity}");
         grow_to(&mut values, 85_000, 7);
         assert_eq!((values.as_ptr(), values.capacity()), (before, capacity));
         assert_eq!((values[79_999], values[84_999]), (3, 7));
