@@ -14,14 +14,13 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 tests=(gpu_parity gpu_backend streaming render)
+declare -A test_bin
 if [ "${1:-}" = "--prebuilt" ]; then
     bin=${2:?"--prebuilt needs a folder"}
-    declare -A test_bin
     for t in "${tests[@]}"; do test_bin[$t]="$bin/$t"; done
 else
     bin=target/release
     cargo build --release --quiet || exit 1
-    declare -A test_bin
     while IFS=$'\t' read -r name path; do
         test_bin[$name]=$path
     done < <(cargo test --release --no-run --message-format=json "${tests[@]/#/--test=}" 2>/dev/null |

@@ -345,7 +345,10 @@ impl StepKernels for GpuKernels {
         // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
-            k.compile_kernels()?;
+            // With no copy of a mesh yet: once, not before every stroke.
+            if k.resident.is_none() {
+                k.compile_kernels()?;
+            }
             let tables = (&mut k.resident, &mut k.uploads);
             GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present)?;
             // Done here, not in the first call that reads something back.
