@@ -357,3 +357,141 @@ fn validate_reports_non_finite_and_huge_coordinates() {
         Err(MeshError::CoordinateOutOfRange { vertex: 2, .. })
     ));
 }
+
+// ---- patches copied out and put back (whole-mesh remeshing's slabs) ----------------------
+
+/// Faces as their corners' positions, each turned to start at its least corner, sorted: the
+/// surface whatever its numbering.
+fn face_triples(faces: impl Iterator<Item = [Vec3; 3]>) -> Vec<[[u32; 3]; 3]> {
+    let mut triples: Vec<[[u32; 3]; 3]> = faces
+        .map(|t| {
+            let bits = t.map(|p| p.to_array().map(f32::to_bits));
+            let first = (0..3).min_by_key(|&k| bits[k]).unwrap();
+            [0, 1, 2].map(|k| bits[(first + k) % 3])
+        })
+        .collect();
+    triples.sort_unstable();
+    triples
+}
+
+fn live_triples(mesh: &Mesh) -> Vec<[[u32; 3]; 3]> {
+    face_triples(
+        (0..mesh.face_count())
+            .filter(|&f| !mesh.is_face_dead(f))
+            .map(|f| mesh.face_positions(f)),
+    )
+}
+
+fn vertices_where(mesh: &Mesh, keep: impl Fn(Vec3) -> bool) -> Vec<u32> {
+    (0..mesh.vertex_count() as u32)
+        .filter(|&v| mesh.is_vertex_live(v) && keep(mesh.positions()[v as usize]))
+        .collect()
+}
+
+/// A patch of scattered vertices (their fans meeting at single vertices, which the copy
+/// must close over to stay manifold) copies out valid, and put back untouched leaves every
+/// kind of mesh as it was.
+#[test]
+fn a_patch_put_back_untouched_leaves_the_mesh_as_it_was() {
+    for (name, mesh) in kinds() {
+        let scattered: Vec<u32> = (0..mesh.vertex_count() as u32).step_by(3).collect();
+        let patch = mesh.copy_patch(&scattered).unwrap();
+        patch
+            .mesh
+            .validate()
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut back = mesh.clone();
+        back.put_back(&[patch]).unwrap();
+        back.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(back.faces(), mesh.faces(), "{name}");
+        assert_eq!(back.positions(), mesh.positions(), "{name}");
+    }
+}
+
+/// Splits, flips and collapses made inside a copied cap of a sphere come back as if made in
+/// place: a valid sphere (χ 2) whose faces are those outside the patch and the copy's.
+#[test]
+fn edits_in_a_patch_come_back_as_if_made_in_place() {
+    let sphere = slayer::scene::geodesic_sphere(12, 1.0).unwrap();
+    let cap = vertices_where(&sphere, |p| p.z > 0.3);
+    let mut patch = sphere.copy_patch(&cap).unwrap();
+    let copy = &mut patch.mesh;
+    let interior = |copy: &Mesh, c: u32| {
+        let (a, b) = copy.edge_vertices(c);
+        [a, b].iter().all(|&v| copy.positions()[v as usize].z > 0.7)
+    };
+    let (mut splits, mut flips, mut collapses) = (0, 0, 0);
+    for c in (0..3 * copy.face_count() as u32).step_by(7) {
+        if !copy.is_face_dead(c as usize / 3) && interior(copy, c) {
+            copy.split_edge(c, 0.5);
+            splits += 1;
+        }
+    }
+    for c in (0..3 * copy.face_count() as u32).step_by(11) {
+        if !copy.is_face_dead(c as usize / 3) && interior(copy, c) && copy.is_flip_ok(c) {
+            copy.flip_edge(c);
+            flips += 1;
+        }
+    }
+    for c in (0..3 * copy.face_count() as u32).step_by(13) {
+        if !copy.is_face_dead(c as usize / 3) && interior(copy, c) && copy.is_collapse_ok(c) {
+            let (a, b) = copy.edge_vertices(c);
+            let middle = 0.5 * (copy.positions()[a as usize] + copy.positions()[b as usize]);
+            copy.collapse_edge(c, middle);
+            collapses += 1;
+        }
+    }
+    assert!(
+        splits > 20 && flips > 5 && collapses > 5,
+        "{splits} {flips} {collapses}"
+    );
+    copy.validate().unwrap();
+    let outside = (0..sphere.face_count())
+        .filter(|f| !patch.faces.contains(&(*f as u32)))
+        .map(|f| sphere.face_positions(f));
+    let expected = face_triples(
+        outside.chain(
+            (0..copy.face_count())
+                .filter(|&f| !copy.is_face_dead(f))
+                .map(|f| copy.face_positions(f)),
+        ),
+    );
+    let mut mesh = sphere.clone();
+    let maps = mesh.put_back(std::slice::from_ref(&patch)).unwrap();
+    mesh.validate().unwrap();
+    assert_eq!(euler_characteristic(&mesh), 2);
+    assert_eq!(live_triples(&mesh), expected);
+    for (i, &v) in maps[0].iter().enumerate() {
+        if v != INVALID {
+            assert_eq!(mesh.positions()[v as usize], patch.mesh.positions()[i]);
+        }
+    }
+}
+
+/// Work that reached a patch's rim cannot be put back by the patch alone: refused, and the
+/// mesh kept as it was. So are two patches holding one face.
+#[test]
+fn a_patch_whose_rim_changed_or_that_overlaps_another_is_refused() {
+    let sphere = slayer::scene::geodesic_sphere(8, 1.0).unwrap();
+    let cap = vertices_where(&sphere, |p| p.z > 0.5);
+    let patch = sphere.copy_patch(&cap).unwrap();
+    // A vertex of the copy's rim: one whose faces in the mesh are not all copied.
+    let rim = (0..patch.sources.len())
+        .find(|&i| {
+            let v = patch.sources[i];
+            sphere.faces_around(v).any(|f| !patch.faces.contains(&f))
+        })
+        .unwrap();
+    let mut moved = patch.clone();
+    moved.mesh.positions_mut()[rim] += Vec3::splat(0.01);
+    let mut mesh = sphere.clone();
+    assert!(mesh.put_back(&[moved]).is_err());
+    assert_eq!(mesh.positions(), sphere.positions());
+    assert_eq!(mesh.faces(), sphere.faces());
+    let band = sphere
+        .copy_patch(&vertices_where(&sphere, |p| p.z > 0.4))
+        .unwrap();
+    assert!(mesh.put_back(&[patch, band]).is_err());
+    assert_eq!(mesh.faces(), sphere.faces());
+    mesh.validate().unwrap();
+}

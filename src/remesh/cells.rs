@@ -13,9 +13,11 @@
 use glam::{IVec3, Vec3};
 
 use super::shape::ClosedParts;
+use super::slabs::{self, Cell, Plan, Round};
 use super::zone::ZoneFinder;
 use super::{
-    Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, remesh,
+    Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, out_of_band,
+    remesh,
 };
 use crate::geom::Aabb;
 use crate::grid::{GridError, SpatialHash};
@@ -64,15 +66,10 @@ pub(super) fn remesh_whole(
         });
         return Ok(report);
     }
-    let mut grid = SpatialHash::build(mesh, GRID_EDGES * settings.target_edge)?;
+    // Before anything changes: a grid cell the grid refuses leaves the mesh as it was.
+    SpatialHash::new(GRID_EDGES * settings.target_edge, 0)?;
     let closed = ClosedParts::find(mesh, &live);
-    let report = remesh_by_cells(
-        mesh,
-        (&mut grid, closed),
-        settings,
-        (start, culling),
-        progress,
-    );
+    let report = remesh_by_cells(mesh, closed, settings, (start, culling), progress);
     Ok(report)
 }
 
@@ -85,13 +82,11 @@ fn rings(start: Start) -> u32 {
 /// `closed`: the mesh's closed components, found once for every cell.
 fn remesh_by_cells(
     mesh: &mut Mesh,
-    (grid, mut closed): (&mut SpatialHash, ClosedParts),
+    mut closed: ClosedParts,
     settings: &RemeshSettings,
     (start, culling): (Start, Culling),
     progress: &mut dyn FnMut(Progress),
 ) -> RemeshReport {
-    let mut sets = RemeshSets::default();
-    let mut zones = ZoneFinder::default();
     let mut report = RemeshReport::default();
     let mut longest_edge = mesh.longest_edge();
     let width = CELL_EDGES * settings.target_edge;
@@ -105,31 +100,111 @@ fn remesh_by_cells(
             region_rings: rings(start),
             ..*settings
         };
-        let cells = cells(mesh, width, shift);
+        let mut cells = cells(mesh, width, shift);
+        if start != Start::Everywhere {
+            // A pass that starts out of band has nothing to do in a cell with no edge out of
+            // band: leaving it out changes nothing, and spares it its copy.
+            cells.retain(|(_, _, seeds)| {
+                seeds
+                    .iter()
+                    .any(|&v| out_of_band(mesh, v, settings.target_edge))
+            });
+        }
         let count = cells.len();
-        for (cell, (core, seeds)) in cells.into_iter().enumerate() {
-            let zone = match culling {
-                Culling::On => zones.find(mesh, grid, &core, (settings.target_edge, longest_edge)),
-                Culling::Off => None,
-            };
-            let pass = Pass {
-                start,
-                sets: &mut sets,
-                closed: Some(&mut closed),
-                zone: Zoning::Cell(zone),
-            };
-            let (done, _) = remesh(mesh, grid, &seeds, &settings, pass);
-            longest_edge = longest_edge.max(done.longest_edge);
-            report.add(&done);
+        let mut done = 0;
+        let mut tell = |cells_done: usize| {
+            done += cells_done;
             progress(Progress {
                 round: round + 1,
                 rounds: rounds.len(),
-                cell: cell + 1,
+                cell: done,
                 cells: count,
             });
-        }
+        };
+        let round = Round {
+            settings: &settings,
+            start,
+            culling,
+            grid_cell: GRID_EDGES * settings.target_edge,
+        };
+        let reach = slabs::reach(&settings, settings.region_rings, longest_edge);
+        let waves = match Plan::of(cells, (width, shift), reach, longest_edge) {
+            Ok(plan) => run_slabs(
+                mesh,
+                plan,
+                &mut closed,
+                &round,
+                (&mut longest_edge, &mut tell),
+            ),
+            Err(cells) => run_in_place(
+                mesh,
+                cells,
+                &mut closed,
+                &round,
+                (&mut longest_edge, &mut tell),
+            ),
+        };
+        report.add(&waves);
     }
     report.passes = 1;
+    report
+}
+
+/// A round's slabs, wave by wave, each wave on every core where its copies can be made and
+/// put back, and in place where not.
+fn run_slabs(
+    mesh: &mut Mesh,
+    plan: Plan,
+    closed: &mut ClosedParts,
+    round: &Round<'_>,
+    (longest, progress): (&mut f32, &mut dyn FnMut(usize)),
+) -> RemeshReport {
+    let mut report = RemeshReport::default();
+    for wave in plan.waves() {
+        match slabs::run_wave(mesh, (&plan, &wave), closed, round, longest, progress) {
+            Ok(done) => report.add(&done),
+            Err(()) => {
+                let cells = wave
+                    .iter()
+                    .flat_map(|&s| plan.cells_of(s).iter().cloned())
+                    .collect();
+                let done = run_in_place(mesh, cells, closed, round, (longest, progress));
+                report.add(&done);
+            }
+        }
+    }
+    report
+}
+
+/// `cells` remeshed one after another in the mesh itself, with a grid of the mesh built for
+/// them.
+fn run_in_place(
+    mesh: &mut Mesh,
+    cells: Vec<Cell>,
+    closed: &mut ClosedParts,
+    round: &Round<'_>,
+    (longest, progress): (&mut f32, &mut dyn FnMut(usize)),
+) -> RemeshReport {
+    let mut grid = SpatialHash::build(mesh, round.grid_cell).expect("a cell checked at the start");
+    let (mut sets, mut zones) = (RemeshSets::default(), ZoneFinder::default());
+    let mut report = RemeshReport::default();
+    let settings = round.settings;
+    for (_, core, seeds) in cells {
+        let zone = match round.culling {
+            Culling::On => zones.find(mesh, &grid, &core, (settings.target_edge, *longest)),
+            Culling::Off => None,
+        };
+        let pass = Pass {
+            start: round.start,
+            sets: &mut sets,
+            closed: Some(&mut *closed),
+            zone: Zoning::Cell(zone),
+        };
+        let (done, _) = remesh(mesh, &mut grid, &seeds, settings, pass);
+        *longest = longest.max(done.longest_edge);
+        report.add(&done);
+        progress(1);
+    }
     report
 }
 
@@ -143,7 +218,7 @@ fn live_vertices(mesh: &Mesh) -> Vec<u32> {
 /// The live vertices grouped by the cube `width` wide they lie in, the cubes shifted by
 /// `shift` of a width, each with its box; in the cubes' order (x, then y, then z), each
 /// cube's vertices ascending, so the order never depends on anything but the mesh.
-fn cells(mesh: &Mesh, width: f32, shift: f32) -> Vec<(Aabb, Vec<u32>)> {
+fn cells(mesh: &Mesh, width: f32, shift: f32) -> Vec<Cell> {
     let cell_of = |p: Vec3| (p / width + shift).floor().as_ivec3();
     let mut keyed: Vec<((i32, i32, i32), u32)> = live_vertices(mesh)
         .into_iter()
@@ -162,7 +237,8 @@ fn cells(mesh: &Mesh, width: f32, shift: f32) -> Vec<(Aabb, Vec<u32>)> {
                 min: lo,
                 max: lo + Vec3::splat(width),
             };
-            (core, cell.iter().map(|&(_, v)| v).collect())
+            let key = IVec3::new(x, y, z);
+            (key, core, cell.iter().map(|&(_, v)| v).collect())
         })
         .collect()
 }

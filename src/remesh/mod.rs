@@ -23,6 +23,7 @@ mod reference;
 mod refine;
 mod safety;
 mod shape;
+mod slabs;
 mod zone;
 
 use std::time::Instant;
@@ -109,6 +110,9 @@ pub struct RemeshReport {
     pub shape_refused: usize,
     /// Edits whose safety checks a sheet zone settled (whole-mesh remeshing, `zone`).
     pub culled: usize,
+    /// Slabs of a whole-mesh remesh copied out and remeshed beside each other, on every core
+    /// (`slabs`); 0 where the mesh was too small to cut into them.
+    pub slabs: usize,
     /// Passes that stopped splitting at [`RemeshSettings::max_splits`], leaving long edges.
     pub growth_capped: usize,
     /// Longest edge among the faces around the region afterwards (the pipeline's running
@@ -129,6 +133,7 @@ impl RemeshReport {
         self.refused += other.refused;
         self.shape_refused += other.shape_refused;
         self.culled += other.culled;
+        self.slabs += other.slabs;
         self.growth_capped += other.growth_capped;
         self.longest_edge = self.longest_edge.max(other.longest_edge);
         self.millis += other.millis;
@@ -333,7 +338,6 @@ pub fn remesh_all_with(
     for _ in 0..levels {
         *mesh = subdivide(mesh)?;
     }
-    let subdivided_ms = started.elapsed().as_secs_f64() * 1e3;
     // A subdivided mesh is as even as its input: only where an edge left the band is there
     // work, as after a stroke (most of a million vertices need nothing).
     let start = if levels > 0 {
@@ -343,9 +347,10 @@ pub fn remesh_all_with(
     };
     let report = cells::remesh_whole(mesh, settings, (start, culling), progress)?;
     mesh.compact();
+    // The cells' passes' times add up across threads: the remesh took what the clock says.
     Ok(RemeshReport {
         subdivisions: levels,
-        millis: report.millis + subdivided_ms,
+        millis: started.elapsed().as_secs_f64() * 1e3,
         ..report
     })
 }
@@ -390,17 +395,7 @@ impl<'a> Remesher<'a> {
         closed: Option<ClosedParts>,
     ) -> Self {
         let live = |v: u32| (v as usize) < mesh.vertex_count() && !mesh.is_vertex_dead(v);
-        let (short, long) = (
-            COLLAPSE_BELOW * settings.target_edge,
-            SPLIT_ABOVE * settings.target_edge,
-        );
-        let out_of_band = |v: u32| {
-            let p = mesh.positions()[v as usize];
-            mesh.neighbours(v).into_iter().any(|u| {
-                let length = p.distance(mesh.positions()[u as usize]);
-                !(short..=long).contains(&length)
-            })
-        };
+        let out_of_band = |v: u32| out_of_band(mesh, v, settings.target_edge);
         // The region grows from the vertices that need work, not from everything the stroke
         // touched: most of a stroke's footprint keeps its edges in band.
         let in_region = &mut sets.in_region;
@@ -579,6 +574,16 @@ impl<'a> Remesher<'a> {
             self.region.push(v);
         }
     }
+}
+
+/// Whether an edge at `v` lies outside the band around `target_edge` that remeshing keeps
+/// edges in: where a pass that starts out of band starts.
+fn out_of_band(mesh: &Mesh, v: u32, target_edge: f32) -> bool {
+    let band = COLLAPSE_BELOW * target_edge..=SPLIT_ABOVE * target_edge;
+    let p = mesh.positions()[v as usize];
+    mesh.neighbours(v)
+        .into_iter()
+        .any(|u| !band.contains(&p.distance(mesh.positions()[u as usize])))
 }
 
 /// A face near an edit, as it is now.

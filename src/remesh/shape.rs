@@ -40,10 +40,16 @@ pub(super) struct ClosedParts {
     parts: Vec<Part>,
 }
 
+#[derive(Clone, Copy)]
 struct Part {
     faces: usize,
-    volume: f64,
     change: f64,
+    /// How far `change` may go either way: [`VOLUME_TOLERANCE`] of the volume, or a share's
+    /// part of what its pass had left ([`ClosedParts::share`]).
+    limit: f64,
+    /// The fewest faces the part may be left with, and the count it started from here.
+    least_faces: usize,
+    start_faces: usize,
 }
 
 impl ClosedParts {
@@ -62,13 +68,16 @@ impl ClosedParts {
             let found = component_faces(mesh, start, &mut seen, &mut budget);
             if let Some((vertices, faces)) = found {
                 let id = parts.parts.len() as u32;
+                let volume = signed_volume(
+                    faces.iter().map(|&f| mesh.face_positions(f as usize)),
+                    mesh.positions()[start as usize],
+                );
                 parts.parts.push(Part {
-                    volume: signed_volume(
-                        faces.iter().map(|&f| mesh.face_positions(f as usize)),
-                        mesh.positions()[start as usize],
-                    ),
                     faces: faces.len(),
                     change: 0.0,
+                    limit: VOLUME_TOLERANCE * volume.abs(),
+                    least_faces: MIN_CLOSED_FACES,
+                    start_faces: faces.len(),
                 });
                 parts
                     .of_vertex
@@ -85,8 +94,7 @@ impl ClosedParts {
             return true;
         };
         let part = &self.parts[id as usize];
-        part.faces >= MIN_CLOSED_FACES + faces_removed
-            && (part.change + delta).abs() <= VOLUME_TOLERANCE * part.volume.abs()
+        part.faces >= part.least_faces + faces_removed && (part.change + delta).abs() <= part.limit
     }
 
     /// Books an edit [`allows`](Self::allows) let through.
@@ -95,6 +103,48 @@ impl ClosedParts {
             let part = &mut self.parts[id as usize];
             part.change += delta;
             part.faces = part.faces.saturating_add_signed(faces_added);
+        }
+    }
+
+    /// The bounds left to this pass split `ways` ways, for one of that many copies of parts of
+    /// the mesh remeshed at once (`slabs`), its vertices renumbered: the copy's vertex `i` is
+    /// the mesh's `sources[i]`. Each share may change a part's volume by its `ways`-th of what
+    /// the pass may still change, and remove its `ways`-th of the faces above the least, so
+    /// all the shares together keep the pass within the bounds.
+    pub(super) fn share(&self, sources: &[u32], ways: usize) -> ClosedParts {
+        let of_vertex = sources
+            .iter()
+            .enumerate()
+            .filter_map(|(i, v)| self.of_vertex.get(v).map(|&id| (i as u32, id)))
+            .collect();
+        let parts = self
+            .parts
+            .iter()
+            .map(|part| Part {
+                change: 0.0,
+                limit: (part.limit - part.change.abs()).max(0.0) / ways as f64,
+                least_faces: part.faces - part.faces.saturating_sub(part.least_faces) / ways,
+                start_faces: part.faces,
+                ..*part
+            })
+            .collect();
+        ClosedParts { of_vertex, parts }
+    }
+
+    /// Books what a [`share`](Self::share) changed, its vertices renumbered back: the copy's
+    /// vertex `i` is now the mesh's `vertex_map[i]` (`INVALID`: removed).
+    pub(super) fn absorb(&mut self, share: &ClosedParts, vertex_map: &[u32]) {
+        for (whole, part) in self.parts.iter_mut().zip(&share.parts) {
+            whole.change += part.change;
+            whole.faces = (whole.faces + part.faces).saturating_sub(part.start_faces);
+        }
+        for (&i, &id) in &share.of_vertex {
+            match vertex_map.get(i as usize) {
+                Some(&v) if v != crate::mesh::INVALID => {
+                    self.of_vertex.insert(v, id);
+                }
+                _ => {}
+            }
         }
     }
 

@@ -48,7 +48,7 @@ const INNER_EDGES: f32 = 3.0;
 /// How far (× L) past the cell the zone's faces are gathered: beyond the inner box by more
 /// than an edge, so that the sheet's boundary loop (edges of faces outside the gathered box)
 /// is out of every vouched edit's reach.
-const MARGIN_EDGES: f32 = 6.0;
+pub(super) const MARGIN_EDGES: f32 = 6.0;
 /// The least cosine between a zone face's unit normal and the axis: far enough from 0 that
 /// `f32` rounding cannot turn a face over.
 const MIN_COS: f32 = 0.25;

@@ -1,0 +1,301 @@
+//! Whole-mesh remeshing on every core (issue 28): a round's cells (`cells`) grouped into
+//! *slabs*, runs of whole cells along the mesh's longest axis, and the slabs taken in two
+//! *waves*, the even ones and then the odd ones. Within a wave, each slab's faces and all
+//! around them within [`reach`] are copied out ([`Mesh::copy_patch`]), the slab's cells are
+//! remeshed in the copy as they would be in the mesh, and the copies are put back in slab
+//! order ([`Mesh::put_back`]).
+//!
+//! Why that is the same as remeshing the slab in place: everything a cell's pass reads (its
+//! zone, its reference surface, the faces its safety checks test) lies within `reach` of
+//! what it writes, and what it writes within `reach` of the cell, so a copy that holds
+//! everything within twice that of the slab holds all it would read. Two slabs of a wave are
+//! a whole slab apart, wider than both their copies' margins: neither reads what the other
+//! writes, and their copies share no face. The closed components' volume bounds are split
+//! between a wave's slabs (`ClosedParts::share`), so together they keep to them.
+//!
+//! Which cells make a slab, the waves and the order copies are put back in follow from the
+//! mesh alone; the thread count only decides how many slabs are worked at once, so the result
+//! is the same, bit for bit, on one thread or many.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
+
+use glam::{IVec3, Vec3};
+
+use super::shape::ClosedParts;
+use super::zone::{MARGIN_EDGES, ZoneFinder};
+use super::{Culling, Pass, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, remesh};
+use crate::geom::Aabb;
+use crate::grid::SpatialHash;
+use crate::mesh::{Mesh, Patch};
+use rustc_hash::FxHashSet;
+
+/// A cell of a round: its integer position, its box, its vertices.
+pub(super) type Cell = (IVec3, Aabb, Vec<u32>);
+
+/// Fewer slabs than this and a round runs in place: a wave of one slab is one thread's work
+/// with a copy's cost on top.
+const MIN_SLABS: usize = 4;
+
+/// What every cell's pass in a round shares.
+pub(super) struct Round<'a> {
+    pub settings: &'a RemeshSettings,
+    pub start: Start,
+    pub culling: Culling,
+    /// The vertex grid's cell, for the copies' grids.
+    pub grid_cell: f32,
+}
+
+/// A round's slabs: the cells of each, in the round's order, and what each copy must hold.
+pub(super) struct Plan {
+    axis: usize,
+    /// The round's cells: `width` wide, shifted by `shift` of a width.
+    lattice: (f32, f32),
+    slabs: Vec<Slab>,
+}
+
+struct Slab {
+    cells: Vec<Cell>,
+    /// The span along the axis a copy may hold: the cells' and the margin each side.
+    span: (f32, f32),
+    /// The cells within the margin of one of `cells`: a copy holds their vertices.
+    near: FxHashSet<IVec3>,
+}
+
+/// How far (world units) a cell's pass may reach past the cell, reading and writing together:
+/// it writes the faces around its region (the cell's vertices and `rings` rings, each edge at
+/// most `longest` long), and reads the zone's margin around the cell, the faces within the
+/// collision distance and three edges of what it writes (the reference surface and the safety
+/// checks), and the faces around the vertices there.
+pub(super) fn reach(settings: &RemeshSettings, rings: u32, longest: f32) -> f32 {
+    let l = settings.target_edge;
+    let writes = (rings as f32 + 2.0) * longest + l;
+    let reads = (MARGIN_EDGES * l).max(settings.collision_distance + 3.0 * l) + 2.0 * longest + l;
+    writes + reads
+}
+
+impl Plan {
+    /// Groups `cells` (in the round's order, on a lattice `width` wide shifted by `shift`)
+    /// into slabs along the axis they span most, each wide enough that a wave's copies stay
+    /// apart; `Err` (the cells back) where that leaves fewer than [`MIN_SLABS`].
+    pub(super) fn of(
+        cells: Vec<Cell>,
+        (width, shift): (f32, f32),
+        reach: f32,
+        longest: f32,
+    ) -> Result<Plan, Vec<Cell>> {
+        let Some(axis) = widest_axis(&cells) else {
+            return Err(cells);
+        };
+        // A slab two copies' margins wide, and two edges each side for the faces around their
+        // rims, keeps a wave's copies apart.
+        let margin = reach + longest;
+        let per_slab = ((2.0 * margin + 4.0 * longest) / width).ceil().max(1.0) as i32;
+        let slab_of = |cell: &Cell| cell.0[axis].div_euclid(per_slab);
+        let mut ids: Vec<i32> = cells.iter().map(slab_of).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        if ids.len() < MIN_SLABS {
+            return Err(cells);
+        }
+        let mut slabs: Vec<Slab> = ids
+            .iter()
+            .map(|_| Slab {
+                cells: Vec::new(),
+                span: (f32::INFINITY, f32::NEG_INFINITY),
+                near: FxHashSet::default(),
+            })
+            .collect();
+        let rings = (margin / width).ceil() as i32;
+        for cell in cells {
+            let slab = &mut slabs[ids.binary_search(&slab_of(&cell)).expect("listed")];
+            slab.span = (
+                slab.span.0.min(cell.1.min[axis] - margin),
+                slab.span.1.max(cell.1.max[axis] + margin),
+            );
+            for dz in -rings..=rings {
+                for dy in -rings..=rings {
+                    for dx in -rings..=rings {
+                        slab.near.insert(cell.0 + IVec3::new(dx, dy, dz));
+                    }
+                }
+            }
+            slab.cells.push(cell);
+        }
+        Ok(Plan {
+            axis,
+            lattice: (width, shift),
+            slabs,
+        })
+    }
+
+    /// The vertices a copy of slab `slab` must hold: those within the margin of its cells.
+    fn copied_vertices(&self, mesh: &Mesh, slab: usize) -> Vec<u32> {
+        let Slab { span, near, .. } = &self.slabs[slab];
+        let (width, shift) = self.lattice;
+        (0..mesh.vertex_count() as u32)
+            .filter(|&v| {
+                let p: Vec3 = mesh.positions()[v as usize];
+                (span.0..=span.1).contains(&p[self.axis])
+                    && mesh.is_vertex_live(v)
+                    && near.contains(&(p / width + shift).floor().as_ivec3())
+            })
+            .collect()
+    }
+
+    /// The two waves' slabs (by index): even, then odd.
+    pub(super) fn waves(&self) -> [Vec<usize>; 2] {
+        let all = 0..self.slabs.len();
+        [
+            all.clone().step_by(2).collect(),
+            all.skip(1).step_by(2).collect(),
+        ]
+    }
+
+    /// How many vertices the cells of slab `slab` hold: the measure of its work.
+    fn vertex_count(&self, slab: usize) -> usize {
+        self.slabs[slab].cells.iter().map(|cell| cell.2.len()).sum()
+    }
+
+    /// The cells of slab `slab`.
+    pub(super) fn cells_of(&self, slab: usize) -> &[Cell] {
+        &self.slabs[slab].cells
+    }
+}
+
+/// The axis (0 x, 1 y, 2 z) along which the cells' positions spread most.
+fn widest_axis(cells: &[Cell]) -> Option<usize> {
+    let first = cells.first()?.0;
+    let (lo, hi) = cells
+        .iter()
+        .fold((first, first), |(lo, hi), c| (lo.min(c.0), hi.max(c.0)));
+    let spread = hi - lo;
+    Some(
+        (0..3)
+            .max_by_key(|&a| (spread[a], -(a as i32)))
+            .expect("three axes"),
+    )
+}
+
+/// What a slab's copy came back with.
+struct Done {
+    patch: Patch,
+    report: RemeshReport,
+    closed: ClosedParts,
+}
+
+/// Remeshes the slabs `wave` of `plan` at once, on as many threads as rayon's pool the caller
+/// runs in has, and puts them back. `progress` hears of every cell done, on the caller's
+/// thread. `Err` (the mesh as it was) where a copy could not be made or put back; the caller
+/// then runs the wave's cells in place.
+pub(super) fn run_wave(
+    mesh: &mut Mesh,
+    (plan, wave): (&Plan, &[usize]),
+    closed: &mut ClosedParts,
+    round: &Round<'_>,
+    longest: &mut f32,
+    progress: &mut dyn FnMut(usize),
+) -> Result<RemeshReport, ()> {
+    let threads = rayon::current_num_threads().clamp(1, wave.len());
+    // The largest slabs first, so no thread is left with a large one at the end.
+    let mut order: Vec<usize> = (0..wave.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(plan.vertex_count(wave[i])));
+    let next = AtomicUsize::new(0);
+    let (tell, told) = mpsc::channel::<()>();
+    let shared: &Mesh = mesh;
+    let closed_now: &ClosedParts = closed;
+    let longest_now = *longest;
+    let results: Vec<(usize, Option<Done>)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                let (next, order, tell) = (&next, &order, tell.clone());
+                scope.spawn(move || {
+                    let mut done = Vec::new();
+                    loop {
+                        let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
+                            return done;
+                        };
+                        let slab = wave[i];
+                        let ways = wave.len();
+                        let work = (shared, closed_now, ways, longest_now);
+                        done.push((i, run_slab(work, (plan, slab), round, &tell)));
+                    }
+                })
+            })
+            .collect();
+        drop(tell);
+        for () in told {
+            progress(1);
+        }
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("a slab's worker panicked"))
+            .collect()
+    });
+    let mut done: Vec<Option<Done>> = (0..wave.len()).map(|_| None).collect();
+    for (i, result) in results {
+        done[i] = result;
+    }
+    let done: Vec<Done> = done.into_iter().collect::<Option<_>>().ok_or(())?;
+    let patches: Vec<Patch> = done.iter().map(|d| d.patch.clone()).collect();
+    let maps = mesh.put_back(&patches).map_err(|_| ())?;
+    let mut report = RemeshReport {
+        slabs: wave.len(),
+        ..RemeshReport::default()
+    };
+    for (d, map) in done.iter().zip(&maps) {
+        closed.absorb(&d.closed, map);
+        *longest = longest.max(d.report.longest_edge);
+        report.add(&d.report);
+    }
+    Ok(report)
+}
+
+/// One slab's cells remeshed in a copy of the mesh around it; `None` where no copy could be
+/// made. `tell` hears of each cell done.
+fn run_slab(
+    (mesh, closed, ways, longest): (&Mesh, &ClosedParts, usize, f32),
+    (plan, slab): (&Plan, usize),
+    round: &Round<'_>,
+    tell: &mpsc::Sender<()>,
+) -> Option<Done> {
+    let inside = plan.copied_vertices(mesh, slab);
+    let mut patch = mesh.copy_patch(&inside).ok()?;
+    let local: rustc_hash::FxHashMap<u32, u32> = patch
+        .sources
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v, i as u32))
+        .collect();
+    let mut closed = closed.share(&patch.sources, ways);
+    let copy = &mut patch.mesh;
+    let mut grid = SpatialHash::build(copy, round.grid_cell).ok()?;
+    let (mut sets, mut zones) = (RemeshSets::default(), ZoneFinder::default());
+    let mut report = RemeshReport::default();
+    let mut longest = longest;
+    let settings = round.settings;
+    for (_, core, seeds) in plan.cells_of(slab) {
+        let seeds: Vec<u32> = seeds.iter().filter_map(|v| local.get(v).copied()).collect();
+        let zone = match round.culling {
+            Culling::On => zones.find(copy, &grid, core, (settings.target_edge, longest)),
+            Culling::Off => None,
+        };
+        let pass = Pass {
+            start: round.start,
+            sets: &mut sets,
+            closed: Some(&mut closed),
+            zone: Zoning::Cell(zone),
+        };
+        let (done, _) = remesh(copy, &mut grid, &seeds, settings, pass);
+        longest = longest.max(done.longest_edge);
+        report.add(&done);
+        // The caller may have stopped listening only by panicking.
+        let _ = tell.send(());
+    }
+    report.longest_edge = longest;
+    Some(Done {
+        patch,
+        report,
+        closed,
+    })
+}
