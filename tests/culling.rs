@@ -45,6 +45,8 @@ struct Run {
     culled_steps: usize,
     culled_vertices: usize,
     steps: usize,
+    /// Remeshing edits a sheet zone vouched for.
+    remesh_culled: usize,
 }
 
 fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run {
@@ -61,6 +63,7 @@ fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run
         culled_steps: 0,
         culled_vertices: 0,
         steps: 0,
+        remesh_culled: 0,
     };
     for stroke in strokes {
         let report = pipeline.apply_stroke(&mut mesh, stroke).unwrap();
@@ -69,6 +72,7 @@ fn run(mesh: &Mesh, strokes: &[Stroke], remeshing: Remeshing, cull: bool) -> Run
         outcome.culled_steps += report.culled_steps;
         outcome.culled_vertices += report.culled_vertices;
         outcome.steps += report.steps;
+        outcome.remesh_culled += report.remesh.culled;
     }
     mesh.validate().unwrap();
     outcome.digest = mesh.digest();
@@ -85,8 +89,12 @@ fn assert_culling_changes_nothing(
     let culled = run(mesh, strokes, remeshing, true);
     let searched = run(mesh, strokes, remeshing, false);
     assert_eq!(
-        (searched.culled_steps, searched.culled_vertices),
-        (0, 0),
+        (
+            searched.culled_steps,
+            searched.culled_vertices,
+            searched.remesh_culled
+        ),
+        (0, 0, 0),
         "{name}: culling off still culled"
     );
     assert_eq!(
@@ -95,8 +103,14 @@ fn assert_culling_changes_nothing(
         "{name}: culling changed the result"
     );
     eprintln!(
-        "{name}: {} steps, {} culled, {} vertex searches culled, {} clamped, {} undone",
-        culled.steps, culled.culled_steps, culled.culled_vertices, culled.clamped, culled.reverted
+        "{name}: {} steps, {} culled, {} vertex searches culled, {} clamped, {} undone, \
+         {} remeshing edits vouched for",
+        culled.steps,
+        culled.culled_steps,
+        culled.culled_vertices,
+        culled.clamped,
+        culled.reverted,
+        culled.remesh_culled
     );
     culled
 }
@@ -144,14 +158,22 @@ fn reshaped(mut mesh: Mesh, shape: impl Fn(f32, f32) -> Vec3) -> Mesh {
 
 #[test]
 fn a_plain_draw_on_a_flat_sheet_is_culled() {
-    let mesh = scene(SceneKind::Plane, 6_000);
-    let strokes = script(&mesh, BrushMix::StraightDraw, 4);
+    // Wide enough that a stroke's region lies farther than a sheet zone's margin from the rim.
+    let mesh = scene(SceneKind::Plane, 40_000);
+    let mut strokes = script(&mesh, BrushMix::StraightDraw, 4);
+    // And three full-strength draws along the middle, which stretch edges out of the band.
+    let (lo, hi) = mesh.bounds().unwrap();
+    let at = |u: f32| lo.lerp(hi, u).with_y(0.5 * (lo.y + hi.y));
+    let middle = || (0..24).map(|i| at(0.3 + 0.4 * i as f32 / 23.0));
+    strokes.extend((0..3).map(|_| draw((0.1 * (hi.x - lo.x), 1.0), middle(), None)));
     let run = assert_culling_changes_nothing("flat sheet", &mesh, &strokes, Remeshing::AfterStroke);
     // Only the steps whose region reaches the sheet's rim are searched.
     assert!(
         run.culled_steps * 2 > run.steps,
         "a flat sheet is a sheet: {run:?}"
     );
+    // And the remesh after the middle's draws is a sheet zone's, which vouches for its edits.
+    assert!(run.remesh_culled > 0, "{run:?}");
 }
 
 #[test]
@@ -274,6 +296,18 @@ fn crumpled_pinched_twisted_and_creased_sheets_end_the_same() {
         );
         assert_culling_changes_nothing(name, &mesh, &strokes, Remeshing::Off);
     }
+}
+
+/// Remeshed after each stroke, a sheet's zones vouch for the remesher's edits, yet keep each
+/// moved vertex from the sheet's own faces beyond its exclusion ring as the full checks do,
+/// where pinches and creases press the sheet together: the same mesh.
+#[test]
+fn remeshing_after_torture_on_a_wide_sheet_ends_the_same() {
+    let mesh = scene(SceneKind::Plane, 30_000);
+    let strokes = script(&mesh, BrushMix::Torture, 12);
+    let name = "torture on a wide sheet, remeshed";
+    let run = assert_culling_changes_nothing(name, &mesh, &strokes, Remeshing::AfterStroke);
+    assert!(run.remesh_culled > 0, "{run:?}");
 }
 
 #[test]

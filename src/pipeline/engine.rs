@@ -17,7 +17,9 @@ use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, MeshVersion, next, prev};
-use crate::remesh::{RemeshReport, RemeshSets, RemeshSettings, remesh_region_with};
+use crate::remesh::{
+    RemeshReport, RemeshSets, RemeshSettings, remesh_region_culled, remesh_region_with,
+};
 use crate::topology::{FuseSettings, TopologyReport, adapt};
 
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
@@ -329,13 +331,14 @@ impl Pipeline {
 }
 
 /// Remeshes around `seeds` with the pipeline's `L`, collision distance and exclusion ring (and
-/// at most `max_splits` splits: what is left of the stroke's bound on new faces),
+/// at most `max_splits` splits: what is left of the stroke's bound on new faces), letting a
+/// sheet zone settle its edits' checks where `culling` gives the mesh's longest edge,
 /// keeping `grid` exact, and tells `kernels` what changed; returns what it did and the
 /// vertices it changed (ascending).
 pub(super) fn remesh_touched(
     mesh: &mut Mesh,
     (grid, kernels, sets): (&mut SpatialHash, &mut dyn StepKernels, &mut RemeshSets),
-    seeds: &[u32],
+    (seeds, culling): (&[u32], Option<f32>),
     (edge, distance, ring, max_splits): (f32, f32, u32, usize),
 ) -> (RemeshReport, Vec<u32>) {
     let settings = RemeshSettings {
@@ -345,7 +348,10 @@ pub(super) fn remesh_touched(
         ..RemeshSettings::new(edge)
     };
     let since = mesh.version();
-    let (report, changed) = remesh_region_with(mesh, grid, seeds, &settings, sets);
+    let (report, changed) = match culling {
+        Some(longest) => remesh_region_culled(mesh, grid, seeds, (&settings, longest), sets),
+        None => remesh_region_with(mesh, grid, seeds, &settings, sets),
+    };
     kernels.remeshed(mesh, since, &changed);
     (report, changed)
 }

@@ -57,6 +57,10 @@ const MIN_NORMAL_COSINE: f32 = 0.5;
 const FLIP_FLATNESS_COSINE: f32 = 0.94;
 /// Relaxation moves shorter than this share of L are not worth their collision checks.
 const RELAX_MIN_MOVE: f32 = 0.05;
+/// How many faces a stroke's region may gather, per region vertex and at least, to find its
+/// sheet zone: each of its edits' checks costs about what gathering a hundred faces does.
+const ZONE_FACES_PER_REGION_VERTEX: usize = 32;
+const ZONE_FACES_MIN: usize = 16_384;
 /// Faces thinner than this share of L² are not created.
 const MIN_AREA_SHARE: f32 = 0.01;
 
@@ -171,6 +175,26 @@ pub fn remesh_region_with(
     remesh(mesh, grid, seeds, settings, pass)
 }
 
+/// [`remesh_region_with`], letting a sheet zone settle the safety checks of its edits where
+/// the region and everything within the zone's margin of it is one sheet of one layer
+/// (`zone`): a stroke on a single sheet need not pay for the checks a stack of layers needs.
+/// `longest_edge` bounds every edge of the mesh.
+pub fn remesh_region_culled(
+    mesh: &mut Mesh,
+    grid: &mut SpatialHash,
+    seeds: &[u32],
+    (settings, longest_edge): (&RemeshSettings, f32),
+    sets: &mut RemeshSets,
+) -> (RemeshReport, Vec<u32>) {
+    let pass = Pass {
+        start: Start::OutOfBand,
+        sets,
+        closed: None,
+        zone: Zoning::Region(longest_edge),
+    };
+    remesh(mesh, grid, seeds, settings, pass)
+}
+
 /// Remeshes `piece`, a mesh a layer tool made to add to another (which checks it exactly
 /// against that mesh afterwards), where its edges are out of band. Where the piece is one sheet
 /// (`zone`'s lone sheet) the zone vouches for the edits that keep it one: the piece has nothing
@@ -199,6 +223,8 @@ pub struct RemeshSets {
     in_region: Stamps,
     dirty: Stamps,
     movable: Stamps,
+    /// The sets a region's sheet zone is found with ([`remesh_region_culled`]).
+    zones: zone::ZoneFinder,
 }
 
 impl RemeshSets {
@@ -239,6 +265,9 @@ enum Zoning {
     /// The zone of a whole-mesh remesh's cell, found before the pass: once an edit it cannot
     /// vouch for has passed its checks, the rest of the cell's pass is checked.
     Cell(Option<Zone>),
+    /// The region's, found once its region is known (a stroke's remesh): the region's box
+    /// is the cell. The longest edge of the mesh comes with it.
+    Region(f32),
     /// The whole mesh, when it is a lone sheet (`zone`): found again before each stage of
     /// the pass (splits, collapses, flips, relaxation) where an edit it could not vouch for
     /// ended it. A piece's rim edits come early in a stage, and its interior is most of it.
@@ -258,9 +287,11 @@ fn remesh(
     remesher.zone = match pass.zone {
         Zoning::Off => None,
         Zoning::Cell(zone) => zone,
+        Zoning::Region(longest) => remesher.region_zone(longest),
         Zoning::LoneSheet => Zone::of_lone_sheet(remesher.mesh, settings.target_edge),
     };
     remesher.lone_sheet = matches!(pass.zone, Zoning::LoneSheet) && remesher.zone.is_some();
+    remesher.zone_keeps_own_gap = matches!(pass.zone, Zoning::Region(_));
     for round in 0..settings.iterations {
         let edits = remesher.edit_count();
         remesher.renew_zone();
@@ -383,6 +414,11 @@ struct Remesher<'a> {
     /// The whole mesh was a lone sheet when the pass began: its zone is found again before
     /// each stage ([`Zoning::LoneSheet`]). A mesh that was not one is not searched again.
     lone_sheet: bool,
+    /// A move the zone vouches for is still kept from its own layer beyond its exclusion
+    /// ring (`safety`), so that the pass is the one every check would make: a stroke's
+    /// remesh, which `PipelineSettings::cull` must not change. A whole-mesh remesh lets the
+    /// zone settle that too (a sheet's second ring within `d` of a vertex is no crossing).
+    zone_keeps_own_gap: bool,
 }
 
 impl<'a> Remesher<'a> {
@@ -447,11 +483,26 @@ impl<'a> Remesher<'a> {
             whole: start != Start::OutOfBand,
             zone: None,
             lone_sheet: false,
+            zone_keeps_own_gap: false,
         };
         for v in starting {
             remesher.mark_dirty(v);
         }
         remesher
+    }
+
+    /// The sheet zone around the region's box, if gathering it costs no more than a few
+    /// times the region's own faces.
+    fn region_zone(&mut self, longest_edge: f32) -> Option<Zone> {
+        let positions = self.mesh.positions();
+        let live = self.region.iter().filter(|&&v| self.mesh.is_vertex_live(v));
+        let core = live.fold(Aabb::EMPTY, |b, &v| b.including(positions[v as usize]));
+        if core.is_empty() {
+            return None;
+        }
+        let budget = ZONE_FACES_PER_REGION_VERTEX * self.region.len() + ZONE_FACES_MIN;
+        let lengths = (self.settings.target_edge, longest_edge);
+        (self.sets.zones).find_within(self.mesh, self.grid, &core, lengths, budget)
     }
 
     /// Finds a lone sheet's zone again where an edit it could not vouch for ended it.

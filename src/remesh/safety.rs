@@ -47,9 +47,70 @@ impl Remesher<'_> {
         let keeps_rim = self.zone.is_some()
             && merged.is_none_or(|m| !rim(m))
             && (!rim(v) || positions[v as usize] == target);
-        self.unless_vouched(&moved, keeps_rim, |remesher| {
-            remesher.move_checks(v, (target, merged), &carrying, &moved)
-        })
+        if keeps_rim && self.zone_vouches(&moved) {
+            if !self.zone_keeps_own_gap {
+                return true;
+            }
+            // The zone settles crossings and other layers, not how near the vertex comes to
+            // its own layer beyond its exclusion ring: a sheet pressed together brings its
+            // second ring within `d`, which the full checks refuse too.
+            let d = self.settings.collision_distance;
+            let from = self.mesh.positions()[v as usize];
+            let near = self.gather_near(&Aabb::of_points(&[from, target]).expanded(d));
+            let clear = self.keeps_off_own_layer(v, (from, target, merged), &near);
+            self.near = near;
+            return clear;
+        }
+        let clear = self.move_checks(v, (target, merged), &carrying, &moved);
+        if clear {
+            // Its faces may leave the zone no longer a sheet.
+            self.zone = None;
+        }
+        clear
+    }
+
+    /// Whether the sheet zone vouches for an edit that makes `triangles` (`zone`), counted.
+    fn zone_vouches(&mut self, triangles: &[([u32; 3], [Vec3; 3])]) -> bool {
+        let vouched =
+            (self.zone.as_ref()).is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t)));
+        self.report.culled += usize::from(vouched);
+        vouched
+    }
+
+    /// No face of `v`'s layer outside its exclusion ring (nor `merged`'s, when a collapse takes
+    /// it along) is within the collision distance of `target`, unless it already was as near
+    /// to `from`. `near` holds every face within that distance of `target`.
+    fn keeps_off_own_layer(
+        &mut self,
+        v: u32,
+        (from, target, merged): (Vec3, Vec3, Option<u32>),
+        near: &[NearFace],
+    ) -> bool {
+        let d = self.settings.collision_distance;
+        let mut ring = std::mem::take(&mut self.scratch);
+        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
+        if let Some(m) = merged {
+            let mut more = Vec::new();
+            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
+            ring.extend(more);
+            ring.sort_unstable();
+            ring.dedup();
+        }
+        let layer = self.mesh.vertex_layers()[v as usize];
+        let face_layers = self.mesh.face_layers();
+        let safe = near.iter().all(|candidate| {
+            // The neighbourhood skipped is the vertex's own, in its own layer; faces beyond
+            // the collision distance do not matter.
+            let own = face_layers[candidate.face as usize] == layer
+                && candidate.ids.iter().any(|&w| in_ring(&ring, w));
+            if own || !candidate.bounds.within(target, d) {
+                return true;
+            }
+            let now = point_triangle_distance(target, candidate.at);
+            !(now < d && now < point_triangle_distance(from, candidate.at))
+        });
+        self.scratch = ring;
+        safe
     }
 
     /// [`Self::move_is_safe`]'s checks in full, given the faces around the moving vertices
@@ -63,15 +124,6 @@ impl Remesher<'_> {
     ) -> bool {
         let d = self.settings.collision_distance;
         let from = self.mesh.positions()[v as usize];
-        let mut ring = std::mem::take(&mut self.scratch);
-        ring_vertices(self.mesh, v, self.settings.exclusion_ring, &mut ring);
-        if let Some(m) = merged {
-            let mut more = Vec::new();
-            ring_vertices(self.mesh, m, self.settings.exclusion_ring, &mut more);
-            ring.extend(more);
-            ring.sort_unstable();
-            ring.dedup();
-        }
         let layer = self.mesh.vertex_layers()[v as usize];
         let (positions, faces) = (self.mesh.positions(), self.mesh.faces());
         // The surface the edit replaces, as it is now (a face around both ends comes twice,
@@ -85,26 +137,7 @@ impl Remesher<'_> {
         let reach = Aabb::of_points(&[from, target]).expanded(d);
         let around = bounds_of(moved).including_box(&reach);
         let near = self.gather_near(&around);
-        let mut safe = true;
-        for candidate in &near {
-            let (face, tri) = (candidate.face, candidate.ids);
-            // The neighbourhood skipped is the vertex's own, in its own layer.
-            if self.mesh.face_layers()[face as usize] == layer
-                && tri.iter().any(|&w| in_ring(&ring, w))
-            {
-                continue;
-            }
-            // Faces beyond the collision distance do not matter.
-            if !candidate.bounds.within(target, d) {
-                continue;
-            }
-            let now = point_triangle_distance(target, candidate.at);
-            if now < d && now < point_triangle_distance(from, candidate.at) {
-                safe = false;
-                break;
-            }
-        }
-        self.scratch = ring;
+        let safe = self.keeps_off_own_layer(v, (from, target, merged), &near);
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
 
         let clear = safe
@@ -124,9 +157,7 @@ impl Remesher<'_> {
         keeps_rim: bool,
         check: impl FnOnce(&mut Self) -> bool,
     ) -> bool {
-        let zone = self.zone.as_ref();
-        if keeps_rim && zone.is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t))) {
-            self.report.culled += 1;
+        if keeps_rim && self.zone_vouches(triangles) {
             return true;
         }
         let clear = check(self);

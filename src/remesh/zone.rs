@@ -67,7 +67,7 @@ pub(super) struct Zone {
 
 /// Finds cells' zones, with the sets it marks faces in kept from cell to cell (sized to the
 /// mesh once, emptied in O(1)).
-#[derive(Default)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct ZoneFinder {
     seen: Stamps,
     members: Stamps,
@@ -83,7 +83,21 @@ impl ZoneFinder {
         mesh: &Mesh,
         grid: &SpatialHash,
         core: &Aabb,
+        lengths: (f32, f32),
+    ) -> Option<Zone> {
+        self.find_within(mesh, grid, core, lengths, usize::MAX)
+    }
+
+    /// [`find`](Self::find), giving up (`None`) once the faces around the box pass
+    /// `max_faces`: a stroke's region may span a box far larger than itself (a long diagonal
+    /// stroke), where gathering the box would cost more than checking the edits.
+    pub(super) fn find_within(
+        &mut self,
+        mesh: &Mesh,
+        grid: &SpatialHash,
+        core: &Aabb,
         (target_edge, longest_edge): (f32, f32),
+        max_faces: usize,
     ) -> Option<Zone> {
         let outer = core.expanded(MARGIN_EDGES * target_edge);
         let reach = outer.expanded(longest_edge);
@@ -91,17 +105,28 @@ impl ZoneFinder {
         seen.start(mesh.face_count());
         members.start(mesh.face_count());
         faces.clear();
+        // Given up on once too many, or on a face of a second layer (stacked layers lie
+        // within each other's margin everywhere: their regions have no zones).
+        let mut given_up = false;
+        let layers = mesh.face_layers();
         grid.for_each_in_box(reach.min, reach.max, |v| {
+            given_up |= faces.len() > max_faces;
+            if given_up {
+                return;
+            }
             for f in mesh.faces_around(v) {
                 let meets =
                     |f: u32| Aabb::of_points(&mesh.face_positions(f as usize)).overlaps(&outer);
                 if seen.insert(f as usize) && meets(f) {
+                    given_up |= faces
+                        .first()
+                        .is_some_and(|&g| layers[g as usize] != layers[f as usize]);
                     members.insert(f as usize);
                     faces.push(f);
                 }
             }
         });
-        if !one_layer(mesh, faces) {
+        if given_up || !one_layer(mesh, faces) {
             return None;
         }
         let boundary = boundary_loop(mesh, faces, |g| members.contains(g as usize))?;

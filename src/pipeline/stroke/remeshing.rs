@@ -28,10 +28,11 @@ impl Active {
             self.prepared.ring,
             self.splits_left,
         );
+        let culling = self.cull.then_some(self.prepared.max_edge);
         let (pass, changed) = remesh_touched(
             mesh,
             (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
-            moved,
+            (moved, culling),
             lengths,
         );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
@@ -105,10 +106,11 @@ impl Active {
             self.splits_left,
         );
         let seeds = &self.touched_list;
+        let culling = self.cull.then_some(self.prepared.max_edge);
         let (pass, changed) = remesh_touched(
             mesh,
             (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
-            seeds,
+            (seeds, culling),
             lengths,
         );
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
