@@ -294,6 +294,69 @@ fn a_whole_mesh_remesh_is_the_same_on_one_and_two_threads() {
     assert!(cv < 0.2, "edge cv {cv}");
 }
 
+/// A field of pebbles: small closed spheres of uneven size and jittered vertices, 240 of them
+/// in a row, many lying across slabs. Each slab is given a share of every component's volume
+/// budget: every pebble keeps its volume within the bound, the field stays valid and apart, and
+/// one thread and two give the same mesh.
+#[test]
+fn a_field_of_pebbles_remeshes_by_slabs_within_each_pebbles_volume_bound() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut positions, mut faces) = (Vec::new(), Vec::new());
+    for i in 0..240 {
+        let pebble = slayer::scene::geodesic_sphere(4, rng.random_range(0.025..0.045)).unwrap();
+        let centre = Vec3::new(
+            (i / 6) as f32 * 0.1,
+            (i % 3) as f32 * 0.1,
+            (i % 2) as f32 * 0.1,
+        );
+        let base = positions.len() as u32;
+        positions.extend(
+            pebble
+                .positions()
+                .iter()
+                .map(|&p| centre + p * rng.random_range(0.9..1.1)),
+        );
+        faces.extend(pebble.faces().iter().map(|t| t.map(|v| v + base)));
+    }
+    let layers = vec![0; faces.len()];
+    let field = Mesh::new(positions, faces, layers, vec!["pebbles".into()]).unwrap();
+    let settings = RemeshSettings::new(field.mean_edge_length());
+    let remeshed = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut mesh = field.clone();
+        let report = pool.install(|| remesh_all(&mut mesh, &settings)).unwrap();
+        (mesh, report)
+    };
+    let ((one, report), (two, _)) = (remeshed(1), remeshed(2));
+    eprintln!("{report:?}");
+    assert!(report.slabs >= 6, "{} slabs", report.slabs);
+    assert!(report.splits + report.collapses > 1_000, "{report:?}");
+    assert_eq!(one.positions(), two.positions());
+    assert_eq!(one.faces(), two.faces());
+    one.validate().unwrap();
+    assert_eq!(find_intersections(&one).total(), 0);
+    // Each pebble by where it lies (its centre on the 0.1 lattice).
+    let volumes = |mesh: &Mesh| {
+        let mut parts: Vec<_> = (mesh.closed_components().iter())
+            .map(|p| ((p.centroid / 0.1).round().as_ivec3().to_array(), p.volume))
+            .collect();
+        parts.sort_by_key(|(at, _)| *at);
+        parts
+    };
+    let (before, after) = (volumes(&field), volumes(&one));
+    assert_eq!(before.len(), 240);
+    assert_eq!(after.len(), 240);
+    for ((at, b), (at_after, a)) in before.iter().zip(&after) {
+        assert_eq!(at, at_after);
+        let change = (a - b).abs() / b.abs();
+        let bound = slayer::remesh::VOLUME_TOLERANCE + 1e-6;
+        assert!(change <= bound, "pebble at {at:?}: {b} -> {a}");
+    }
+}
+
 /// Torture strokes (every brush, full strength, pushes into the layers below) with remeshing
 /// after each: no crossing ever, a valid mesh, and the worked region mostly back in the edge
 /// band. Mostly: pinches and push-downs leave patches compressed against another layer or an
