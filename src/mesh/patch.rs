@@ -204,7 +204,7 @@ impl Mesh {
             .iter()
             .map(|&v| self.faces_around(v).any(|f| !in_patch(f)))
             .collect();
-        let vertex_map = self.put_back_vertices(patch);
+        let vertex_map = self.put_back_vertices(patch, &on_rim);
         // The copy's faces: its first ones take their slots back, the rest are appended.
         let mut face_map = patch.faces.clone();
         for f in patch.faces.len()..copy.face_count() {
@@ -249,14 +249,17 @@ impl Mesh {
         vertex_map
     }
 
-    /// The copy's vertex data into the mesh: copied vertices in place, new ones appended.
-    fn put_back_vertices(&mut self, patch: &Patch) -> Vec<u32> {
+    /// The copy's vertex data into the mesh: copied vertices in place, new ones appended. A
+    /// rim vertex keeps its normal: the copy holds only part of its faces.
+    fn put_back_vertices(&mut self, patch: &Patch, on_rim: &[bool]) -> Vec<u32> {
         let copy = &patch.mesh;
         let mut vertex_map = patch.sources.clone();
         for (i, &v) in patch.sources.iter().enumerate() {
             let v = v as usize;
             self.positions[v] = copy.positions[i];
-            self.normals[v] = copy.normals[i];
+            if !on_rim[i] {
+                self.normals[v] = copy.normals[i];
+            }
             self.brdfs[v] = copy.brdfs[i];
             self.flags[v] = copy.flags[i];
         }

@@ -185,7 +185,8 @@ fn run_in_place(
     round: &Round<'_>,
     (longest, progress): (&mut f32, &mut dyn FnMut(usize)),
 ) -> RemeshReport {
-    let mut grid = SpatialHash::build(mesh, round.grid_cell).expect("a cell checked at the start");
+    let mut grid = SpatialHash::build(mesh, round.grid_cell)
+        .expect("the cell size was checked before the rounds");
     let (mut sets, mut zones) = (RemeshSets::default(), ZoneFinder::default());
     let mut report = RemeshReport::default();
     let settings = round.settings;

@@ -57,7 +57,7 @@ impl Remesher<'_> {
             let d = self.settings.collision_distance;
             let from = self.mesh.positions()[v as usize];
             let near = self.gather_near(&Aabb::of_points(&[from, target]).expanded(d));
-            let clear = self.keeps_off_own_layer(v, (from, target, merged), &near);
+            let clear = self.keeps_collision_distance(v, (from, target, merged), &near);
             self.near = near;
             return clear;
         }
@@ -77,10 +77,11 @@ impl Remesher<'_> {
         vouched
     }
 
-    /// No face of `v`'s layer outside its exclusion ring (nor `merged`'s, when a collapse takes
-    /// it along) is within the collision distance of `target`, unless it already was as near
-    /// to `from`. `near` holds every face within that distance of `target`.
-    fn keeps_off_own_layer(
+    /// No face near `target` but those of `v`'s own neighbourhood (its exclusion ring in its
+    /// layer, and `merged`'s when a collapse takes it along) is within the collision distance
+    /// of it, unless it already was as near to `from`. `near` holds every face within that
+    /// distance of `target`.
+    fn keeps_collision_distance(
         &mut self,
         v: u32,
         (from, target, merged): (Vec3, Vec3, Option<u32>),
@@ -137,7 +138,7 @@ impl Remesher<'_> {
         let reach = Aabb::of_points(&[from, target]).expanded(d);
         let around = bounds_of(moved).including_box(&reach);
         let near = self.gather_near(&around);
-        let safe = self.keeps_off_own_layer(v, (from, target, merged), &near);
+        let safe = self.keeps_collision_distance(v, (from, target, merged), &near);
         let involved: Vec<u32> = [Some(v), merged].into_iter().flatten().collect();
 
         let clear = safe

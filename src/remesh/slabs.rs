@@ -1,17 +1,19 @@
 //! Whole-mesh remeshing on every core (issue 28): a round's cells (`cells`) grouped into
-//! *slabs*, runs of whole cells along the mesh's longest axis, and the slabs taken in two
-//! *waves*, the even ones and then the odd ones. Within a wave, each slab's faces and all
-//! around them within [`reach`] are copied out ([`Mesh::copy_patch`]), the slab's cells are
-//! remeshed in the copy as they would be in the mesh, and the copies are put back in slab
-//! order ([`Mesh::put_back`]).
+//! *slabs*, runs of whole cells along the axis the cells spread most along, and the slabs
+//! taken in two *waves*, the even ones and then the odd ones. Within a wave, each slab's
+//! faces and all around them within [`reach`] are copied out ([`Mesh::copy_patch`]), the
+//! slab's cells are remeshed in the copy as they would be in the mesh, and the copies are put
+//! back in slab order ([`Mesh::put_back`]).
 //!
-//! Why that is the same as remeshing the slab in place: everything a cell's pass reads (its
-//! zone, its reference surface, the faces its safety checks test) lies within `reach` of
-//! what it writes, and what it writes within `reach` of the cell, so a copy that holds
-//! everything within twice that of the slab holds all it would read. Two slabs of a wave are
-//! a whole slab apart, wider than both their copies' margins: neither reads what the other
-//! writes, and their copies share no face. The closed components' volume bounds are split
-//! between a wave's slabs (`ClosedParts::share`), so together they keep to them.
+//! Why that is the same as remeshing the slab in place: a cell's pass writes near the cell
+//! and reads (its zone, its reference surface, the faces its safety checks test) near what it
+//! writes, all within `reach` of the cell, so a copy of every face within `reach` (and an
+//! edge) of the slab's cells holds all the passes read. Two slabs of a wave are a whole slab
+//! apart, wider than both their copies' margins: neither reads what the other writes, and
+//! their copies share no face. A pass that wrote farther than `reach` would have changed its
+//! copy's rim, which putting back refuses (the wave then runs in place). The closed
+//! components' volume bounds are split between a wave's slabs (`ClosedParts::share`), so
+//! together they keep to them.
 //!
 //! Which cells make a slab, the waves and the order copies are put back in follow from the
 //! mesh alone; the thread count only decides how many slabs are worked at once, so the result
@@ -28,7 +30,7 @@ use super::{Culling, Pass, RemeshReport, RemeshSets, RemeshSettings, Start, Zoni
 use crate::geom::Aabb;
 use crate::grid::SpatialHash;
 use crate::mesh::{Mesh, Patch};
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A cell of a round: its integer position, its box, its vertices.
 pub(super) type Cell = (IVec3, Aabb, Vec<u32>);
@@ -106,16 +108,16 @@ impl Plan {
                 near: FxHashSet::default(),
             })
             .collect();
-        let rings = (margin / width).ceil() as i32;
+        let around = (margin / width).ceil() as i32;
         for cell in cells {
             let slab = &mut slabs[ids.binary_search(&slab_of(&cell)).expect("listed")];
             slab.span = (
                 slab.span.0.min(cell.1.min[axis] - margin),
                 slab.span.1.max(cell.1.max[axis] + margin),
             );
-            for dz in -rings..=rings {
-                for dy in -rings..=rings {
-                    for dx in -rings..=rings {
+            for dz in -around..=around {
+                for dy in -around..=around {
+                    for dx in -around..=around {
                         slab.near.insert(cell.0 + IVec3::new(dx, dy, dz));
                     }
                 }
@@ -196,6 +198,9 @@ pub(super) fn run_wave(
     longest: &mut f32,
     progress: &mut dyn FnMut(usize),
 ) -> Result<RemeshReport, ()> {
+    if wave.is_empty() {
+        return Ok(RemeshReport::default());
+    }
     let threads = rayon::current_num_threads().clamp(1, wave.len());
     // The largest slabs first, so no thread is left with a large one at the end.
     let mut order: Vec<usize> = (0..wave.len()).collect();
@@ -237,16 +242,19 @@ pub(super) fn run_wave(
         done[i] = result;
     }
     let done: Vec<Done> = done.into_iter().collect::<Option<_>>().ok_or(())?;
-    let patches: Vec<Patch> = done.iter().map(|d| d.patch.clone()).collect();
+    let (patches, rest): (Vec<Patch>, Vec<_>) = done
+        .into_iter()
+        .map(|d| (d.patch, (d.report, d.closed)))
+        .unzip();
     let maps = mesh.put_back(&patches).map_err(|_| ())?;
     let mut report = RemeshReport {
         slabs: wave.len(),
         ..RemeshReport::default()
     };
-    for (d, map) in done.iter().zip(&maps) {
-        closed.absorb(&d.closed, map);
-        *longest = longest.max(d.report.longest_edge);
-        report.add(&d.report);
+    for ((done, share), map) in rest.iter().zip(&maps) {
+        closed.absorb(share, map);
+        *longest = longest.max(done.longest_edge);
+        report.add(done);
     }
     Ok(report)
 }
@@ -261,7 +269,7 @@ fn run_slab(
 ) -> Option<Done> {
     let inside = plan.copied_vertices(mesh, slab);
     let mut patch = mesh.copy_patch(&inside).ok()?;
-    let local: rustc_hash::FxHashMap<u32, u32> = patch
+    let local: FxHashMap<u32, u32> = patch
         .sources
         .iter()
         .enumerate()
