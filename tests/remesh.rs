@@ -261,6 +261,17 @@ fn a_lone_sheet_is_remeshed_as_with_every_check_made() {
     );
 }
 
+/// `mesh` remeshed whole on a pool of `threads` threads.
+fn on_threads(threads: usize, mesh: &Mesh, settings: &RemeshSettings) -> (Mesh, RemeshReport) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let mut mesh = mesh.clone();
+    let report = pool.install(|| remesh_all(&mut mesh, settings)).unwrap();
+    (mesh, report)
+}
+
 /// The issue asks that a whole-mesh remesh not depend on the thread count: the slabs a round
 /// is cut into, the waves and the order their copies are put back in follow from the mesh,
 /// whatever the pool.
@@ -269,16 +280,10 @@ fn a_whole_mesh_remesh_is_the_same_on_one_and_two_threads() {
     // 80,000 vertices: long enough along x for its rounds to be cut into slabs.
     let torus = common::torus(500, 160, (1.0, 0.35));
     let settings = RemeshSettings::new(torus.mean_edge_length());
-    let remeshed = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut mesh = torus.clone();
-        let report = pool.install(|| remesh_all(&mut mesh, &settings)).unwrap();
-        (mesh, report)
-    };
-    let ((one, report), (two, _)) = (remeshed(1), remeshed(2));
+    let ((one, report), (two, _)) = (
+        on_threads(1, &torus, &settings),
+        on_threads(2, &torus, &settings),
+    );
     eprintln!("{report:?}");
     assert!(
         report.slabs >= 6,
@@ -321,16 +326,10 @@ fn a_field_of_pebbles_remeshes_by_slabs_within_each_pebbles_volume_bound() {
     let layers = vec![0; faces.len()];
     let field = Mesh::new(positions, faces, layers, vec!["pebbles".into()]).unwrap();
     let settings = RemeshSettings::new(field.mean_edge_length());
-    let remeshed = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut mesh = field.clone();
-        let report = pool.install(|| remesh_all(&mut mesh, &settings)).unwrap();
-        (mesh, report)
-    };
-    let ((one, report), (two, _)) = (remeshed(1), remeshed(2));
+    let ((one, report), (two, _)) = (
+        on_threads(1, &field, &settings),
+        on_threads(2, &field, &settings),
+    );
     eprintln!("{report:?}");
     assert!(report.slabs >= 6, "{} slabs", report.slabs);
     assert!(report.splits + report.collapses > 1_000, "{report:?}");

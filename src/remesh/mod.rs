@@ -166,13 +166,13 @@ pub fn remesh_region_with(
     settings: &RemeshSettings,
     sets: &mut RemeshSets,
 ) -> (RemeshReport, Vec<u32>) {
-    let pass = Pass {
-        start: Start::OutOfBand,
-        sets,
-        closed: None,
-        zone: Zoning::Off,
-    };
-    remesh(mesh, grid, seeds, settings, pass)
+    remesh(
+        mesh,
+        grid,
+        seeds,
+        settings,
+        Pass::of_region(sets, Zoning::Off),
+    )
 }
 
 /// [`remesh_region_with`], letting a sheet zone settle the safety checks of its edits where
@@ -186,12 +186,7 @@ pub fn remesh_region_culled(
     (settings, longest_edge): (&RemeshSettings, f32),
     sets: &mut RemeshSets,
 ) -> (RemeshReport, Vec<u32>) {
-    let pass = Pass {
-        start: Start::OutOfBand,
-        sets,
-        closed: None,
-        zone: Zoning::Region(longest_edge),
-    };
+    let pass = Pass::of_region(sets, Zoning::Region(longest_edge));
     remesh(mesh, grid, seeds, settings, pass)
 }
 
@@ -256,6 +251,18 @@ struct Pass<'s> {
     closed: Option<&'s mut ClosedParts>,
     /// Which sheet zone vouches for the pass's edits.
     zone: Zoning,
+}
+
+impl<'s> Pass<'s> {
+    /// A stroke's pass over the region around what it moved, starting out of band.
+    fn of_region(sets: &'s mut RemeshSets, zone: Zoning) -> Self {
+        Pass {
+            start: Start::OutOfBand,
+            sets,
+            closed: None,
+            zone,
+        }
+    }
 }
 
 /// Which sheet zone vouches for a pass's edits, sparing them their safety checks (`zone`).
