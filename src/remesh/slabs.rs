@@ -216,6 +216,8 @@ pub(super) fn run_wave(
                 let (next, order, tell) = (&next, &order, tell.clone());
                 scope.spawn(move || {
                     let mut done = Vec::new();
+                    // Kept from slab to slab: sized once, emptied in O(1).
+                    let mut scratch = (RemeshSets::default(), ZoneFinder::default());
                     loop {
                         let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
                             return done;
@@ -223,7 +225,8 @@ pub(super) fn run_wave(
                         let slab = wave[i];
                         let ways = wave.len();
                         let work = (shared, closed_now, ways, longest_now);
-                        done.push((i, run_slab(work, (plan, slab), round, &tell)));
+                        let slab = (plan, slab);
+                        done.push((i, run_slab(work, slab, round, (&mut scratch, &tell))));
                     }
                 })
             })
@@ -259,13 +262,13 @@ pub(super) fn run_wave(
     Ok(report)
 }
 
-/// One slab's cells remeshed in a copy of the mesh around it; `None` where no copy could be
-/// made. `tell` hears of each cell done.
+/// One slab's cells remeshed in a copy of the mesh around it, with the thread's sets; `None`
+/// where no copy could be made. `tell` hears of each cell done.
 fn run_slab(
     (mesh, closed, ways, longest): (&Mesh, &ClosedParts, usize, f32),
     (plan, slab): (&Plan, usize),
     round: &Round<'_>,
-    tell: &mpsc::Sender<()>,
+    ((sets, zones), tell): (&mut (RemeshSets, ZoneFinder), &mpsc::Sender<()>),
 ) -> Option<Done> {
     let inside = plan.copied_vertices(mesh, slab);
     let mut patch = mesh.copy_patch(&inside).ok()?;
@@ -278,7 +281,6 @@ fn run_slab(
     let mut closed = closed.share(&patch.sources, ways);
     let copy = &mut patch.mesh;
     let mut grid = SpatialHash::build(copy, round.grid_cell).ok()?;
-    let (mut sets, mut zones) = (RemeshSets::default(), ZoneFinder::default());
     let mut report = RemeshReport::default();
     let mut longest = longest;
     let settings = round.settings;
@@ -290,7 +292,7 @@ fn run_slab(
         };
         let pass = Pass {
             start: round.start,
-            sets: &mut sets,
+            sets: &mut *sets,
             closed: Some(&mut closed),
             zone: Zoning::Cell(zone),
         };
