@@ -468,8 +468,9 @@ fn edits_in_a_patch_come_back_as_if_made_in_place() {
     }
 }
 
-/// Work that reached a patch's rim cannot be put back by the patch alone: refused, and the
-/// mesh kept as it was. So are two patches holding one face.
+/// Work that reached a patch's rim (a rim vertex moved, or its fan rewired inside the copy)
+/// cannot be put back by the patch alone: refused, and the mesh kept as it was. So are two
+/// patches holding one face.
 #[test]
 fn a_patch_whose_rim_changed_or_that_overlaps_another_is_refused() {
     let sphere = slayer::scene::geodesic_sphere(8, 1.0).unwrap();
@@ -487,6 +488,30 @@ fn a_patch_whose_rim_changed_or_that_overlaps_another_is_refused() {
     let mut mesh = sphere.clone();
     assert!(mesh.put_back(&[moved]).is_err());
     assert_eq!(mesh.positions(), sphere.positions());
+    assert_eq!(mesh.faces(), sphere.faces());
+    // A flip inside the copy, of an edge whose faces border only copied faces but meet a rim
+    // vertex: that vertex's fan, which runs on outside the copy, changed.
+    let on_rim = |l: u32| {
+        let v = patch.sources.get(l as usize).copied();
+        v.is_some_and(|v| sphere.faces_around(v).any(|f| !patch.faces.contains(&f)))
+    };
+    let inner_face = |copy: &Mesh, f: u32| {
+        (0..3).all(|k| copy.adjacency().opposite[3 * f as usize + k] != INVALID)
+    };
+    let mut flipped = patch.clone();
+    let copy = &mut flipped.mesh;
+    let corner = (0..3 * copy.face_count() as u32)
+        .find(|&c| {
+            let o = copy.adjacency().opposite[c as usize];
+            o != INVALID
+                && inner_face(copy, c / 3)
+                && inner_face(copy, o / 3)
+                && copy.faces()[c as usize / 3].iter().any(|&l| on_rim(l))
+                && copy.is_flip_ok(c)
+        })
+        .unwrap();
+    copy.flip_edge(corner);
+    assert!(mesh.put_back(&[flipped]).is_err());
     assert_eq!(mesh.faces(), sphere.faces());
     let band = sphere
         .copy_patch(&vertices_where(&sphere, |p| p.z > 0.4))

@@ -168,25 +168,39 @@ impl Mesh {
         Ok(maps)
     }
 
-    /// Whether every face of the copy on its rim (an edge whose face across, in the mesh, is
-    /// not the patch's) is as it was, with its vertices where they were.
+    /// Whether the copy's rim is as it was: every face of the copy around a rim vertex (one
+    /// with a face outside the patch), with its vertices where they were, and no new face at
+    /// one. Then the rim vertices' fans, which run on outside the copy, still join.
     fn check_rim(&self, patch: &Patch, in_patch: impl Fn(u32) -> bool) -> Result<(), PutBackError> {
         let copy = &patch.mesh;
-        for (i, &f) in patch.faces.iter().enumerate() {
-            let on_rim = (0..3).any(|k| {
-                let o = self.adjacency.opposite[3 * f as usize + k];
-                o != INVALID && !in_patch(face_of(o))
-            });
-            if !on_rim {
+        let copied = patch.sources.len();
+        let on_rim = self.rim_of(patch, &in_patch);
+        let rim: rustc_hash::FxHashSet<u32> = (patch.sources.iter())
+            .zip(&on_rim)
+            .filter_map(|(&v, &rim)| rim.then_some(v))
+            .collect();
+        let local_on_rim = |l: u32| (l as usize) < copied && on_rim[l as usize];
+        for f in 0..copy.face_count() {
+            let now = copy.faces[f];
+            let live = !copy.is_face_dead(f);
+            let at_rim_now = live && now.iter().any(|&l| local_on_rim(l));
+            let Some(&g) = patch.faces.get(f) else {
+                if at_rim_now {
+                    return Err(PutBackError::RimChanged {
+                        vertex: patch.sources[now[0] as usize],
+                    });
+                }
+                continue;
+            };
+            let was = self.faces[g as usize];
+            if !at_rim_now && !was.iter().any(|v| rim.contains(v)) {
                 continue;
             }
-            let now = copy.faces[i];
-            let was = self.faces[f as usize];
-            let same = now != [INVALID; 3]
-                && now.iter().zip(&was).all(|(&l, &g)| {
-                    (l as usize) < patch.sources.len()
-                        && patch.sources[l as usize] == g
-                        && copy.positions[l as usize] == self.positions[g as usize]
+            let same = live
+                && now.iter().zip(&was).all(|(&l, &v)| {
+                    (l as usize) < copied
+                        && patch.sources[l as usize] == v
+                        && copy.positions[l as usize] == self.positions[v as usize]
                 });
             if !same {
                 return Err(PutBackError::RimChanged { vertex: was[0] });
@@ -195,15 +209,18 @@ impl Mesh {
         Ok(())
     }
 
+    /// For each copied vertex, whether a face around it in the mesh is not the patch's.
+    fn rim_of(&self, patch: &Patch, in_patch: &impl Fn(u32) -> bool) -> Vec<bool> {
+        (patch.sources.iter())
+            .map(|&v| self.faces_around(v).any(|f| !in_patch(f)))
+            .collect()
+    }
+
     /// Puts one patch back (its rim checked); returns its vertex map.
     fn put_back_one(&mut self, patch: &Patch, in_patch: impl Fn(u32) -> bool) -> Vec<u32> {
         let copy = &patch.mesh;
         // Found while the mesh's fans still run as they did.
-        let on_rim: Vec<bool> = patch
-            .sources
-            .iter()
-            .map(|&v| self.faces_around(v).any(|f| !in_patch(f)))
-            .collect();
+        let on_rim = self.rim_of(patch, &in_patch);
         let vertex_map = self.put_back_vertices(patch, &on_rim);
         // The copy's faces: its first ones take their slots back, the rest are appended.
         let mut face_map = patch.faces.clone();
