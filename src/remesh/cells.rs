@@ -7,8 +7,9 @@
 //! Edges between two cells belong to neither region. A second round over cells shifted by half
 //! a cell takes them where they are still out of band, and a third, shifted by a quarter, what
 //! lies on both earlier rounds' seams (near where their planes cross) and what the second left
-//! out of band. Each round's cells and their order follow from the mesh alone, never from the
-//! thread count.
+//! out of band. A round's cells are remeshed slab by slab on every core (`slabs`), or, on a
+//! mesh too short for that, one after another in place; either way what runs in what order
+//! follows from the mesh alone, never from the thread count.
 
 use glam::{IVec3, Vec3};
 
