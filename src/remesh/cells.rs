@@ -104,7 +104,8 @@ fn remesh_by_cells(
         let mut cells = cells(mesh, width, shift);
         if start != Start::Everywhere {
             // A pass that starts out of band has nothing to do in a cell with no edge out of
-            // band: leaving it out changes nothing, and spares it its copy.
+            // band as the round begins, and is spared its copy. (An earlier cell's edit that
+            // puts such a cell's edge out of band leaves it to the next round.)
             cells.retain(|(_, _, seeds)| {
                 seeds
                     .iter()
