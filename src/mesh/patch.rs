@@ -21,6 +21,15 @@ pub struct Patch {
     pub sources: Vec<u32>,
     /// The mesh's faces the copy was made of, in the copy's order.
     pub faces: Vec<u32>,
+    /// `sources` the other way: the copy's vertex of each copied vertex of the mesh.
+    copies: FxHashMap<u32, u32>,
+}
+
+impl Patch {
+    /// The copy's vertex copied from the mesh's vertex `v`, if the copy holds it.
+    pub fn copy_of(&self, v: u32) -> Option<u32> {
+        self.copies.get(&v).copied()
+    }
 }
 
 /// Why patches could not be put back.
@@ -39,18 +48,19 @@ impl Mesh {
     /// the copy manifold: a vertex of the copy's rim whose faces in the copy would make two
     /// fans brings all its faces (then its neighbours are checked in turn).
     pub fn copy_patch(&self, vertices: &[u32]) -> Result<Patch, MeshError> {
-        let mut taken: FxHashMap<u32, u32> = FxHashMap::default();
+        // Each face's index in the copy (`INVALID`: not taken), as `restricted` wants it.
+        let mut kept = vec![INVALID; self.face_count()];
         let mut faces = Vec::new();
-        let take_fan = |v: u32, taken: &mut FxHashMap<u32, u32>, faces: &mut Vec<u32>| {
+        let take_fan = |v: u32, kept: &mut Vec<u32>, faces: &mut Vec<u32>| {
             for f in self.faces_around(v) {
-                taken.entry(f).or_insert_with(|| {
+                if kept[f as usize] == INVALID {
+                    kept[f as usize] = faces.len() as u32;
                     faces.push(f);
-                    faces.len() as u32 - 1
-                });
+                }
             }
         };
         for &v in vertices {
-            take_fan(v, &mut taken, &mut faces);
+            take_fan(v, &mut kept, &mut faces);
         }
         let mut checked = 0;
         let mut whole: rustc_hash::FxHashSet<u32> = vertices.iter().copied().collect();
@@ -58,20 +68,20 @@ impl Mesh {
             let f = faces[checked];
             checked += 1;
             for v in self.faces[f as usize] {
-                if !whole.contains(&v) && self.fans_in(v, &taken) > 1 {
+                if !whole.contains(&v) && self.fans_in(v, &kept) > 1 {
                     whole.insert(v);
-                    take_fan(v, &mut taken, &mut faces);
+                    take_fan(v, &mut kept, &mut faces);
                 }
             }
         }
-        self.copy_faces(faces, &taken)
+        self.copy_faces(faces, &kept)
     }
 
-    /// How many separate runs of `taken` faces lie around `v`.
-    fn fans_in(&self, v: u32, taken: &FxHashMap<u32, u32>) -> usize {
+    /// How many separate runs of `kept` faces lie around `v`.
+    fn fans_in(&self, v: u32, kept: &[u32]) -> usize {
         let around: Vec<bool> = self
             .faces_around(v)
-            .map(|f| taken.contains_key(&f))
+            .map(|f| kept[f as usize] != INVALID)
             .collect();
         let starts = (0..around.len())
             .filter(|&i| {
@@ -88,26 +98,22 @@ impl Mesh {
         starts.max(usize::from(around.iter().all(|&t| t)))
     }
 
-    /// The copy of `faces` (`taken` maps each to its index among them).
-    fn copy_faces(&self, faces: Vec<u32>, taken: &FxHashMap<u32, u32>) -> Result<Patch, MeshError> {
-        let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+    /// The copy of `faces` (`kept` maps each to its index among them).
+    fn copy_faces(&self, faces: Vec<u32>, kept: &[u32]) -> Result<Patch, MeshError> {
+        let mut copies: FxHashMap<u32, u32> = FxHashMap::default();
         let mut sources = Vec::new();
         let tris: Vec<[u32; 3]> = faces
             .iter()
             .map(|&f| {
                 self.faces[f as usize].map(|v| {
-                    *local.entry(v).or_insert_with(|| {
+                    *copies.entry(v).or_insert_with(|| {
                         sources.push(v);
                         sources.len() as u32 - 1
                     })
                 })
             })
             .collect();
-        let mut kept = vec![INVALID; self.face_count()];
-        for (&f, &i) in taken {
-            kept[f as usize] = i;
-        }
-        let adjacency = self.adjacency.restricted(&kept, &tris, sources.len())?;
+        let adjacency = self.adjacency.restricted(kept, &tris, sources.len())?;
         let mut mesh = Mesh {
             positions: sources
                 .iter()
@@ -134,6 +140,7 @@ impl Mesh {
             mesh,
             sources,
             faces,
+            copies,
         })
     }
 
@@ -152,16 +159,18 @@ impl Mesh {
                 owner[f as usize] = p as u32;
             }
         }
-        for (p, patch) in patches.iter().enumerate() {
-            self.check_rim(patch, |f| owner[f as usize] == p as u32)?;
+        // Each patch's rim, found while the mesh's fans still run as they did.
+        let rims: Vec<Vec<bool>> = (patches.iter().enumerate())
+            .map(|(p, patch)| self.rim_of(patch, |f| owner[f as usize] == p as u32))
+            .collect();
+        for (patch, on_rim) in patches.iter().zip(&rims) {
+            self.check_rim(patch, on_rim)?;
         }
-        let maps = patches
-            .iter()
-            .enumerate()
+        let maps = (patches.iter().enumerate())
             .map(|(p, patch)| {
                 // Appended faces belong to no patch: they lie past `owner`'s end.
                 let in_patch = |f: u32| owner.get(f as usize) == Some(&(p as u32));
-                self.put_back_one(patch, in_patch)
+                self.put_back_one(patch, (in_patch, &rims[p]))
             })
             .collect();
         self.version = super::MeshVersion::fresh();
@@ -171,12 +180,11 @@ impl Mesh {
     /// Whether the copy's rim is as it was: every face of the copy around a rim vertex (one
     /// with a face outside the patch), with its vertices where they were, and no new face at
     /// one. Then the rim vertices' fans, which run on outside the copy, still join.
-    fn check_rim(&self, patch: &Patch, in_patch: impl Fn(u32) -> bool) -> Result<(), PutBackError> {
+    fn check_rim(&self, patch: &Patch, on_rim: &[bool]) -> Result<(), PutBackError> {
         let copy = &patch.mesh;
         let copied = patch.sources.len();
-        let on_rim = self.rim_of(patch, &in_patch);
         let rim: rustc_hash::FxHashSet<u32> = (patch.sources.iter())
-            .zip(&on_rim)
+            .zip(on_rim)
             .filter_map(|(&v, &rim)| rim.then_some(v))
             .collect();
         let local_on_rim = |l: u32| (l as usize) < copied && on_rim[l as usize];
@@ -210,18 +218,20 @@ impl Mesh {
     }
 
     /// For each copied vertex, whether a face around it in the mesh is not the patch's.
-    fn rim_of(&self, patch: &Patch, in_patch: &impl Fn(u32) -> bool) -> Vec<bool> {
+    fn rim_of(&self, patch: &Patch, in_patch: impl Fn(u32) -> bool) -> Vec<bool> {
         (patch.sources.iter())
             .map(|&v| self.faces_around(v).any(|f| !in_patch(f)))
             .collect()
     }
 
     /// Puts one patch back (its rim checked); returns its vertex map.
-    fn put_back_one(&mut self, patch: &Patch, in_patch: impl Fn(u32) -> bool) -> Vec<u32> {
+    fn put_back_one(
+        &mut self,
+        patch: &Patch,
+        (in_patch, on_rim): (impl Fn(u32) -> bool, &[bool]),
+    ) -> Vec<u32> {
         let copy = &patch.mesh;
-        // Found while the mesh's fans still run as they did.
-        let on_rim = self.rim_of(patch, &in_patch);
-        let vertex_map = self.put_back_vertices(patch, &on_rim);
+        let vertex_map = self.put_back_vertices(patch, on_rim);
         // The copy's faces: its first ones take their slots back, the rest are appended.
         let mut face_map = patch.faces.clone();
         for f in patch.faces.len()..copy.face_count() {
@@ -262,7 +272,7 @@ impl Mesh {
                 };
             }
         }
-        self.put_back_fans(patch, (&vertex_map, &on_rim), corner);
+        self.put_back_fans(patch, (&vertex_map, on_rim), corner);
         vertex_map
     }
 

@@ -14,8 +14,7 @@
 use glam::{IVec3, Vec3};
 
 use super::shape::ClosedParts;
-use super::slabs::{self, Cell, Plan, Round};
-use super::zone::ZoneFinder;
+use super::slabs::{self, Carried, Cell, Plan, Round};
 use super::{
     Culling, Pass, Progress, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, out_of_band,
     remesh,
@@ -83,13 +82,16 @@ fn rings(start: Start) -> u32 {
 /// `closed`: the mesh's closed components, found once for every cell.
 fn remesh_by_cells(
     mesh: &mut Mesh,
-    mut closed: ClosedParts,
+    closed: ClosedParts,
     settings: &RemeshSettings,
     (start, culling): (Start, Culling),
     progress: &mut dyn FnMut(Progress),
 ) -> RemeshReport {
     let mut report = RemeshReport::default();
-    let mut longest_edge = mesh.longest_edge();
+    let mut carried = Carried {
+        closed,
+        longest: mesh.longest_edge(),
+    };
     let width = CELL_EDGES * settings.target_edge;
     let rounds = [
         (0.0, start),
@@ -129,22 +131,10 @@ fn remesh_by_cells(
             culling,
             grid_cell: GRID_EDGES * settings.target_edge,
         };
-        let reach = slabs::reach(&settings, settings.region_rings, longest_edge);
-        let waves = match Plan::of(cells, (width, shift), reach, longest_edge) {
-            Ok(plan) => run_slabs(
-                mesh,
-                plan,
-                &mut closed,
-                &round,
-                (&mut longest_edge, &mut tell),
-            ),
-            Err(cells) => run_in_place(
-                mesh,
-                cells,
-                &mut closed,
-                &round,
-                (&mut longest_edge, &mut tell),
-            ),
+        let reach = slabs::reach(&settings, settings.region_rings, carried.longest);
+        let waves = match Plan::of(cells, (width, shift), reach, carried.longest) {
+            Ok(plan) => run_slabs(mesh, plan, &mut carried, &round, &mut tell),
+            Err(cells) => run_in_place(mesh, &cells, &mut carried, &round, &mut tell),
         };
         report.add(&waves);
     }
@@ -157,23 +147,20 @@ fn remesh_by_cells(
 fn run_slabs(
     mesh: &mut Mesh,
     plan: Plan,
-    closed: &mut ClosedParts,
+    carried: &mut Carried,
     round: &Round<'_>,
-    (longest, progress): (&mut f32, &mut dyn FnMut(usize)),
+    progress: &mut dyn FnMut(usize),
 ) -> RemeshReport {
     let mut report = RemeshReport::default();
     for wave in plan.waves() {
-        match slabs::run_wave(mesh, (&plan, &wave), closed, round, longest, progress) {
-            Ok(done) => report.add(&done),
-            Err(()) => {
-                let cells = wave
-                    .iter()
+        let done =
+            slabs::run_wave(mesh, (&plan, &wave), carried, round, progress).unwrap_or_else(|()| {
+                let cells: Vec<Cell> = (wave.iter())
                     .flat_map(|&s| plan.cells_of(s).iter().cloned())
                     .collect();
-                let done = run_in_place(mesh, cells, closed, round, (longest, progress));
-                report.add(&done);
-            }
-        }
+                run_in_place(mesh, &cells, carried, round, progress)
+            });
+        report.add(&done);
     }
     report
 }
@@ -182,33 +169,23 @@ fn run_slabs(
 /// them.
 fn run_in_place(
     mesh: &mut Mesh,
-    cells: Vec<Cell>,
-    closed: &mut ClosedParts,
+    cells: &[Cell],
+    carried: &mut Carried,
     round: &Round<'_>,
-    (longest, progress): (&mut f32, &mut dyn FnMut(usize)),
+    progress: &mut dyn FnMut(usize),
 ) -> RemeshReport {
     let mut grid = SpatialHash::build(mesh, round.grid_cell)
         .expect("the cell size was checked before the rounds");
-    let (mut sets, mut zones) = (RemeshSets::default(), ZoneFinder::default());
-    let mut report = RemeshReport::default();
-    let settings = round.settings;
-    for (_, core, seeds) in cells {
-        let zone = match round.culling {
-            Culling::On => zones.find(mesh, &grid, &core, (settings.target_edge, *longest)),
-            Culling::Off => None,
-        };
-        let pass = Pass {
-            start: round.start,
-            sets: &mut sets,
-            closed: Some(&mut *closed),
-            zone: Zoning::Cell(zone),
-        };
-        let (done, _) = remesh(mesh, &mut grid, &seeds, settings, pass);
-        *longest = longest.max(done.longest_edge);
-        report.add(&done);
-        progress(1);
-    }
-    report
+    let cells = cells.iter().map(|(_, core, seeds)| (core, seeds.clone()));
+    let mut sets = RemeshSets::default();
+    let mut done = || progress(1);
+    slabs::remesh_cells(
+        (mesh, &mut grid),
+        cells,
+        (&mut sets, carried),
+        round,
+        &mut done,
+    )
 }
 
 /// The vertices with faces.
@@ -222,7 +199,7 @@ fn live_vertices(mesh: &Mesh) -> Vec<u32> {
 /// `shift` of a width, each with its box; in the cubes' order (x, then y, then z), each
 /// cube's vertices ascending, so the order never depends on anything but the mesh.
 fn cells(mesh: &Mesh, width: f32, shift: f32) -> Vec<Cell> {
-    let cell_of = |p: Vec3| (p / width + shift).floor().as_ivec3();
+    let cell_of = |p: Vec3| slabs::cell_of(p, (width, shift));
     let mut keyed: Vec<((i32, i32, i32), u32)> = live_vertices(mesh)
         .into_iter()
         .map(|v| {

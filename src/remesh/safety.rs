@@ -47,34 +47,30 @@ impl Remesher<'_> {
         let keeps_rim = self.zone.is_some()
             && merged.is_none_or(|m| !rim(m))
             && (!rim(v) || positions[v as usize] == target);
-        if keeps_rim && self.zone_vouches(&moved) {
-            if !self.zone_keeps_own_gap {
-                return true;
-            }
-            // The zone settles crossings and other layers, not how near the vertex comes to
-            // its own layer beyond its exclusion ring: a sheet pressed together brings its
-            // second ring within `d`, which the full checks refuse too.
-            let d = self.settings.collision_distance;
-            let from = self.mesh.positions()[v as usize];
-            let near = self.gather_near(&Aabb::of_points(&[from, target]).expanded(d));
-            let clear = self.keeps_collision_distance(v, (from, target, merged), &near);
-            self.near = near;
-            return clear;
-        }
-        let clear = self.move_checks(v, (target, merged), &carrying, &moved);
-        if clear {
-            // Its faces may leave the zone no longer a sheet.
-            self.zone = None;
-        }
-        clear
+        let in_zone = |remesher: &mut Self| remesher.clear_in_zone(v, target, merged);
+        self.unless_vouched(
+            &moved,
+            keeps_rim,
+            (in_zone, |remesher| {
+                remesher.move_checks(v, (target, merged), &carrying, &moved)
+            }),
+        )
     }
 
-    /// Whether the sheet zone vouches for an edit that makes `triangles` (`zone`), counted.
-    fn zone_vouches(&mut self, triangles: &[([u32; 3], [Vec3; 3])]) -> bool {
-        let vouched =
-            (self.zone.as_ref()).is_some_and(|z| z.holds(triangles.iter().map(|(_, t)| t)));
-        self.report.culled += usize::from(vouched);
-        vouched
+    /// A move the sheet zone vouches for: safe, unless the pass keeps the zone's moves from
+    /// their own layer (`Remesher::zone_keeps_own_gap`). The zone settles crossings and other
+    /// layers, not how near the vertex comes to its own layer beyond its exclusion ring: a
+    /// sheet pressed together brings its second ring within `d`, which the full checks refuse.
+    fn clear_in_zone(&mut self, v: u32, target: Vec3, merged: Option<u32>) -> bool {
+        if !self.zone_keeps_own_gap {
+            return true;
+        }
+        let d = self.settings.collision_distance;
+        let from = self.mesh.positions()[v as usize];
+        let near = self.gather_near(&Aabb::of_points(&[from, target]).expanded(d));
+        let clear = self.keeps_collision_distance(v, (from, target, merged), &near);
+        self.near = near;
+        clear
     }
 
     /// No face near `target` but those of `v`'s own neighbourhood (its exclusion ring in its
@@ -149,17 +145,22 @@ impl Remesher<'_> {
     }
 
     /// `check`'s verdict on an edit that makes `triangles` (and leaves the mesh's rim as it
-    /// was, when `keeps_rim`), unless the sheet zone vouches for them (`zone`): then the edit
-    /// is safe unchecked. An edit checked in full that passes ends the zone, since its faces
-    /// may leave the zone no longer a sheet.
+    /// was, when `keeps_rim`), unless the sheet zone vouches for them (`zone`, counted): then
+    /// `vouched`'s. An edit checked in full that passes ends the zone, since its faces may
+    /// leave the zone no longer a sheet.
     fn unless_vouched(
         &mut self,
         triangles: &[([u32; 3], [Vec3; 3])],
         keeps_rim: bool,
-        check: impl FnOnce(&mut Self) -> bool,
+        (vouched, check): (
+            impl FnOnce(&mut Self) -> bool,
+            impl FnOnce(&mut Self) -> bool,
+        ),
     ) -> bool {
-        if keeps_rim && self.zone_vouches(triangles) {
-            return true;
+        let holds = |z: &super::zone::Zone| z.holds(triangles.iter().map(|(_, t)| t));
+        if keeps_rim && self.zone.as_ref().is_some_and(holds) {
+            self.report.culled += 1;
+            return vouched(self);
         }
         let clear = check(self);
         if clear {
@@ -177,14 +178,21 @@ impl Remesher<'_> {
         before: &[[Vec3; 3]],
     ) -> bool {
         // A flip's edge is never on the rim (a rim edge has one face).
-        self.unless_vouched(after, true, |remesher| {
-            let layer = remesher.mesh.face_layers()[replaced[0] as usize];
-            let near = remesher.gather_near(&bounds_of(after));
-            let clear = remesher.faces_clear_among(after, &[], &replaced, &near)
-                && remesher.keeps_layer_gap(layer, before, after);
-            remesher.near = near;
-            clear
-        })
+        self.unless_vouched(
+            after,
+            true,
+            (
+                |_| true,
+                |remesher| {
+                    let layer = remesher.mesh.face_layers()[replaced[0] as usize];
+                    let near = remesher.gather_near(&bounds_of(after));
+                    let clear = remesher.faces_clear_among(after, &[], &replaced, &near)
+                        && remesher.keeps_layer_gap(layer, before, after);
+                    remesher.near = near;
+                    clear
+                },
+            ),
+        )
     }
 
     /// The layer gap kept through an edit that replaces the surface `before` (triangles of
@@ -254,20 +262,27 @@ impl Remesher<'_> {
             replaced.push(o / 3);
         }
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
-        self.unless_vouched(&halves, o != INVALID, |remesher| {
-            // The halves lie on the faces they replace: only the new vertex needs the wider
-            // reach.
-            let mut reach = bounds_of(&halves);
-            if remesher.mesh.layer_count() > 1 {
-                let d = remesher.settings.collision_distance;
-                reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
-            }
-            let near = remesher.gather_near(&reach);
-            let clear = remesher.faces_clear_among(&halves, &[], &replaced, &near)
-                && remesher.midpoint_keeps_gap(layer, ends, at_m, &near);
-            remesher.near = near;
-            clear
-        })
+        self.unless_vouched(
+            &halves,
+            o != INVALID,
+            (
+                |_| true,
+                |remesher| {
+                    // The halves lie on the faces they replace: only the new vertex needs the wider
+                    // reach.
+                    let mut reach = bounds_of(&halves);
+                    if remesher.mesh.layer_count() > 1 {
+                        let d = remesher.settings.collision_distance;
+                        reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
+                    }
+                    let near = remesher.gather_near(&reach);
+                    let clear = remesher.faces_clear_among(&halves, &[], &replaced, &near)
+                        && remesher.midpoint_keeps_gap(layer, ends, at_m, &near);
+                    remesher.near = near;
+                    clear
+                },
+            ),
+        )
     }
 
     /// A split's new vertex `m` on the edge `ends` is no nearer to another layer's face within

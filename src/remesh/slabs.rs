@@ -25,12 +25,12 @@ use std::sync::mpsc;
 use glam::{IVec3, Vec3};
 
 use super::shape::ClosedParts;
-use super::zone::{MARGIN_EDGES, ZoneFinder};
+use super::zone::MARGIN_EDGES;
 use super::{Culling, Pass, RemeshReport, RemeshSets, RemeshSettings, Start, Zoning, remesh};
 use crate::geom::Aabb;
 use crate::grid::SpatialHash;
 use crate::mesh::{Mesh, Patch};
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 
 /// A cell of a round: its integer position, its box, its vertices.
 pub(super) type Cell = (IVec3, Aabb, Vec<u32>);
@@ -46,6 +46,50 @@ pub(super) struct Round<'a> {
     pub culling: Culling,
     /// The vertex grid's cell, for the copies' grids.
     pub grid_cell: f32,
+}
+
+/// What a whole-mesh remesh carries from cell to cell: the closed components' volume
+/// budgets, and a bound on every edge of the mesh as the passes leave it.
+pub(super) struct Carried {
+    pub closed: ClosedParts,
+    pub longest: f32,
+}
+
+/// Remeshes `cells` (a box and its seeds each) one after another in `mesh`, indexed by
+/// `grid`; `done` hears of each cell. The same loop runs a round in place and a slab in its
+/// copy.
+pub(super) fn remesh_cells<'c>(
+    (mesh, grid): (&mut Mesh, &mut SpatialHash),
+    cells: impl Iterator<Item = (&'c Aabb, Vec<u32>)>,
+    (sets, carried): (&mut RemeshSets, &mut Carried),
+    round: &Round<'_>,
+    done: &mut dyn FnMut(),
+) -> RemeshReport {
+    let settings = round.settings;
+    let mut report = RemeshReport::default();
+    for (core, seeds) in cells {
+        let lengths = (settings.target_edge, carried.longest);
+        let zone = match round.culling {
+            Culling::On => sets.zones.find(mesh, grid, core, lengths),
+            Culling::Off => None,
+        };
+        let pass = Pass {
+            start: round.start,
+            sets: &mut *sets,
+            closed: Some(&mut carried.closed),
+            zone: Zoning::Cell(zone),
+        };
+        let (pass_report, _) = remesh(mesh, grid, &seeds, settings, pass);
+        carried.longest = carried.longest.max(pass_report.longest_edge);
+        report.add(&pass_report);
+        done();
+    }
+    report
+}
+
+/// The cell of a lattice `width` wide shifted by `shift` of a width that `p` lies in.
+pub(super) fn cell_of(p: Vec3, (width, shift): (f32, f32)) -> IVec3 {
+    (p / width + shift).floor().as_ivec3()
 }
 
 /// A round's slabs: the cells of each, in the round's order, and what each copy must hold.
@@ -134,13 +178,12 @@ impl Plan {
     /// The vertices a copy of slab `slab` must hold: those within the margin of its cells.
     fn copied_vertices(&self, mesh: &Mesh, slab: usize) -> Vec<u32> {
         let Slab { span, near, .. } = &self.slabs[slab];
-        let (width, shift) = self.lattice;
         (0..mesh.vertex_count() as u32)
             .filter(|&v| {
                 let p: Vec3 = mesh.positions()[v as usize];
                 (span.0..=span.1).contains(&p[self.axis])
                     && mesh.is_vertex_live(v)
-                    && near.contains(&(p / width + shift).floor().as_ivec3())
+                    && near.contains(&cell_of(p, self.lattice))
             })
             .collect()
     }
@@ -183,7 +226,8 @@ fn widest_axis(cells: &[Cell]) -> Option<usize> {
 struct Done {
     patch: Patch,
     report: RemeshReport,
-    closed: ClosedParts,
+    /// The slab's share of the volume budgets, and its bound on edges.
+    carried: Carried,
 }
 
 /// Remeshes the slabs `wave` of `plan` at once, on as many threads as rayon's pool the caller
@@ -193,9 +237,8 @@ struct Done {
 pub(super) fn run_wave(
     mesh: &mut Mesh,
     (plan, wave): (&Plan, &[usize]),
-    closed: &mut ClosedParts,
+    carried: &mut Carried,
     round: &Round<'_>,
-    longest: &mut f32,
     progress: &mut dyn FnMut(usize),
 ) -> Result<RemeshReport, ()> {
     if wave.is_empty() {
@@ -207,9 +250,7 @@ pub(super) fn run_wave(
     order.sort_by_key(|&i| std::cmp::Reverse(plan.vertex_count(wave[i])));
     let next = AtomicUsize::new(0);
     let (tell, told) = mpsc::channel::<()>();
-    let shared: &Mesh = mesh;
-    let closed_now: &ClosedParts = closed;
-    let longest_now = *longest;
+    let (shared, carried_now): (&Mesh, &Carried) = (mesh, carried);
     let results: Vec<(usize, Option<Done>)> = std::thread::scope(|scope| {
         let workers: Vec<_> = (0..threads)
             .map(|_| {
@@ -217,16 +258,14 @@ pub(super) fn run_wave(
                 scope.spawn(move || {
                     let mut done = Vec::new();
                     // Kept from slab to slab: sized once, emptied in O(1).
-                    let mut scratch = (RemeshSets::default(), ZoneFinder::default());
+                    let mut sets = RemeshSets::default();
                     loop {
                         let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
                             return done;
                         };
-                        let slab = wave[i];
-                        let ways = wave.len();
-                        let work = (shared, closed_now, ways, longest_now);
-                        let slab = (plan, slab);
-                        done.push((i, run_slab(work, slab, round, (&mut scratch, &tell))));
+                        let work = (shared, carried_now, wave.len());
+                        let slab = run_slab(work, (plan, wave[i]), round, (&mut sets, &tell));
+                        done.push((i, slab));
                     }
                 })
             })
@@ -247,7 +286,7 @@ pub(super) fn run_wave(
     let done: Vec<Done> = done.into_iter().collect::<Option<_>>().ok_or(())?;
     let (patches, rest): (Vec<Patch>, Vec<_>) = done
         .into_iter()
-        .map(|d| (d.patch, (d.report, d.closed)))
+        .map(|d| (d.patch, (d.report, d.carried)))
         .unzip();
     let maps = mesh.put_back(&patches).map_err(|_| ())?;
     let mut report = RemeshReport {
@@ -255,57 +294,51 @@ pub(super) fn run_wave(
         ..RemeshReport::default()
     };
     for ((done, share), map) in rest.iter().zip(&maps) {
-        closed.absorb(share, map);
-        *longest = longest.max(done.longest_edge);
+        carried.closed.absorb(&share.closed, map);
+        carried.longest = carried.longest.max(share.longest);
         report.add(done);
     }
     Ok(report)
 }
 
-/// One slab's cells remeshed in a copy of the mesh around it, with the thread's sets; `None`
-/// where no copy could be made. `tell` hears of each cell done.
+/// One slab's cells remeshed in a copy of the mesh around it (of `ways` slabs run at once),
+/// with the thread's sets; `None` where no copy could be made. `tell` hears of each cell done.
 fn run_slab(
-    (mesh, closed, ways, longest): (&Mesh, &ClosedParts, usize, f32),
+    (mesh, carried, ways): (&Mesh, &Carried, usize),
     (plan, slab): (&Plan, usize),
     round: &Round<'_>,
-    ((sets, zones), tell): (&mut (RemeshSets, ZoneFinder), &mpsc::Sender<()>),
+    (sets, tell): (&mut RemeshSets, &mpsc::Sender<()>),
 ) -> Option<Done> {
     let inside = plan.copied_vertices(mesh, slab);
     let mut patch = mesh.copy_patch(&inside).ok()?;
-    let local: FxHashMap<u32, u32> = patch
-        .sources
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| (v, i as u32))
+    let mut share = Carried {
+        closed: carried.closed.share(&patch.sources, ways),
+        longest: carried.longest,
+    };
+    let mut grid = SpatialHash::build(&patch.mesh, round.grid_cell).ok()?;
+    let cells: Vec<(&Aabb, Vec<u32>)> = (plan.cells_of(slab).iter())
+        .map(|(_, core, seeds)| {
+            (
+                core,
+                seeds.iter().filter_map(|&v| patch.copy_of(v)).collect(),
+            )
+        })
         .collect();
-    let mut closed = closed.share(&patch.sources, ways);
-    let copy = &mut patch.mesh;
-    let mut grid = SpatialHash::build(copy, round.grid_cell).ok()?;
-    let mut report = RemeshReport::default();
-    let mut longest = longest;
-    let settings = round.settings;
-    for (_, core, seeds) in plan.cells_of(slab) {
-        let seeds: Vec<u32> = seeds.iter().filter_map(|v| local.get(v).copied()).collect();
-        let zone = match round.culling {
-            Culling::On => zones.find(copy, &grid, core, (settings.target_edge, longest)),
-            Culling::Off => None,
-        };
-        let pass = Pass {
-            start: round.start,
-            sets: &mut *sets,
-            closed: Some(&mut closed),
-            zone: Zoning::Cell(zone),
-        };
-        let (done, _) = remesh(copy, &mut grid, &seeds, settings, pass);
-        longest = longest.max(done.longest_edge);
-        report.add(&done);
-        // The caller may have stopped listening only by panicking.
+    // The caller may have stopped listening only by panicking.
+    let mut done = || {
         let _ = tell.send(());
-    }
-    report.longest_edge = longest;
+    };
+    let copy = (&mut patch.mesh, &mut grid);
+    let report = remesh_cells(
+        copy,
+        cells.into_iter(),
+        (sets, &mut share),
+        round,
+        &mut done,
+    );
     Some(Done {
         patch,
         report,
-        closed,
+        carried: share,
     })
 }

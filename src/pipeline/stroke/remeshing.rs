@@ -10,6 +10,7 @@ use crate::mesh::Mesh;
 use crate::pipeline::Remeshing;
 use crate::pipeline::engine::{fuse_touched, longest_edge_at, millis, remesh_touched};
 use crate::pipeline::kernels::StepKernels;
+use crate::remesh::RemeshReport;
 
 impl Active {
     /// [`Remeshing::AfterSample`]: remeshes around `moved`, what the last sample moved (a
@@ -22,22 +23,7 @@ impl Active {
         call: &mut SamplesReport,
     ) {
         let started = Instant::now();
-        let lengths = (
-            self.lengths.edge,
-            self.lengths.collision_distance,
-            self.prepared.ring,
-            self.splits_left,
-        );
-        let culling = self.cull.then_some(self.prepared.max_edge);
-        let (pass, changed) = remesh_touched(
-            mesh,
-            (&mut self.prepared.grid, kernels, &mut self.scratch.remesh),
-            (moved, culling),
-            lengths,
-        );
-        self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
-        self.splits_left -= pass.splits;
-        self.report.remesh.add(&pass);
+        let (pass, changed) = self.remesh_around(kernels, mesh, moved);
         self.remeshed.extend_from_slice(&changed);
         self.scratch.size_for(mesh);
         call.changed.extend_from_slice(&changed);
@@ -99,13 +85,27 @@ impl Active {
             return Vec::new();
         }
         let started = Instant::now();
+        let seeds = std::mem::take(&mut self.touched_list);
+        let (_, changed) = self.remesh_around(kernels, mesh, &seeds);
+        self.touched_list = seeds;
+        self.report.phases.remesh += millis(started);
+        changed
+    }
+
+    /// Remeshes around `seeds` with the stroke's lengths, what is left of its bound on new
+    /// faces and its culling, and books the pass in the stroke's report and edge bound.
+    fn remesh_around(
+        &mut self,
+        kernels: &mut dyn StepKernels,
+        mesh: &mut Mesh,
+        seeds: &[u32],
+    ) -> (RemeshReport, Vec<u32>) {
         let lengths = (
             self.lengths.edge,
             self.lengths.collision_distance,
             self.prepared.ring,
             self.splits_left,
         );
-        let seeds = &self.touched_list;
         let culling = self.cull.then_some(self.prepared.max_edge);
         let (pass, changed) = remesh_touched(
             mesh,
@@ -116,8 +116,7 @@ impl Active {
         self.prepared.max_edge = self.prepared.max_edge.max(pass.longest_edge);
         self.splits_left -= pass.splits;
         self.report.remesh.add(&pass);
-        self.report.phases.remesh += millis(started);
-        changed
+        (pass, changed)
     }
 
     /// Joins and splits the stroke's fuse layers where it left them touching themselves
