@@ -247,7 +247,15 @@ impl<'a> StrokeInProgress<'a> {
     }
 
     /// Runs resampled `samples`, telling the kernels of them first where they may run ahead.
+    ///
+    /// They run on a thread of rayon's pool. A step's parallel parts (a few hundred
+    /// microseconds each) then share it with one more thread, where a caller outside the pool
+    /// would hand each of them over and sleep until it came back.
     fn run_samples(&mut self, samples: &[Sample]) -> SamplesReport {
+        rayon::scope(|_| self.run_samples_in_pool(samples))
+    }
+
+    fn run_samples_in_pool(&mut self, samples: &[Sample]) -> SamplesReport {
         let Some(active) = self.active.as_mut() else {
             return SamplesReport::default();
         };
