@@ -35,6 +35,12 @@ fn stroke_state<'a>(
     }
 }
 
+/// Runs `f` on a thread of rayon's pool, as the pipeline runs a stroke's steps
+/// (`StrokeInProgress::add_samples`); the hand-over costs some microseconds per call.
+fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| f())
+}
+
 fn phases(c: &mut Criterion) {
     let mesh = generate(&SceneSpec {
         kind: SceneKind::Plaster,
@@ -85,16 +91,20 @@ fn phases(c: &mut Criterion) {
     let mut group = c.benchmark_group("pipeline");
     group.sample_size(30);
     group.bench_function(format!("select ({} vertices)", selection.len()), |b| {
-        b.iter(|| select(&state, black_box(&mesh), &dab).len())
+        b.iter(|| in_pool(|| select(&state, black_box(&mesh), &dab).len()))
     });
     group.bench_function("deform", |b| {
-        b.iter(|| deform(&state, black_box(&mesh), &dab, &selection).len())
+        b.iter(|| in_pool(|| deform(&state, black_box(&mesh), &dab, &selection).len()))
     });
     let mut region = Region::default();
     group.bench_function("collide", |b| {
         b.iter_batched_ref(
             || mesh.clone(),
-            |m| collide(&state, &mut region, m, &selection, &targets, &target_of).clamped,
+            |m| {
+                in_pool(|| {
+                    collide(&state, &mut region, m, &selection, &targets, &target_of).clamped
+                })
+            },
             BatchSize::LargeInput,
         )
     });
@@ -153,7 +163,11 @@ fn collision_alone(c: &mut Criterion, kind: SceneKind, triangles: usize, brush: 
         group.bench_function(format!("{brush:?} {name}"), |b| {
             b.iter_batched_ref(
                 || mesh.clone(),
-                |m| collide(&state, &mut region, m, &selection, &targets, &target_of).clamped,
+                |m| {
+                    in_pool(|| {
+                        collide(&state, &mut region, m, &selection, &targets, &target_of).clamped
+                    })
+                },
                 BatchSize::LargeInput,
             )
         });
