@@ -98,6 +98,31 @@ proptest! {
     }
 }
 
+/// A stroke's samples run on a thread of rayon's pool, whoever calls: from outside any pool,
+/// from the only thread of a one-thread pool (run where it is), or from a pool of three, the
+/// CPU backend sculpts the same mesh bit for bit, and none of them waits on a thread it
+/// occupies itself.
+#[test]
+fn strokes_sculpt_the_same_mesh_whatever_thread_calls() {
+    let (start, strokes) = plaster_and_strokes(3_000, 4, 17);
+    let settings = PipelineSettings::default();
+    let outside = sculpt(&mut Pipeline::new(settings), &start, &strokes, Some(2));
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let inside =
+            pool.install(|| sculpt(&mut Pipeline::new(settings), &start, &strokes, Some(2)));
+        assert_identical(&outside, &inside, &format!("called in a pool of {threads}"));
+    }
+    assert!(
+        outside.positions() != start.positions(),
+        "the strokes moved nothing"
+    );
+    outside.validate().unwrap();
+}
+
 /// The resampler emits the same samples whatever the chunks it is fed in, and the same as
 /// `resample` over the whole polyline.
 #[test]
