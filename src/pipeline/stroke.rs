@@ -248,9 +248,10 @@ impl<'a> StrokeInProgress<'a> {
 
     /// Runs resampled `samples`, telling the kernels of them first where they may run ahead.
     ///
-    /// They run on a thread of rayon's pool. A step's parallel parts (a few hundred
-    /// microseconds each) then share it with one more thread, where a caller outside the pool
-    /// would hand each of them over and sleep until it came back.
+    /// They run on a thread of rayon's pool, so that a step's parallel parts (a few hundred
+    /// microseconds each) are split among the pool's threads from within it. Called from
+    /// outside the pool, each part was handed over while the caller slept until it came back:
+    /// 15–20 % of a sample on two cores.
     fn run_samples(&mut self, samples: &[Sample]) -> SamplesReport {
         rayon::scope(|_| self.run_samples_in_pool(samples))
     }
