@@ -292,9 +292,7 @@ fn crossings(
         if in_sheet(f) && region.single_layer() {
             return found;
         }
-        // A sheet's own faces are passed over, as in_sheet would pass each.
-        let skipped = in_sheet(f).then_some(layer);
-        region.candidates_along((tri_f, skipped), scratch, |local| {
+        region.candidates_along(tri_f, scratch, |local| {
             let g = region.faces[local];
             if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
                 return;

@@ -5,8 +5,6 @@
 //! gather the region's faces once through the hash and file their boxes in a small dense array
 //! (counting sort, no hashing), so a query reads only the few cells its own box covers.
 
-use std::ops::Range;
-
 use glam::{IVec3, Vec3};
 
 use crate::geom::{Aabb, Polygon};
@@ -240,45 +238,23 @@ impl LocalFaceGrid {
 
     /// Calls `f` with every local face filed in a cell overlapping `query` (a face may come
     /// more than once; callers deduplicate).
-    pub fn for_each_candidate(&self, query: &Aabb, f: impl FnMut(u32)) {
-        self.for_each_candidate_outside(query, 0..0, f);
-    }
-
-    /// [`LocalFaceGrid::for_each_candidate`] but the local faces of `skip`, passed over.
-    pub fn for_each_candidate_outside(
-        &self,
-        query: &Aabb,
-        skip: Range<u32>,
-        mut f: impl FnMut(u32),
-    ) {
+    pub fn for_each_candidate(&self, query: &Aabb, mut f: impl FnMut(u32)) {
         if self.offsets.is_empty() {
             return;
         }
         self.for_each_cell(self.cell_span(query), |c, _| {
-            self.cell_outside(c, &skip).for_each(&mut f);
+            for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                f(e);
+            }
         });
-    }
-
-    /// Cell `c`'s entries but those in `skip`: a cell lists its faces in ascending order (both
-    /// builds file them face by face), so those of `skip` are one run within it.
-    fn cell_outside(&self, c: usize, skip: &Range<u32>) -> impl Iterator<Item = u32> + '_ {
-        let entries = &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize];
-        let (before, after) = if skip.is_empty() {
-            (entries.len(), entries.len())
-        } else {
-            let below = |end: u32| entries.partition_point(|&e| e < end);
-            (below(skip.start), below(skip.end))
-        };
-        entries[..before].iter().chain(&entries[after..]).copied()
     }
 
     /// Calls `f` with every local face filed in a cell that `swept` (whose box is `query`)
     /// can pass through, as [`LocalFaceGrid::build_swept`] files faces (`cells` is scratch; a
     /// face may come more than once): what can meet a long face, without the whole of its box.
-    /// The local faces of `skip` are passed over.
     pub fn for_each_candidate_along(
         &self,
-        (query, skip): (&Aabb, Range<u32>),
+        query: &Aabb,
         swept: &SweptTriangle,
         cells: &mut Vec<u32>,
         mut f: impl FnMut(u32),
@@ -289,7 +265,10 @@ impl LocalFaceGrid {
         cells.clear();
         self.swept_cells(query, swept, cells);
         for &c in cells.iter() {
-            self.cell_outside(c as usize, &skip).for_each(&mut f);
+            let c = c as usize;
+            for &e in &self.entries[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                f(e);
+            }
         }
     }
 
@@ -435,49 +414,6 @@ mod tests {
                 box_cells += span.x * span.y * span.z;
             }
             prop_assert!(grid.entries.len() <= box_cells as usize);
-        }
-
-        /// A query that passes over a run of faces meets every other face exactly as often as
-        /// the whole query does, and none of the run, on both builds and along a face.
-        #[test]
-        fn a_query_passes_over_exactly_the_faces_skipped(
-            faces in prop::collection::vec(swept_face(), 1..24),
-            skip in (0u32..24, 0u32..24),
-            query in (point(1.0), point(0.5)),
-        ) {
-            let boxes: Vec<Aabb> = faces.iter().map(swept_box).collect();
-            let region = boxes.iter().fold(Aabb::EMPTY, |b, f| b.including_box(f));
-            let skip = skip.0.min(skip.1)..skip.0.max(skip.1);
-            let query = Aabb::of_points(&[query.0, query.0 + query.1]);
-            let counted = |visit: &mut dyn FnMut(&mut dyn FnMut(u32))| {
-                let mut met = vec![0usize; faces.len()];
-                visit(&mut |e| met[e as usize] += 1);
-                met
-            };
-            let outside = |met: Vec<usize>| -> Vec<usize> {
-                met.iter().enumerate()
-                    .map(|(i, &n)| if skip.contains(&(i as u32)) { 0 } else { n })
-                    .collect()
-            };
-            let mut grid = LocalFaceGrid::default();
-            for swept in [false, true] {
-                if swept {
-                    grid.build_swept(&boxes, &faces, region, 0.05);
-                } else {
-                    grid.build(&boxes, region, 0.05);
-                }
-                let all = counted(&mut |f| grid.for_each_candidate(&query, f));
-                let but = counted(&mut |f| grid.for_each_candidate_outside(&query, skip.clone(), f));
-                prop_assert_eq!(but, outside(all));
-                let along = SweptTriangle::at_rest(faces[0].corners);
-                let at = Aabb::of_points(&along.corners);
-                let met_along = |skip: Range<u32>| {
-                    let mut cells = Vec::new();
-                    counted(&mut |f| grid.for_each_candidate_along((&at, skip.clone()), &along, &mut cells, f))
-                };
-                prop_assert!(met_along(0..0)[0] > 0, "a face is not met along itself");
-                prop_assert_eq!(met_along(skip.clone()), outside(met_along(0..0)));
-            }
         }
     }
 

@@ -71,10 +71,6 @@ pub struct Region {
     pub(super) ready: bool,
     /// The layers of the region's faces, ascending.
     layers: Vec<u32>,
-    /// Per layer of `layers`: its run of local faces (the faces are grouped by layer).
-    spans: Vec<(u32, std::ops::Range<u32>)>,
-    /// Scratch for grouping the faces by layer.
-    grouped: Vec<u32>,
     /// The layers of the step's selection, ascending: those whose searches may be skipped.
     moving_layers: Vec<u32>,
     /// Per layer id: the region's faces of that layer as a sheet where the mesh is now, if
@@ -186,7 +182,6 @@ impl Region {
         }
         let face_layers = self.faces.iter().map(|&f| mesh.face_layers()[f as usize]);
         layers_among(mesh.layer_count(), face_layers, &mut self.layers);
-        self.group_by_layer(mesh);
         // Only a moving vertex's own layer is ever skipped: only those layers are tested.
         let moving = selection
             .iter()
@@ -199,44 +194,6 @@ impl Region {
         self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
         self.filed = false;
         self.changed.filed = false;
-    }
-
-    /// Orders the faces layer by layer, each layer's in the order they were met, so that a
-    /// layer's faces are one run of local indices: the local grid then lists each cell's
-    /// faces layer by layer, and a search that skips a layer passes over its run
-    /// ([`Region::candidates`]) instead of meeting each face and turning it away.
-    fn group_by_layer(&mut self, mesh: &Mesh) {
-        self.spans.clear();
-        let everything = 0..self.faces.len() as u32;
-        if let [layer] = self.layers[..] {
-            self.spans.push((layer, everything));
-            return;
-        }
-        let layers = mesh.face_layers();
-        let grouped = &mut self.grouped;
-        grouped.clear();
-        for &layer in &self.layers {
-            let start = grouped.len() as u32;
-            let of_layer = self.faces.iter().filter(|&&f| layers[f as usize] == layer);
-            grouped.extend(of_layer);
-            self.spans.push((layer, start..grouped.len() as u32));
-        }
-        std::mem::swap(&mut self.faces, grouped);
-        for (local, &f) in self.faces.iter().enumerate() {
-            self.local_index[f as usize] = local as u32;
-        }
-    }
-
-    /// The local faces of `layer`, in the order met.
-    pub(super) fn faces_of_layer(&self, layer: u32) -> &[u32] {
-        let span = self.span_of(Some(layer));
-        &self.faces[span.start as usize..span.end as usize]
-    }
-
-    /// The run of local indices of `layer`'s faces; empty for none.
-    fn span_of(&self, layer: Option<u32>) -> std::ops::Range<u32> {
-        let found = self.spans.iter().find(|(l, _)| Some(*l) == layer);
-        found.map_or(0..0, |(_, span)| span.clone())
     }
 
     /// Boxes the faces (around where each vertex starts the step and, if it moves, its
@@ -416,17 +373,17 @@ impl Region {
         self.changed.filed = false;
     }
 
-    /// The local faces [`Region::file_changed`] filed whose box overlaps `query`, each once
-    /// (the `skipped` layer's among them: few); [`Region::candidates`] when none were filed.
+    /// The local faces [`Region::file_changed`] filed whose box overlaps `query`, each once;
+    /// all of [`Region::candidates`] when none were filed.
     pub(super) fn changed_candidates(
         &self,
-        (query, skipped): (&Aabb, Option<u32>),
+        query: &Aabb,
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
         let changed = &self.changed;
         if !changed.filed {
-            return self.candidates((query, skipped), scratch, f);
+            return self.candidates(query, scratch, f);
         }
         if self.use_grid {
             scratch.seen.start(changed.faces.len());
@@ -448,21 +405,20 @@ impl Region {
     /// passes, each once: those that can cross it.
     pub(super) fn candidates_along(
         &self,
-        (triangle, skipped): ([Vec3; 3], Option<u32>),
+        triangle: [Vec3; 3],
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
         debug_assert!(self.filed, "a search before the faces were filed");
         let query = Aabb::of_points(&triangle);
         if !self.use_grid {
-            return self.candidates((&query, skipped), scratch, f);
+            return self.candidates(&query, scratch, f);
         }
         let swept = SweptTriangle::at_rest(triangle);
         scratch.seen.start(self.faces.len());
         let mut cells = std::mem::take(&mut scratch.cells);
-        let skip = self.span_of(skipped);
         self.grid
-            .for_each_candidate_along((&query, skip), &swept, &mut cells, |local| {
+            .for_each_candidate_along(&query, &swept, &mut cells, |local| {
                 if scratch.seen.insert(local as usize)
                     && self.boxes[local as usize].overlaps(&query)
                 {
@@ -472,18 +428,12 @@ impl Region {
         scratch.cells = cells;
     }
 
-    /// Local faces whose box overlaps `query`, each once, but those of the `skipped` layer.
-    pub(super) fn candidates(
-        &self,
-        (query, skipped): (&Aabb, Option<u32>),
-        scratch: &mut Scratch,
-        mut f: impl FnMut(usize),
-    ) {
+    /// Local faces whose box overlaps `query`, each once.
+    pub(super) fn candidates(&self, query: &Aabb, scratch: &mut Scratch, mut f: impl FnMut(usize)) {
         debug_assert!(self.filed, "a search before the faces were filed");
-        let skip = self.span_of(skipped);
         if self.use_grid {
             scratch.seen.start(self.faces.len());
-            self.grid.for_each_candidate_outside(query, skip, |local| {
+            self.grid.for_each_candidate(query, |local| {
                 if scratch.seen.insert(local as usize) && self.boxes[local as usize].overlaps(query)
                 {
                     f(local as usize);
@@ -491,7 +441,7 @@ impl Region {
             });
         } else {
             for (local, b) in self.boxes.iter().enumerate() {
-                if !skip.contains(&(local as u32)) && b.overlaps(query) {
+                if b.overlaps(query) {
                     f(local);
                 }
             }

@@ -54,12 +54,10 @@ pub fn pull_back(
     let mut nearby = std::mem::take(&mut scratch.nearby);
     nearby.clear();
     let gather = |local| nearby.push(local as u32);
-    // The own layer's faces are passed over where they are clear, as below.
-    let skipped = own_clear.then_some(own_layer);
     match changed {
         // Only the faces the last pass changed are tested: those filed apart, if they are.
-        Some(_) => region.changed_candidates((&query, skipped), scratch, gather),
-        None => region.candidates((&query, skipped), scratch, gather),
+        Some(_) => region.changed_candidates(&query, scratch, gather),
+        None => region.candidates(&query, scratch, gather),
     }
     let mut t = 1.0f32;
     for &local in &nearby {

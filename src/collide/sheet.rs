@@ -63,8 +63,8 @@ pub(super) fn find_sheets(
 ) -> Vec<Option<Sheet>> {
     let mut sheets = vec![None; mesh.layer_count()];
     for &layer in layers {
-        let faces = region.faces_of_layer(layer);
-        sheets[layer as usize] = sheet_of(state, mesh, region, faces);
+        let faces = faces_of_layer(mesh, region, layer);
+        sheets[layer as usize] = sheet_of(state, mesh, region, &faces);
     }
     sheets
 }
@@ -78,6 +78,20 @@ pub(crate) struct Sheet {
     pub(crate) clear: bool,
     /// Two unit vectors across the axis the sheet projects one-to-one along.
     frame: [DVec3; 2],
+}
+
+/// The region's faces of `layer`, in the region's order.
+pub(super) fn faces_of_layer<'r>(
+    mesh: &Mesh,
+    region: &'r Region,
+    layer: u32,
+) -> std::borrow::Cow<'r, [u32]> {
+    if region.single_layer() {
+        return std::borrow::Cow::Borrowed(&region.faces);
+    }
+    let layers = mesh.face_layers();
+    let faces = region.faces.iter().copied();
+    std::borrow::Cow::Owned(faces.filter(|&f| layers[f as usize] == layer).collect())
 }
 
 fn sheet_of(state: &StrokeState<'_>, mesh: &Mesh, region: &Region, faces: &[u32]) -> Option<Sheet> {
