@@ -251,7 +251,7 @@ impl<'a> StrokeInProgress<'a> {
     /// They run on a thread of rayon's pool, so that a step's parallel parts (a few hundred
     /// microseconds each) are split among the pool's threads from within it. Called from
     /// outside the pool, each part was handed over while the caller slept until it came back:
-    /// 15–20 % of a sample on two cores.
+    /// 10–20 % of a sample on two cores.
     fn run_samples(&mut self, samples: &[Sample]) -> SamplesReport {
         rayon::scope(|_| self.run_samples_in_pool(samples))
     }
