@@ -183,11 +183,8 @@ impl Mesh {
     fn check_rim(&self, patch: &Patch, on_rim: &[bool]) -> Result<(), PutBackError> {
         let copy = &patch.mesh;
         let copied = patch.sources.len();
-        let rim: rustc_hash::FxHashSet<u32> = (patch.sources.iter())
-            .zip(on_rim)
-            .filter_map(|(&v, &rim)| rim.then_some(v))
-            .collect();
         let local_on_rim = |l: u32| (l as usize) < copied && on_rim[l as usize];
+        let on_rim_in_mesh = |v: &u32| patch.copy_of(*v).is_some_and(local_on_rim);
         for f in 0..copy.face_count() {
             let now = copy.faces[f];
             let live = !copy.is_face_dead(f);
@@ -201,7 +198,7 @@ impl Mesh {
                 continue;
             };
             let was = self.faces[g as usize];
-            if !at_rim_now && !was.iter().any(|v| rim.contains(v)) {
+            if !at_rim_now && !was.iter().any(on_rim_in_mesh) {
                 continue;
             }
             let same = live

@@ -17,9 +17,7 @@ use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
 use crate::mesh::{INVALID, Mesh, MeshVersion, next, prev};
-use crate::remesh::{
-    RemeshReport, RemeshSets, RemeshSettings, remesh_region_culled, remesh_region_with,
-};
+use crate::remesh::{RemeshReport, RemeshSets, RemeshSettings, remesh_region_with};
 use crate::topology::{FuseSettings, TopologyReport, adapt};
 
 /// sLayer's Algorithm 2 over one mesh, on every backend: the loop, the exact backstop and
@@ -348,10 +346,7 @@ pub(super) fn remesh_touched(
         ..RemeshSettings::new(edge)
     };
     let since = mesh.version();
-    let (report, changed) = match culling {
-        Some(longest) => remesh_region_culled(mesh, grid, seeds, (&settings, longest), sets),
-        None => remesh_region_with(mesh, grid, seeds, &settings, sets),
-    };
+    let (report, changed) = remesh_region_with(mesh, grid, seeds, (&settings, culling), sets);
     kernels.remeshed(mesh, since, &changed);
     (report, changed)
 }

@@ -155,10 +155,8 @@ fn run_slabs(
     for wave in plan.waves() {
         let done =
             slabs::run_wave(mesh, (&plan, &wave), carried, round, progress).unwrap_or_else(|()| {
-                let cells: Vec<Cell> = (wave.iter())
-                    .flat_map(|&s| plan.cells_of(s).iter().cloned())
-                    .collect();
-                run_in_place(mesh, &cells, carried, round, progress)
+                let cells = wave.iter().flat_map(|&s| plan.cells_of(s));
+                run_in_place(mesh, cells, carried, round, progress)
             });
         report.add(&done);
     }
@@ -167,16 +165,16 @@ fn run_slabs(
 
 /// `cells` remeshed one after another in the mesh itself, with a grid of the mesh built for
 /// them.
-fn run_in_place(
+fn run_in_place<'c>(
     mesh: &mut Mesh,
-    cells: &[Cell],
+    cells: impl IntoIterator<Item = &'c Cell>,
     carried: &mut Carried,
     round: &Round<'_>,
     progress: &mut dyn FnMut(usize),
 ) -> RemeshReport {
     let mut grid = SpatialHash::build(mesh, round.grid_cell)
         .expect("the cell size was checked before the rounds");
-    let cells = cells.iter().map(|(_, core, seeds)| (core, seeds.clone()));
+    let cells = (cells.into_iter()).map(|(_, core, seeds)| (core, seeds.as_slice()));
     let mut sets = RemeshSets::default();
     let mut done = || progress(1);
     slabs::remesh_cells(

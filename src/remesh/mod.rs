@@ -154,39 +154,29 @@ pub fn remesh_region(
     seeds: &[u32],
     settings: &RemeshSettings,
 ) -> (RemeshReport, Vec<u32>) {
-    remesh_region_with(mesh, grid, seeds, settings, &mut RemeshSets::default())
+    let pass = (settings, None);
+    remesh_region_with(mesh, grid, seeds, pass, &mut RemeshSets::default())
 }
 
 /// [`remesh_region`] with sets kept from earlier passes: a pass then costs what its region
-/// does, never what the mesh does (a stroke on 16M faces remeshes as fast as on 250K).
+/// does, never what the mesh does (a stroke on 16M faces remeshes as fast as on 250K). Where
+/// `culling` gives the mesh's longest edge, a sheet zone settles the safety checks of the
+/// edits it vouches for where the region and everything within the zone's margin of it is
+/// one sheet of one layer (`zone`): a stroke on a single sheet need not pay for the checks a
+/// stack of layers needs.
 pub fn remesh_region_with(
     mesh: &mut Mesh,
     grid: &mut SpatialHash,
     seeds: &[u32],
-    settings: &RemeshSettings,
+    (settings, culling): (&RemeshSettings, Option<f32>),
     sets: &mut RemeshSets,
 ) -> (RemeshReport, Vec<u32>) {
-    remesh(
-        mesh,
-        grid,
-        seeds,
-        settings,
-        Pass::of_region(sets, Zoning::Off),
-    )
-}
-
-/// [`remesh_region_with`], letting a sheet zone settle the safety checks of its edits where
-/// the region and everything within the zone's margin of it is one sheet of one layer
-/// (`zone`): a stroke on a single sheet need not pay for the checks a stack of layers needs.
-/// `longest_edge` bounds every edge of the mesh.
-pub fn remesh_region_culled(
-    mesh: &mut Mesh,
-    grid: &mut SpatialHash,
-    seeds: &[u32],
-    (settings, longest_edge): (&RemeshSettings, f32),
-    sets: &mut RemeshSets,
-) -> (RemeshReport, Vec<u32>) {
-    let pass = Pass::of_region(sets, Zoning::Region(longest_edge));
+    let pass = Pass {
+        start: Start::OutOfBand,
+        sets,
+        closed: None,
+        zone: culling.map_or(Zoning::Off, Zoning::Region),
+    };
     remesh(mesh, grid, seeds, settings, pass)
 }
 
@@ -218,7 +208,7 @@ pub struct RemeshSets {
     in_region: Stamps,
     dirty: Stamps,
     movable: Stamps,
-    /// The sets a region's sheet zone is found with ([`remesh_region_culled`]).
+    /// The sets a region's sheet zone is found with ([`remesh_region_with`]).
     zones: zone::ZoneFinder,
 }
 
@@ -251,18 +241,6 @@ struct Pass<'s> {
     closed: Option<&'s mut ClosedParts>,
     /// Which sheet zone vouches for the pass's edits.
     zone: Zoning,
-}
-
-impl<'s> Pass<'s> {
-    /// A stroke's pass over the region around what it moved, starting out of band.
-    fn of_region(sets: &'s mut RemeshSets, zone: Zoning) -> Self {
-        Pass {
-            start: Start::OutOfBand,
-            sets,
-            closed: None,
-            zone,
-        }
-    }
 }
 
 /// Which sheet zone vouches for a pass's edits, sparing them their safety checks (`zone`).

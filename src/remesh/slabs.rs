@@ -58,9 +58,9 @@ pub(super) struct Carried {
 /// Remeshes `cells` (a box and its seeds each) one after another in `mesh`, indexed by
 /// `grid`; `done` hears of each cell. The same loop runs a round in place and a slab in its
 /// copy.
-pub(super) fn remesh_cells<'c>(
+pub(super) fn remesh_cells<'c, Seeds: AsRef<[u32]>>(
     (mesh, grid): (&mut Mesh, &mut SpatialHash),
-    cells: impl Iterator<Item = (&'c Aabb, Vec<u32>)>,
+    cells: impl Iterator<Item = (&'c Aabb, Seeds)>,
     (sets, carried): (&mut RemeshSets, &mut Carried),
     round: &Round<'_>,
     done: &mut dyn FnMut(),
@@ -79,7 +79,7 @@ pub(super) fn remesh_cells<'c>(
             closed: Some(&mut carried.closed),
             zone: Zoning::Cell(zone),
         };
-        let (pass_report, _) = remesh(mesh, grid, &seeds, settings, pass);
+        let (pass_report, _) = remesh(mesh, grid, seeds.as_ref(), settings, pass);
         carried.longest = carried.longest.max(pass_report.longest_edge);
         report.add(&pass_report);
         done();
