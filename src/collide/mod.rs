@@ -28,7 +28,8 @@ pub use intersections::{
 pub use local_grid::{LocalFaceGrid, SweptTriangle};
 pub use region::{Region, Scratch, StepMoves};
 pub use response::{
-    CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, collide, collide_with, pull_back,
+    CollisionOutcome, MAX_PASSES, clamp_in_region, clamp_moves, clamp_on_a_clear_sheet, collide,
+    collide_with, lies_on_a_clear_sheet, pull_back,
 };
 pub use rings::RingCache;
 pub(crate) use sheet::{boundary_loop, normal_cone, projected_loop_is_simple, rim_loop};

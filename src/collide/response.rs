@@ -268,6 +268,67 @@ pub fn clamp_in_region(
     Backstop::Search
 }
 
+/// The first phase of a step whose region is one layer, a clear sheet where the moves end
+/// (`super::sheet`): the targets placed and nothing pulled back, which is what
+/// [`clamp_moves`] leaves there (each [`pull_back`] finds nothing), at the cost of the
+/// region's gathering and the sheet test alone. Returns whether it was so; if not, the
+/// selection is back at `before` and the region gathered for the passes to run elsewhere.
+/// For backends whose proximity passes run off the CPU (the GPU's): they skip them where the
+/// CPU's would have skipped every search.
+pub fn clamp_on_a_clear_sheet(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &mut Mesh,
+    (selection, targets, _): StepMoves<'_>,
+    before: &[Vec3],
+) -> bool {
+    if !state.cull || selection.is_empty() {
+        return false;
+    }
+    region.gather_unfiled(state, mesh, selection, targets);
+    place(mesh, selection, targets);
+    if is_a_clear_sheet_alone(state, region, mesh) {
+        return true;
+    }
+    place(mesh, selection, before);
+    region.positions_changed();
+    false
+}
+
+/// Whether the step's region, gathered around the selection where it is now and its
+/// `targets`, is one layer and a clear sheet where the mesh is now; the region is left
+/// ungathered. For a backend that ran the passes elsewhere to guess whether the next step's
+/// may be skipped ([`clamp_on_a_clear_sheet`]).
+pub fn lies_on_a_clear_sheet(
+    state: &StrokeState<'_>,
+    region: &mut Region,
+    mesh: &Mesh,
+    (selection, targets): (&[(u32, f32)], &[Vec3]),
+) -> bool {
+    if !state.cull || selection.is_empty() {
+        return false;
+    }
+    region.gather_unfiled(state, mesh, selection, targets);
+    let clear = is_a_clear_sheet_alone(state, region, mesh);
+    region.forget();
+    clear
+}
+
+/// Whether the gathered region is one layer, a clear sheet where the mesh is now.
+fn is_a_clear_sheet_alone(state: &StrokeState<'_>, region: &mut Region, mesh: &Mesh) -> bool {
+    region.positions_changed();
+    region.find_sheets(state, mesh);
+    !region.worth_searching_near()
+}
+
+/// Writes `at` as the positions of the `selection`'s vertices.
+fn place(mesh: &mut Mesh, selection: &[(u32, f32)], at: &[Vec3]) {
+    let positions = mesh.positions_mut();
+    for (&(v, _), &p) in selection.iter().zip(at) {
+        positions[v as usize] = p;
+    }
+}
+
 /// The first phase of [`collide`] (sLayer's narrow phase and response): the selection moved to
 /// its targets, then Jacobi passes of [`pull_back`] until none pulls a vertex back. `before`
 /// holds each selected vertex's start; the positions are left in `mesh`.
@@ -279,12 +340,7 @@ pub fn clamp_moves(
     before: &[Vec3],
 ) {
     let (selection, targets, _) = moves;
-    {
-        let positions = mesh.positions_mut();
-        for (&(v, _), &q) in selection.iter().zip(targets) {
-            positions[v as usize] = q;
-        }
-    }
+    place(mesh, selection, targets);
     region.positions_changed();
     region.forget_changed();
 

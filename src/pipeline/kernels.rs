@@ -227,6 +227,12 @@ pub struct Uploads {
     /// host's check of the move or the edges disagreed with the gate's).
     pub clamped_ahead: usize,
     pub dropped_ahead: usize,
+    /// Steps whose proximity passes were skipped, their region one layer and a clear sheet
+    /// where the moves end (`collide::clamp_on_a_clear_sheet`: the CPU's clamp would have
+    /// searched nothing either), and steps recorded ahead without passes on that expectation
+    /// whose region proved otherwise (their passes ran apart).
+    pub skipped_passes: usize,
+    pub passes_needed: usize,
     /// Steps whose passes ran ahead and the GPU's gate stopped before they moved anything
     /// (`sample_gate`; a run stops there): their selection outgrew its room, a ring its room, a
     /// vertex moved farther or an edge grew longer than the passes were sized for.

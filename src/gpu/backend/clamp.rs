@@ -33,6 +33,9 @@ pub(super) struct ClampedAhead {
     /// One per selected vertex.
     pub(super) finals: Vec<Vec3>,
     pub(super) backstop: Backstop,
+    /// No passes ran: the finals are the targets, to be taken only where the host finds the
+    /// step's region one layer and a clear sheet there (`collide::clamp_on_a_clear_sheet`).
+    pub(super) without_passes: bool,
 }
 
 /// How a step's proximity passes are sized: `count` slots of the step's moving list, no move
@@ -46,6 +49,9 @@ pub(super) struct PassBounds<'a> {
     /// How far any vertex may be from where the table filed it.
     pub(super) drift: f32,
     pub(super) counted_by: Option<&'a wgpu::Buffer>,
+    /// The targets placed and gathered as finals, no passes nor filter between
+    /// ([`AheadBounds::skip_passes`](super::select_deform::AheadBounds)).
+    pub(super) skip_passes: bool,
 }
 
 impl GpuKernels {
@@ -94,6 +100,7 @@ impl GpuKernels {
             },
             drift: r.hashed().drift,
             counted_by: None,
+            skip_passes: false,
         };
         step.reserve_clamp(gpu, count, filter)?;
         let mut encoder = gpu.encoder("clamp");
@@ -247,8 +254,10 @@ pub(super) fn record_clamp(
         &ApplyParams::new(count, ApplyMode::Place),
         None,
     )?;
-    let passes = (&params(true), &params(false));
-    record_passes(gpu, encoder, step, (&proximity, &apply), passes, bounds)?;
+    if !bounds.skip_passes {
+        let passes = (&params(true), &params(false));
+        record_passes(gpu, encoder, step, (&proximity, &apply), passes, bounds)?;
+    }
     record_apply_moves(
         gpu,
         encoder,
@@ -257,16 +266,18 @@ pub(super) fn record_clamp(
         None,
     )?;
     let finals_bytes = (count * std::mem::size_of::<Vec3>()) as u64;
-    if !filter {
+    if !filter || bounds.skip_passes {
         return Ok(ClampRead {
             finals_bytes,
             pair_bytes: None,
+            without_passes: bounds.skip_passes,
         });
     }
     let pair_bytes = record_filter(gpu, encoder, (r, step), (&proximity, &apply), state, bounds)?;
     Ok(ClampRead {
         finals_bytes,
         pair_bytes: Some(pair_bytes),
+        without_passes: false,
     })
 }
 

@@ -47,7 +47,10 @@ use resident::{CopyScope, Resident};
 use step_buffers::StepBuffers;
 
 use crate::brush::Dab;
-use crate::collide::{Backstop, Region, StepMoves, StrokeState, clamp_in_region};
+use crate::collide::{
+    Backstop, Region, StepMoves, StrokeState, clamp_in_region, clamp_on_a_clear_sheet,
+    lies_on_a_clear_sheet,
+};
 use crate::gpu::reusable::ReusableBuffer;
 use crate::gpu::{AdapterSummary, GpuContext, GpuError, GpuOptions};
 use crate::mesh::{Mesh, MeshVersion};
@@ -87,6 +90,16 @@ pub struct GpuKernels {
     ahead: Option<ClampedAhead>,
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
+    /// What the host's last sheet test found (`collide::clamp_on_a_clear_sheet`): the step's
+    /// region one layer and a clear sheet. While it holds, steps are recorded ahead without
+    /// their proximity passes, and each is tested before it is taken. Before the first test
+    /// on a mesh it holds for a mesh of one layer: a run recorded without passes that needed
+    /// them costs a read-back more, one recorded with passes that needed none costs them
+    /// (on lavapipe, the plane bench's runs took eleven times as long with them).
+    expect_clear: bool,
+    /// Steps taken with passes since the last sheet test: one is tested every
+    /// [`SHEET_TEST_EVERY`], so that the expectation follows the stroke.
+    untested_steps: usize,
     /// How much a run's later samples assume the edges grow per sample before them, as a
     /// share of the assumed move: raised by runs that measured more on this mesh
     /// (`RunShape::next_edge_growth`).
@@ -122,6 +135,11 @@ pub struct GpuKernels {
     /// Read-backs the checks made, left out of [`Uploads::read_backs`].
     check_read_backs: usize,
 }
+
+/// While no clear sheet is expected, steps are tested for one one in this many (and the first
+/// of each stroke): the region gathered on the CPU, which the backstop's filter on the GPU
+/// otherwise spares, paid for an eighth of the steps.
+const SHEET_TEST_EVERY: usize = 8;
 
 /// A sample start the pipeline may go on to deform in several steps.
 #[derive(Debug, Clone, Copy)]
@@ -206,6 +224,8 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
+            expect_clear: false,
+            untested_steps: SHEET_TEST_EVERY,
             edge_growth: run_record::EDGE_GROWTH_LEAST,
             step_limit: None,
             opened: None,
@@ -312,6 +332,83 @@ impl GpuKernels {
             .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
     }
 
+    /// Whether steps recorded ahead now leave out their passes: the last sheet test found a
+    /// clear sheet alone, and the stroke culls.
+    fn skips_passes(&self, state: &StrokeState<'_>) -> bool {
+        self.expect_clear && state.cull
+    }
+
+    /// Whether a step whose passes are still to run is one to test for a clear sheet alone:
+    /// every one while such a sheet is expected, else one in [`SHEET_TEST_EVERY`].
+    fn sheet_test_due(&mut self) -> bool {
+        self.untested_steps += 1;
+        self.expect_clear || self.untested_steps >= SHEET_TEST_EVERY
+    }
+
+    /// The first phase of a step where its region is one layer and a clear sheet at the
+    /// targets (`collide::clamp_on_a_clear_sheet`), skipping the passes there; remembers
+    /// what it found for the steps after it.
+    fn sheet_test(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &mut Region,
+        mesh: &mut Mesh,
+        moves: StepMoves<'_>,
+        before: &[Vec3],
+    ) -> bool {
+        self.untested_steps = 0;
+        let current = |r: &Resident, mesh: &Mesh| r.version.positions == mesh.version().positions;
+        let was_current = self.resident.as_ref().is_some_and(|r| current(r, mesh));
+        self.expect_clear = clamp_on_a_clear_sheet(state, region, mesh, moves, before);
+        self.uploads.skipped_passes += usize::from(self.expect_clear);
+        if let Some(r) = self
+            .resident
+            .as_mut()
+            .filter(|_| was_current && !self.expect_clear)
+        {
+            // The test put the selection back where it was: the copy is as current as before
+            // (else the next call would send every position and file them anew).
+            r.version.positions = mesh.version().positions;
+        }
+        self.expect_clear
+    }
+
+    /// After passes that ran ahead: whether the region where they left the selection is one
+    /// layer and a clear sheet, for the steps after it (`collide::lies_on_a_clear_sheet`).
+    fn test_for_a_clear_sheet(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &mut Region,
+        mesh: &Mesh,
+        moved: (&[(u32, f32)], &[Vec3]),
+    ) {
+        self.untested_steps = 0;
+        self.expect_clear = lies_on_a_clear_sheet(state, region, mesh, moved);
+    }
+
+    /// Takes the passes run ahead for exactly the pipeline's moves: their final positions into
+    /// `mesh`, and what they left the backstop; every [`SHEET_TEST_EVERY`] steps a sheet test
+    /// where they left the selection, a guide for the steps after it.
+    fn take_ahead(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &mut Region,
+        mesh: &mut Mesh,
+        (selection, ahead): (&[(u32, f32)], ClampedAhead),
+    ) -> Backstop {
+        self.uploads.clamped_ahead += 1;
+        tally(&mut self.filter, &ahead.backstop, self.backstop_on_gpu);
+        let positions = mesh.positions_mut();
+        for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
+            positions[v as usize] = p;
+        }
+        if self.sheet_test_due() {
+            self.test_for_a_clear_sheet(state, region, mesh, (selection, &ahead.targets));
+        }
+        self.taken = Some((ahead.vertices, ahead.finals));
+        ahead.backstop
+    }
+
     /// `run`'s result, unless the GPU was given up before or fails now (then given up for
     /// good): the caller falls back to the CPU on `None`.
     fn on_gpu<T>(&mut self, run: impl FnOnce(&mut GpuKernels) -> Result<T, GpuError>) -> Option<T> {
@@ -342,12 +439,15 @@ impl StepKernels for GpuKernels {
     }
 
     fn warm_up(&mut self, mesh: &Mesh, cell_size: f32) {
+        // A stroke's first step is tested for a clear sheet: the last stroke's may be elsewhere.
+        self.untested_steps = SHEET_TEST_EVERY;
         // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
             // With no copy of a mesh yet: once, not before every stroke.
             if k.resident.is_none() {
                 k.compile_kernels()?;
+                k.expect_clear = mesh.layer_count() == 1;
             }
             let tables = (&mut k.resident, &mut k.uploads);
             GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present)?;
@@ -488,22 +588,33 @@ impl StepKernels for GpuKernels {
                     .map(|&(v, _)| v)
                     .eq(ahead.vertices.iter().copied())
         });
-        match self.ahead.take() {
-            Some(ahead) if same => {
-                self.uploads.clamped_ahead += 1;
-                tally(&mut self.filter, &ahead.backstop, self.backstop_on_gpu);
-                let positions = mesh.positions_mut();
-                for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
-                    positions[v as usize] = p;
+        let mut tested = false;
+        if let Some(ahead) = self.ahead.take() {
+            if same && !ahead.without_passes {
+                return self.take_ahead(state, region, mesh, (selection, ahead));
+            }
+            if same {
+                // Recorded without passes: right where the region is a clear sheet alone.
+                tested = true;
+                if self.sheet_test(state, region, mesh, moves, before) {
+                    self.uploads.clamped_ahead += 1;
+                    self.taken = Some((ahead.vertices, ahead.finals));
+                    return Backstop::Search;
                 }
-                self.taken = Some((ahead.vertices, ahead.finals));
-                return ahead.backstop;
+                self.uploads.passes_needed += 1;
             }
-            // Passes run ahead for other moves: dropped, with the samples queued after them.
-            not_these => {
-                self.ahead = not_these;
-                self.drop_ahead(mesh);
-            }
+            // Passes run ahead for other moves, or skipped where they were needed: dropped,
+            // with the samples queued after them.
+            self.ahead = Some(ahead);
+            self.drop_ahead(mesh);
+        }
+        if self.proximity_on_gpu
+            && self.failed.is_none()
+            && !tested
+            && self.sheet_test_due()
+            && self.sheet_test(state, region, mesh, moves, before)
+        {
+            return Backstop::Search;
         }
         if self.proximity_on_gpu
             && let Some((finals, backstop)) =

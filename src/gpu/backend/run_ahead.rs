@@ -146,6 +146,7 @@ impl GpuKernels {
         let count = calls.len();
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
+        let skip_passes = self.skips_passes(state);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
@@ -185,6 +186,7 @@ impl GpuKernels {
                 assumed_move,
                 drift,
                 split: GateSplit::default(),
+                skip_passes,
             },
             filter,
             limit,
@@ -322,6 +324,7 @@ impl GpuKernels {
                     targets: read.targets,
                     finals,
                     backstop,
+                    without_passes: layouts[j].clamp.is_some_and(|c| c.without_passes),
                 });
             }
             self.queued.push_back(queued);

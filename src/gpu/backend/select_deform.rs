@@ -176,6 +176,7 @@ impl GpuKernels {
         assumed_move: Option<f32>,
     ) -> Result<SubmittedSample, GpuError> {
         let filter = self.backstop_on_gpu;
+        let skip_passes = self.skips_passes(state);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
@@ -208,6 +209,7 @@ impl GpuKernels {
             assumed_move,
             drift: r.hashed().drift,
             split: GateSplit::default(),
+            skip_passes,
         });
         if ahead.is_some() {
             step.start_gate(gpu, state.max_edge);
@@ -264,6 +266,7 @@ impl GpuKernels {
                     targets: targets.clone(),
                     finals: permuted(order, &finals),
                     backstop,
+                    without_passes: clamp_read.without_passes,
                 });
             }
             // Nothing selected: nothing moved, nothing to drop.
@@ -312,6 +315,10 @@ pub(super) struct AheadBounds {
     pub(super) assumed_move: f32,
     pub(super) drift: f32,
     pub(super) split: GateSplit,
+    /// Record no passes, on the expectation that the step's region is one layer and a clear
+    /// sheet where its moves end (the targets placed and gathered as finals): the host checks
+    /// it before it takes them ([`ClampedAhead::without_passes`]).
+    pub(super) skip_passes: bool,
 }
 
 /// Where a recorded call's brush frame comes from.
@@ -531,6 +538,7 @@ fn record_ahead_passes<'b>(
         assumed_move,
         drift,
         split,
+        ..
     } = ahead;
     let Some(topology) = &r.topology else {
         unreachable!("the caller made the topology resident");
@@ -567,6 +575,7 @@ fn record_ahead_passes<'b>(
         moved_edge: state.max_edge + 2.0 * assumed_move,
         drift,
         counted_by: Some(&r.selection.count),
+        skip_passes: ahead.skip_passes,
     };
     let read = record_clamp(gpu, encoder, (r, step), state, &bounds, filter)?;
     parts.push((&step.ring_overflows, 4));
