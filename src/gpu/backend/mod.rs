@@ -91,12 +91,18 @@ pub struct GpuKernels {
     /// The longest move of the last deformation read back (zero before the first).
     last_move: f32,
     /// What the host's last sheet test found (`collide::clamp_on_a_clear_sheet`): the step's
-    /// region one layer and a clear sheet. While it holds, steps are recorded ahead without
-    /// their proximity passes, and each is tested before it is taken. Before the first test
-    /// on a mesh it holds for a mesh of one layer: a run recorded without passes that needed
-    /// them costs a read-back more, one recorded with passes that needed none costs them
-    /// (on lavapipe, the plane bench's runs took eleven times as long with them).
+    /// region one layer and a clear sheet. While it holds on a mesh of one layer, steps are
+    /// recorded ahead without their proximity passes, and each is tested before it is taken.
+    /// It holds before the first test: a run recorded without passes that needed them costs
+    /// a read-back more, one recorded with passes that needed none costs them (on lavapipe,
+    /// the plane bench's runs took eleven times as long with them).
     expect_clear: bool,
+    /// The mesh of the stroke under way has one layer. Among several, a region of one layer
+    /// alone and clear lasts a step or two: at 600 faces, 16 strokes, plaster, bark and metal
+    /// each had one step recorded ahead without passes that needed them, and none that did
+    /// not, and their strokes read back 10-13 % more for it. There steps ahead keep their passes,
+    /// and only steps whose passes run apart are tested.
+    one_layer: bool,
     /// Steps taken with passes since the last sheet test: one is tested every
     /// [`SHEET_TEST_EVERY`], so that the expectation follows the stroke.
     untested_steps: usize,
@@ -224,7 +230,8 @@ impl GpuKernels {
             filter: BackstopFilter::default(),
             ahead: None,
             last_move: 0.0,
-            expect_clear: false,
+            expect_clear: true,
+            one_layer: false,
             untested_steps: SHEET_TEST_EVERY,
             edge_growth: run_record::EDGE_GROWTH_LEAST,
             step_limit: None,
@@ -333,9 +340,9 @@ impl GpuKernels {
     }
 
     /// Whether steps recorded ahead now leave out their passes: the last sheet test found a
-    /// clear sheet alone, and the stroke culls.
+    /// clear sheet alone on a mesh of one layer, and the stroke culls.
     fn skips_passes(&self, state: &StrokeState<'_>) -> bool {
-        self.expect_clear && state.cull
+        self.expect_clear && self.one_layer && state.cull
     }
 
     /// Whether a step whose passes are still to run is one to test for a clear sheet alone:
@@ -402,7 +409,7 @@ impl GpuKernels {
         for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
             positions[v as usize] = p;
         }
-        if self.sheet_test_due() {
+        if self.one_layer && self.sheet_test_due() {
             self.test_for_a_clear_sheet(state, region, mesh, (selection, &ahead.targets));
         }
         self.taken = Some((ahead.vertices, ahead.finals));
@@ -441,13 +448,13 @@ impl StepKernels for GpuKernels {
     fn warm_up(&mut self, mesh: &Mesh, cell_size: f32) {
         // A stroke's first step is tested for a clear sheet: the last stroke's may be elsewhere.
         self.untested_steps = SHEET_TEST_EVERY;
+        self.one_layer = mesh.layer_count() == 1;
         // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
             // With no copy of a mesh yet: once, not before every stroke.
             if k.resident.is_none() {
                 k.compile_kernels()?;
-                k.expect_clear = mesh.layer_count() == 1;
             }
             let tables = (&mut k.resident, &mut k.uploads);
             GpuKernels::prepare(&k.gpu, tables, mesh, cell_size, TableUse::Present)?;
