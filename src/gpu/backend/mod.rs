@@ -142,8 +142,8 @@ pub struct GpuKernels {
     check_read_backs: usize,
 }
 
-/// While no clear sheet is expected, steps are tested for one one in this many (and the first
-/// of each stroke): the region gathered on the CPU, which the backstop's filter on the GPU
+/// While no clear sheet is expected, one step in this many is tested for one (and the first of
+/// each stroke): the region gathered on the CPU, which the backstop's filter on the GPU
 /// otherwise spares, paid for an eighth of the steps.
 const SHEET_TEST_EVERY: usize = 8;
 
