@@ -7,6 +7,9 @@
 //! acts where a sheet's bound on proximity fails, vertex by vertex, and the narrow groove
 //! that a vertex's own bound still lets its sheet's other wall be found.
 
+mod common;
+
+use common::reshaped;
 use glam::Vec3;
 use slayer::bench::{BrushMix, ScriptSpec, generate_script};
 use slayer::brush::{Brush, BrushKind, Falloff, Sample, Stroke};
@@ -142,18 +145,6 @@ fn draw(
             })
             .collect(),
     }
-}
-
-/// Moves every vertex of `mesh` by `shape`, given its position in the unit square.
-fn reshaped(mut mesh: Mesh, shape: impl Fn(f32, f32) -> Vec3) -> Mesh {
-    let (lo, hi) = mesh.bounds().unwrap();
-    let size = hi - lo;
-    for p in mesh.positions_mut() {
-        let (u, v) = ((p.x - lo.x) / size.x, (p.y - lo.y) / size.y);
-        *p = shape(u, v);
-    }
-    mesh.recompute_normals();
-    mesh
 }
 
 #[test]

@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::reshaped;
 use glam::Vec3;
 use slayer::bench::{BrushMix, ScriptSpec, generate_script};
 use slayer::brush::{BrushKind, Stroke};
@@ -23,18 +24,6 @@ fn plane(triangles: usize) -> Mesh {
         seed: 3,
     })
     .unwrap()
-}
-
-/// Moves every vertex of `mesh` by `shape`, given its position in the unit square.
-fn reshaped(mut mesh: Mesh, shape: impl Fn(f32, f32) -> Vec3) -> Mesh {
-    let (lo, hi) = mesh.bounds().unwrap();
-    let size = hi - lo;
-    for p in mesh.positions_mut() {
-        let (u, v) = ((p.x - lo.x) / size.x, (p.y - lo.y) / size.y);
-        *p = shape(u, v);
-    }
-    mesh.recompute_normals();
-    mesh
 }
 
 /// A draw on layer 0 of `radius` at full strength through `positions`, pushing along

@@ -122,6 +122,23 @@ pub fn crossing_edges(h: f32) -> (slayer::mesh::Mesh, slayer::brush::Stroke) {
     (mesh, stroke)
 }
 
+/// `mesh` (a plane, say) with every vertex moved by `shape`, given its position in the unit
+/// square of the mesh's x and y extent: the folded, ridged and grooved sheets of the culling
+/// tests.
+pub fn reshaped(
+    mut mesh: slayer::mesh::Mesh,
+    shape: impl Fn(f32, f32) -> glam::Vec3,
+) -> slayer::mesh::Mesh {
+    let (lo, hi) = mesh.bounds().unwrap();
+    let size = hi - lo;
+    for p in mesh.positions_mut() {
+        let (u, v) = ((p.x - lo.x) / size.x, (p.y - lo.y) / size.y);
+        *p = shape(u, v);
+    }
+    mesh.recompute_normals();
+    mesh
+}
+
 /// Points from `from` to `to`, `count` of them, ends included: a stroke's path.
 pub fn line(from: glam::Vec3, to: glam::Vec3, count: usize) -> Vec<glam::Vec3> {
     (0..count)
