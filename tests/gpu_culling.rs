@@ -209,7 +209,7 @@ fn where_a_sheet_meets_itself_the_gpu_runs_its_passes() {
     });
     let into_the_far_wall = |depth: f32| {
         let to = |k: usize| Vec3::new(0.485, 0.4 + 0.2 * ((k % 8) as f32 / 7.0), depth);
-        draw(0.03, (0..24).map(to), Vec3::X)
+        draw(0.03, (0..16).map(to), Vec3::X)
     };
     let strokes: Vec<Stroke> = [-0.13, -0.12].map(into_the_far_wall).into();
     let Culled {
