@@ -21,6 +21,9 @@
 //! are known. The proximity passes run here on hardware adapters; see [`GpuKernels::new`].
 //! There, several samples of a stroke run ahead in one submission (`run_ahead`), while the
 //! pipeline takes them as predicted.
+//! Where a step's region is one layer and a clear sheet, the CPU's clamp would search nothing,
+//! and no passes run: the host's sheet test decides (`collide::clamp_on_a_clear_sheet`), and
+//! on a mesh of one layer steps recorded ahead leave their passes out while it last held.
 //!
 //! A GPU that fails mid-stroke (device lost, an allocation refused, a buffer past the
 //! adapter's limits, a mesh past our memory budget) is not fatal: the kernels keep why and

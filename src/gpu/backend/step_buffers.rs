@@ -172,6 +172,7 @@ impl StepBuffers {
 pub(super) struct ClampRead {
     pub(super) finals_bytes: u64,
     pub(super) pair_bytes: Option<u64>,
-    /// The finals are the targets: no passes ran ([`PassBounds::skip_passes`](super::clamp::PassBounds)).
+    /// The finals are the targets: no passes ran
+    /// ([`PassBounds::skip_passes`](super::clamp::PassBounds)).
     pub(super) without_passes: bool,
 }
