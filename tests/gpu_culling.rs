@@ -76,8 +76,8 @@ fn run(mut pipeline: Pipeline, mesh: &Mesh, strokes: &[Stroke]) -> Run {
 }
 
 /// A pipeline with the proximity passes on the GPU (a software adapter leaves them on the CPU
-/// by default), runs ahead as given.
-fn on_gpu(settings: PipelineSettings, runs_ahead: bool) -> Pipeline {
+/// by default), runs ahead as given, and whether its adapter is a software one.
+fn on_gpu(settings: PipelineSettings, runs_ahead: bool) -> (Pipeline, bool) {
     let gpu = GpuContext::new(AdapterChoice {
         allow_software: true,
     })
@@ -85,7 +85,11 @@ fn on_gpu(settings: PipelineSettings, runs_ahead: bool) -> Pipeline {
     let mut kernels = GpuKernels::new(gpu);
     kernels.set_proximity_on_gpu(true);
     kernels.set_run_ahead(runs_ahead);
-    Pipeline::with_kernels(settings, Box::new(kernels))
+    let software = kernels.adapter().software;
+    (
+        Pipeline::with_kernels(settings, Box::new(kernels)),
+        software,
+    )
 }
 
 /// What the culled runs on the GPU counted, runs ahead off and on, beside the CPU's run.
@@ -106,14 +110,11 @@ fn assert_gpu_culls_as_the_cpu(name: &str, mesh: &Mesh, strokes: &[Stroke]) -> C
         ..PipelineSettings::default()
     };
     let on_cpu = run(Pipeline::new(settings(true)), mesh, strokes);
-    let software = GpuContext::new(AdapterChoice {
-        allow_software: true,
-    })
-    .is_ok_and(|gpu| gpu.adapter.software);
     let mut culled = Vec::new();
     for (cull, runs_ahead) in [(true, false), (true, true), (false, false)] {
         let label = format!("{name}, culled {cull}, runs ahead {runs_ahead}");
-        let on_gpu = run(on_gpu(settings(cull), runs_ahead), mesh, strokes);
+        let (pipeline, software) = on_gpu(settings(cull), runs_ahead);
+        let on_gpu = run(pipeline, mesh, strokes);
         let uploads = on_gpu.uploads.expect("GPU kernels keep a copy");
         let deviation = (on_cpu.mesh.positions().iter())
             .zip(on_gpu.mesh.positions())

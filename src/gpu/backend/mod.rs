@@ -100,12 +100,6 @@ pub struct GpuKernels {
     /// a read-back more, one recorded with passes that needed none costs them (on lavapipe,
     /// the plane bench's runs took eleven times as long with them).
     expect_clear: bool,
-    /// The mesh of the stroke under way has one layer. Among several, a region of one layer
-    /// alone and clear lasts a step or two: at 600 faces, 16 strokes, plaster, bark and metal
-    /// each had one step recorded ahead without passes that needed them, and none that did
-    /// not, and their strokes read back 10-13 % more for it. There steps ahead keep their passes,
-    /// and only steps whose passes run apart are tested.
-    one_layer: bool,
     /// Steps taken with passes since the last sheet test: one is tested every
     /// [`SHEET_TEST_EVERY`], so that the expectation follows the stroke.
     untested_steps: usize,
@@ -234,7 +228,6 @@ impl GpuKernels {
             ahead: None,
             last_move: 0.0,
             expect_clear: true,
-            one_layer: false,
             untested_steps: SHEET_TEST_EVERY,
             edge_growth: run_record::EDGE_GROWTH_LEAST,
             step_limit: None,
@@ -342,10 +335,14 @@ impl GpuKernels {
             .unwrap_or_else(|| CpuKernels.select_and_deform(state, mesh, dab, how))
     }
 
-    /// Whether steps recorded ahead now leave out their passes: the last sheet test found a
-    /// clear sheet alone on a mesh of one layer, and the stroke culls.
-    fn skips_passes(&self, state: &StrokeState<'_>) -> bool {
-        self.expect_clear && self.one_layer && state.cull
+    /// Whether steps recorded ahead on `mesh` now leave out their passes: the last sheet test
+    /// found a clear sheet alone, the stroke culls, and the mesh has one layer. Among several,
+    /// a region of one layer alone and clear lasts a step or two: at 600 faces, 16 strokes,
+    /// plaster, bark and metal each had one step recorded ahead without passes that needed
+    /// them, and none that did not, and their strokes read back 10-13 % more for it. There
+    /// steps ahead keep their passes, and only steps whose passes run apart are tested.
+    fn skips_passes(&self, state: &StrokeState<'_>, mesh: &Mesh) -> bool {
+        self.expect_clear && state.cull && mesh.layer_count() == 1
     }
 
     /// Whether a step whose passes are still to run is one to test for a clear sheet alone:
@@ -367,8 +364,9 @@ impl GpuKernels {
         before: &[Vec3],
     ) -> bool {
         self.untested_steps = 0;
-        let current = |r: &Resident, mesh: &Mesh| r.version.positions == mesh.version().positions;
-        let was_current = self.resident.as_ref().is_some_and(|r| current(r, mesh));
+        let positions = mesh.version().positions;
+        let was_current =
+            (self.resident.as_ref()).is_some_and(|r| r.version.positions == positions);
         self.expect_clear = clamp_on_a_clear_sheet(state, region, mesh, moves, before);
         self.uploads.skipped_passes += usize::from(self.expect_clear);
         if let Some(r) = self
@@ -383,22 +381,10 @@ impl GpuKernels {
         self.expect_clear
     }
 
-    /// After passes that ran ahead: whether the region where they left the selection is one
-    /// layer and a clear sheet, for the steps after it (`collide::lies_on_a_clear_sheet`).
-    fn test_for_a_clear_sheet(
-        &mut self,
-        state: &StrokeState<'_>,
-        region: &mut Region,
-        mesh: &Mesh,
-        moved: (&[(u32, f32)], &[Vec3]),
-    ) {
-        self.untested_steps = 0;
-        self.expect_clear = lies_on_a_clear_sheet(state, region, mesh, moved);
-    }
-
     /// Takes the passes run ahead for exactly the pipeline's moves: their final positions into
-    /// `mesh`, and what they left the backstop; every [`SHEET_TEST_EVERY`] steps a sheet test
-    /// where they left the selection, a guide for the steps after it.
+    /// `mesh`, and what they left the backstop; on a mesh of one layer, every
+    /// [`SHEET_TEST_EVERY`] steps a sheet test where they left the selection
+    /// (`collide::lies_on_a_clear_sheet`), a guide for the steps after it.
     fn take_ahead(
         &mut self,
         state: &StrokeState<'_>,
@@ -412,11 +398,37 @@ impl GpuKernels {
         for (&v, &p) in ahead.vertices.iter().zip(&ahead.finals) {
             positions[v as usize] = p;
         }
-        if self.one_layer && self.sheet_test_due() {
-            self.test_for_a_clear_sheet(state, region, mesh, (selection, &ahead.targets));
+        if mesh.layer_count() == 1 && self.sheet_test_due() {
+            self.untested_steps = 0;
+            let moved = (selection, ahead.targets.as_slice());
+            self.expect_clear = lies_on_a_clear_sheet(state, region, mesh, moved);
         }
         self.taken = Some((ahead.vertices, ahead.finals));
         ahead.backstop
+    }
+
+    /// A step's first phase in a submission of its own, its moves known: the passes on the GPU
+    /// where they run there and it has not failed, else on the CPU (`clamp_in_region`).
+    fn clamp_apart(
+        &mut self,
+        state: &StrokeState<'_>,
+        region: &mut Region,
+        mesh: &mut Mesh,
+        moves: StepMoves<'_>,
+        before: &[Vec3],
+    ) -> Backstop {
+        let (selection, targets, _) = moves;
+        if self.proximity_on_gpu
+            && let Some((finals, backstop)) =
+                self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
+        {
+            let positions = mesh.positions_mut();
+            for (&(v, _), p) in selection.iter().zip(finals) {
+                positions[v as usize] = p;
+            }
+            return backstop;
+        }
+        clamp_in_region(state, region, mesh, moves, before)
     }
 
     /// `run`'s result, unless the GPU was given up before or fails now (then given up for
@@ -451,7 +463,6 @@ impl StepKernels for GpuKernels {
     fn warm_up(&mut self, mesh: &Mesh, cell_size: f32) {
         // A stroke's first step is tested for a clear sheet: the last stroke's may be elsewhere.
         self.untested_steps = SHEET_TEST_EVERY;
-        self.one_layer = mesh.layer_count() == 1;
         // Not counted as a GPU call by the `fail_after` hook: the tests of the fallback aim
         // their failures at the strokes' calls.
         self.on_gpu(|k| {
@@ -598,45 +609,37 @@ impl StepKernels for GpuKernels {
                     .map(|&(v, _)| v)
                     .eq(ahead.vertices.iter().copied())
         });
-        let mut tested = false;
-        if let Some(ahead) = self.ahead.take() {
-            if same && !ahead.without_passes {
+        match self.ahead.take() {
+            Some(ahead) if same && !ahead.without_passes => {
                 return self.take_ahead(state, region, mesh, (selection, ahead));
             }
-            if same {
-                // Recorded without passes: right where the region is a clear sheet alone.
-                tested = true;
+            // Recorded without passes: right where the region is a clear sheet alone; else
+            // dropped, with the samples queued after it, and its passes run apart.
+            Some(ahead) if same => {
                 if self.sheet_test(state, region, mesh, moves, before) {
                     self.uploads.clamped_ahead += 1;
                     self.taken = Some((ahead.vertices, ahead.finals));
                     return Backstop::Search;
                 }
                 self.uploads.passes_needed += 1;
+                self.ahead = Some(ahead);
+                self.drop_ahead(mesh);
+                return self.clamp_apart(state, region, mesh, moves, before);
             }
-            // Passes run ahead for other moves, or skipped where they were needed: dropped,
-            // with the samples queued after them.
-            self.ahead = Some(ahead);
-            self.drop_ahead(mesh);
+            // Passes run ahead for other moves: dropped, with the samples queued after them.
+            not_these => {
+                self.ahead = not_these;
+                self.drop_ahead(mesh);
+            }
         }
         if self.proximity_on_gpu
             && self.failed.is_none()
-            && !tested
             && self.sheet_test_due()
             && self.sheet_test(state, region, mesh, moves, before)
         {
             return Backstop::Search;
         }
-        if self.proximity_on_gpu
-            && let Some((finals, backstop)) =
-                self.on_gpu(|k| k.gpu_clamp(state, mesh, selection, targets, before))
-        {
-            let positions = mesh.positions_mut();
-            for (&(v, _), p) in selection.iter().zip(finals) {
-                positions[v as usize] = p;
-            }
-            return backstop;
-        }
-        clamp_in_region(state, region, mesh, moves, before)
+        self.clamp_apart(state, region, mesh, moves, before)
     }
 
     fn moved(&mut self, mesh: &Mesh, vertices: &[u32], max_move: f32) {

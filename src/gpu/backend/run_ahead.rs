@@ -146,7 +146,7 @@ impl GpuKernels {
         let count = calls.len();
         let filter = self.backstop_on_gpu;
         let assumed_move = self.assumed_move(limit);
-        let skip_passes = self.skips_passes(state);
+        let skip_passes = self.skips_passes(state, mesh);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,

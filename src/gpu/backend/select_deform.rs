@@ -176,7 +176,7 @@ impl GpuKernels {
         assumed_move: Option<f32>,
     ) -> Result<SubmittedSample, GpuError> {
         let filter = self.backstop_on_gpu;
-        let skip_passes = self.skips_passes(state);
+        let skip_passes = self.skips_passes(state, mesh);
         let (gpu, step, readback) = (&self.gpu, &mut self.step, &mut self.readback);
         let r = GpuKernels::prepare(
             gpu,
