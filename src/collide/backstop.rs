@@ -57,25 +57,36 @@ pub(super) fn undo_crossings(
         .filter(|(_, m)| **m)
         .map(|(&(v, _), _)| v)
         .collect();
-    loop {
-        // In the order met: the pairs found are sorted.
-        let moving_faces = region.faces_around_once(mesh, changed.iter().copied());
-        if moving_faces.is_empty() {
-            break;
-        }
+    while !changed.is_empty() {
         let mut pairs: Vec<(u32, u32)> = match undecided.take() {
             // The filter tested exactly the pairs the search below would: the same crossings.
-            Some(candidates) => candidates
-                .into_iter()
-                .map(|[f, g]| (f.min(g), f.max(g)))
-                .filter(|&pair| pair_crosses(mesh, pair, target_of, before))
-                .collect(),
+            Some(candidates) => {
+                if region
+                    .faces_around_once(mesh, changed.iter().copied())
+                    .is_empty()
+                {
+                    break;
+                }
+                candidates
+                    .into_iter()
+                    .map(|[f, g]| (f.min(g), f.max(g)))
+                    .filter(|&pair| pair_crosses(mesh, pair, target_of, before))
+                    .collect()
+            }
             None => {
                 if !gathered {
                     gather_from_start(state, region, mesh, moves, before);
                     gathered = true;
                 }
                 region.find_sheets(state, mesh);
+                if kept_a_lone_sheet(state, region, mesh, &changed, (target_of, before)) {
+                    break;
+                }
+                // In the order met: the pairs found are sorted.
+                let moving_faces = region.faces_around_once(mesh, changed.iter().copied());
+                if moving_faces.is_empty() {
+                    break;
+                }
                 let all_local = moving_faces.iter().all(|&f| region.local(f).is_some());
                 if region.worth_searching_crossings() || !all_local {
                     region.file_faces(mesh, moves, before);
@@ -158,6 +169,38 @@ fn gather_from_start(
     let positions = mesh.positions_mut();
     for (&(v, _), p) in selection.iter().zip(now) {
         positions[v as usize] = p;
+    }
+}
+
+/// Whether the region is one layer, a sheet, that holds every face around the `changed`
+/// vertices, and none of those turned over in the step: then [`crossings`] skips every one of
+/// them, and this finds it so without listing them. Each face is tested from the first of its
+/// vertices that changed (the listing, on one thread, cost as much as the tests).
+fn kept_a_lone_sheet(
+    state: &StrokeState<'_>,
+    region: &Region,
+    mesh: &Mesh,
+    changed: &[u32],
+    (target_of, before): (&[u32], &[Vec3]),
+) -> bool {
+    if region.worth_searching_crossings() {
+        return false;
+    }
+    let mut sorted = changed.to_vec();
+    sorted.sort_unstable();
+    let is_changed = |w: u32| sorted.binary_search(&w).is_ok();
+    let kept_around = |&v: &u32| {
+        mesh.faces_around(v).all(|f| {
+            let ids = mesh.faces()[f as usize];
+            let first = ids.iter().position(|&w| w == v).unwrap_or(0);
+            let tested_before = ids[..first].iter().any(|&w| is_changed(w));
+            tested_before || (region.local(f).is_some() && !turned_over(mesh, f, target_of, before))
+        })
+    };
+    if state.parallel {
+        changed.par_iter().all(kept_around)
+    } else {
+        changed.iter().all(kept_around)
     }
 }
 

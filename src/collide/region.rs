@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::rings::RingCache;
-use super::sheet::Sheet;
+use super::sheet::{FaceSlope, Sheet};
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps, SweptTriangle};
 use crate::geom::Aabb;
@@ -76,6 +76,9 @@ pub struct Region {
     /// Per layer id: the region's faces of that layer as a sheet where the mesh is now, if
     /// they are one (`super::sheet`); `None` once a vertex moved since it was found.
     sheets: Option<Vec<Option<Sheet>>>,
+    /// Per local face, when the region is one layer and a sheet not clear as a whole: how it
+    /// stands to the sheet's axis (`super::sheet::clear_around`).
+    pub(super) slopes: Vec<FaceSlope>,
     /// The first look this step found no sheet.
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
@@ -266,11 +269,14 @@ impl Region {
             self.sheets = Some(Vec::new());
             return;
         }
+        let mut slopes = std::mem::take(&mut self.slopes);
         self.sheets = Some(if state.cull {
-            super::sheet::find_sheets(state, mesh, self, &self.moving_layers)
+            super::sheet::find_sheets(state, mesh, self, &self.moving_layers, &mut slopes)
         } else {
+            slopes.clear();
             Vec::new()
         });
+        self.slopes = slopes;
         self.no_sheet_this_step = !self.sheets.iter().flatten().any(Option::is_some);
     }
 

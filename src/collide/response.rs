@@ -134,6 +134,7 @@ fn without_cleared(
         return moving;
     };
     let view: &Region = region;
+    let d = state.collision_distance;
     let cleared = map_with_scratch(state.parallel, &moving, |scratch, &i| {
         let v = selection[i].0;
         let ring = match view.rings.get(mesh, v, state.ring) {
@@ -143,7 +144,7 @@ fn without_cleared(
                 &scratch.ring
             }
         };
-        clear_around(mesh, view, &sheet, (v, ring), state.collision_distance)
+        clear_around(mesh, view, &sheet, (v, ring, state.ring), d)
     });
     region.cleared_vertices += cleared.iter().filter(|&&c| c).count();
     let kept = moving.into_iter().zip(cleared).filter(|&(_, c)| !c);

@@ -713,17 +713,14 @@ fn refresh_normals(
     call: &mut SamplesReport,
 ) {
     let started = Instant::now();
-    // Listed once each as met, then sorted: far fewer than the fans' repeats.
+    // Listed once each as met, then sorted: far fewer than the fans' repeats. The vertices of
+    // a vertex's faces are itself, if it has any, and its ring.
     marks.start(mesh.vertex_count());
     let mut refresh: Vec<u32> = Vec::new();
     for &v in moved {
-        for f in mesh.faces_around(v) {
-            refresh.extend(
-                mesh.faces()[f as usize]
-                    .into_iter()
-                    .filter(|&w| marks.insert(w as usize)),
-            );
-        }
+        let on_a_face = mesh.adjacency().vertex_corner[v as usize] != INVALID;
+        let fan = std::iter::once(v).filter(|_| on_a_face).chain(mesh.ring(v));
+        refresh.extend(fan.filter(|&w| marks.insert(w as usize)));
     }
     refresh.sort_unstable();
     mesh.recompute_normals_at(&refresh);
