@@ -186,9 +186,13 @@ fn kept_a_lone_sheet(
     if region.worth_searching_crossings() {
         return false;
     }
-    let mut sorted = changed.to_vec();
-    sorted.sort_unstable();
-    let is_changed = |w: u32| sorted.binary_search(&w).is_ok();
+    // The changed vertices are selected ones: flagged by their slot in the selection.
+    let mut flagged = vec![false; before.len()];
+    for &v in changed {
+        flagged[target_of[v as usize] as usize] = true;
+    }
+    let is_changed =
+        |w: u32| target_of[w as usize] != INVALID && flagged[target_of[w as usize] as usize];
     let kept_around = |&v: &u32| {
         mesh.faces_around(v).all(|f| {
             let ids = mesh.faces()[f as usize];

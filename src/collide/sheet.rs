@@ -106,13 +106,20 @@ fn sheet_of(
     faces: &[u32],
     slopes: Option<&mut Vec<FaceSlope>>,
 ) -> Option<Sheet> {
-    // The loop first: a layer with a rim in the region (a flake, a peeling patch) is no
-    // sheet, found without computing a normal.
     let layers = mesh.face_layers();
     let layer = layers[faces[0] as usize];
     let in_set = |g: u32| layers[g as usize] == layer && region.local(g).is_some();
-    let boundary = boundary_loop(mesh, faces, in_set)?;
-    let shapes = face_shapes(mesh, faces, |v: u32| mesh.positions()[v as usize]);
+    let loop_of = || boundary_loop(mesh, faces, in_set);
+    let shapes_of = || face_shapes(mesh, faces, |v: u32| mesh.positions()[v as usize]);
+    // Two walks over the faces, about even: one on each core. On one thread, the loop first:
+    // a layer with a rim in the region (a flake, a peeling patch) is no sheet, found without
+    // computing a normal.
+    let (boundary, shapes) = if state.parallel {
+        let (boundary, shapes) = rayon::join(loop_of, shapes_of);
+        (boundary?, shapes)
+    } else {
+        (loop_of()?, shapes_of())
+    };
     let cone = cone_of(&shapes)?;
     if !projected_loop_is_simple(mesh, &boundary, cone.axis) {
         return None;
