@@ -33,13 +33,15 @@ pub fn to_fixed(q: f32) -> Fixed {
         return [0; 3];
     }
     let clamped = a.min(FIXED_LIMIT);
-    let whole = clamped.floor();
-    let upper = (clamped - whole) * FIXED_WORD;
-    let upper_whole = upper.floor();
+    // The shader's floors, as truncating casts: the same on values in [0, 2^32), and no call
+    // into libm where the CPU has no rounding instruction (x86-64's baseline has none).
+    let whole = clamped as u32;
+    let upper = (clamped - whole as f32) * FIXED_WORD;
+    let upper_whole = upper as u32;
     let magnitude = [
-        ((upper - upper_whole) * FIXED_WORD) as u32,
-        upper_whole as u32,
-        whole as u32,
+        ((upper - upper_whole as f32) * FIXED_WORD) as u32,
+        upper_whole,
+        whole,
     ];
     if q < 0.0 {
         fixed_negate(magnitude)
