@@ -16,7 +16,7 @@ use crate::brush::{Stroke, StrokeSettings};
 use crate::collide::Region;
 use crate::collide::neighbourhood::exclusion_ring;
 use crate::grid::SpatialHash;
-use crate::mesh::{INVALID, Mesh, MeshVersion, next, prev};
+use crate::mesh::{INVALID, Mesh, MeshVersion};
 use crate::remesh::{RemeshReport, RemeshSets, RemeshSettings, remesh_region_with};
 use crate::topology::{FuseSettings, TopologyReport, adapt};
 
@@ -399,11 +399,11 @@ pub(super) fn longest_edge_at(mesh: &Mesh, vertices: &[u32]) -> f32 {
     vertices
         .par_iter()
         .map(|&v| {
+            // Each neighbour once: around a vertex inside the mesh, a corner's next and
+            // prev edges are its neighbours' prev and next.
             let p = positions[v as usize];
-            mesh.adjacency()
-                .corners_around(v)
-                .flat_map(|c| [next(c), prev(c)])
-                .map(|c| p.distance_squared(positions[mesh.corner_vertex(c) as usize]))
+            mesh.ring(v)
+                .map(|w| p.distance_squared(positions[w as usize]))
                 .fold(0.0f32, f32::max)
         })
         .reduce(|| 0.0, f32::max)
