@@ -56,7 +56,8 @@ const MARGIN: f64 = 1e-3;
 /// Per layer id: the region's faces of that layer as a sheet where the mesh is now, if they
 /// are one (the module's conditions), for the `layers` present in the region. Where the region
 /// is one layer and a sheet not clear as a whole, `slopes` gets its faces' [`FaceSlope`]s, in
-/// the region's order, for [`clear_around`]; it is left empty otherwise.
+/// the region's order, for [`clear_around`]; it is left empty otherwise. (Callers that only
+/// ask whether the sheet is clear, the GPU's, pay for them too: a root and a division a face.)
 pub(super) fn find_sheets(
     state: &StrokeState<'_>,
     mesh: &Mesh,

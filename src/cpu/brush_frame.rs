@@ -87,8 +87,8 @@ pub struct FrameInputs<'a> {
 /// Adds the selection's sums into `sums`. The shader adds each workgroup's partial sums into
 /// the totals word by word ([`add_fixed`]); this adds every term into one wide integer and
 /// the wide totals into `sums` once: both are sums modulo 2⁹⁶, so the grouping and the width
-/// cannot change the bits, and a wide addition costs one instruction where the words took a
-/// dozen (the sums were a third of the CPU's selection on the 1M plane).
+/// cannot change the bits, and a wide addition is two instructions where the words' carries
+/// took a dozen (the frame was a third of the CPU's selection phase on the 1M plane).
 pub fn brush_frame(params: &FrameParams, inputs: &FrameInputs<'_>, sums: &mut FrameSums) {
     let count = inputs.selection_count.min(params.capacity);
     let center = Vec3::from_array(params.center);
