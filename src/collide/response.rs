@@ -273,7 +273,8 @@ pub fn clamp_in_region(
 /// (`super::sheet`): the targets placed and nothing pulled back, which is what
 /// [`clamp_moves`] leaves there (each [`pull_back`] finds nothing), at the cost of the
 /// region's gathering and the sheet test alone. Returns whether it was so; if not, the
-/// selection is back at `before` and the region gathered for the passes to run elsewhere.
+/// selection is back at `before` (the positions' version too: nothing moved) and the region
+/// gathered for the passes to run elsewhere.
 /// For backends whose proximity passes run off the CPU (the GPU's): they skip them where the
 /// CPU's would have skipped every search.
 pub fn clamp_on_a_clear_sheet(
@@ -287,11 +288,16 @@ pub fn clamp_on_a_clear_sheet(
         return false;
     }
     region.gather_unfiled(state, mesh, selection, targets);
+    let stamp = mesh.version().positions;
     place(mesh, selection, targets);
     if is_a_clear_sheet_alone(state, region, mesh) {
         return true;
     }
-    place(mesh, selection, before);
+    let starts = selection
+        .iter()
+        .map(|&(v, _)| v)
+        .zip(before.iter().copied());
+    mesh.put_back_positions(starts, stamp);
     region.positions_changed();
     false
 }

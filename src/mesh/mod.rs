@@ -245,6 +245,16 @@ impl Mesh {
         &mut self.positions
     }
 
+    /// Undoes a trial: puts each `(vertex, position)` back, the trial having moved only those
+    /// vertices since the positions' version was `stamp`, and takes that version back, so that
+    /// a copy current at `stamp` (the GPU's) is current again instead of sent anew.
+    pub fn put_back_positions(&mut self, moved: impl IntoIterator<Item = (u32, Vec3)>, stamp: u64) {
+        for (v, p) in moved {
+            self.positions[v as usize] = p;
+        }
+        self.version.positions = stamp;
+    }
+
     pub fn normals(&self) -> &[Vec3] {
         &self.normals
     }

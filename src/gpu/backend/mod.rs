@@ -364,20 +364,8 @@ impl GpuKernels {
         before: &[Vec3],
     ) -> bool {
         self.untested_steps = 0;
-        let positions = mesh.version().positions;
-        let was_current =
-            (self.resident.as_ref()).is_some_and(|r| r.version.positions == positions);
         self.expect_clear = clamp_on_a_clear_sheet(state, region, mesh, moves, before);
         self.uploads.skipped_passes += usize::from(self.expect_clear);
-        if let Some(r) = self
-            .resident
-            .as_mut()
-            .filter(|_| was_current && !self.expect_clear)
-        {
-            // The test put the selection back where it was: the copy is as current as before
-            // (else the next call would send every position and file them anew).
-            r.version.positions = mesh.version().positions;
-        }
         self.expect_clear
     }
 
