@@ -103,6 +103,39 @@ impl Mesh {
         self.edge_length_stats().mean as f32
     }
 
+    /// Recomputes the normals of `moved` (vertices on faces, each once) and of their
+    /// neighbours that are not `moved`, whose faces turned with them; returns those
+    /// neighbours, ascending. Each moved vertex lists its ring right after its own fan, while
+    /// the fan's corners are still in cache, on every core: listing the ring in a walk of its
+    /// own cost as much as the normals.
+    pub fn recompute_normals_around(
+        &mut self,
+        moved: &[u32],
+        is_moved: impl Fn(u32) -> bool + Sync,
+    ) -> Vec<u32> {
+        const CHUNK: usize = 512;
+        let parts: Vec<(Vec<Vec3>, Vec<u32>)> = moved
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let normals = chunk.iter().map(|&v| self.area_weighted_normal(v));
+                let normals: Vec<Vec3> = normals.collect();
+                let still = chunk.iter().flat_map(|&v| self.ring(v));
+                (normals, still.filter(|&w| !is_moved(w)).collect())
+            })
+            .collect();
+        let mut rim = Vec::new();
+        for (chunk, (normals, still)) in moved.chunks(CHUNK).zip(parts) {
+            for (&v, n) in chunk.iter().zip(normals) {
+                self.normals[v as usize] = n;
+            }
+            rim.extend(still);
+        }
+        rim.sort_unstable();
+        rim.dedup();
+        self.recompute_normals_at(&rim);
+        rim
+    }
+
     /// Area-weighted vertex normals of the whole mesh.
     pub fn recompute_normals(&mut self) {
         let normals: Vec<Vec3> = (0..self.vertex_count() as u32)

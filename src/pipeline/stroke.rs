@@ -713,17 +713,18 @@ fn refresh_normals(
     call: &mut SamplesReport,
 ) {
     let started = Instant::now();
-    // Listed once each as met, then sorted: far fewer than the fans' repeats. The vertices of
-    // a vertex's faces are itself, if it has any, and its ring.
     marks.start(mesh.vertex_count());
-    let mut refresh: Vec<u32> = Vec::new();
-    for &v in moved {
-        let on_a_face = mesh.adjacency().vertex_corner[v as usize] != INVALID;
-        let fan = std::iter::once(v).filter(|_| on_a_face).chain(mesh.ring(v));
-        refresh.extend(fan.filter(|&w| marks.insert(w as usize)));
-    }
+    let on_a_face = |v: u32| mesh.adjacency().vertex_corner[v as usize] != INVALID;
+    let movers: Vec<u32> = moved
+        .iter()
+        .copied()
+        .filter(|&v| marks.insert(v as usize) && on_a_face(v))
+        .collect();
+    let marks = &*marks;
+    let rim = mesh.recompute_normals_around(&movers, |w| marks.contains(w as usize));
+    let mut refresh = movers;
+    refresh.extend(rim);
     refresh.sort_unstable();
-    mesh.recompute_normals_at(&refresh);
     kernels.normals_changed(mesh, &refresh);
     call.changed.extend_from_slice(&refresh);
     call.phases.deformation += millis(started);
