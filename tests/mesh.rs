@@ -105,6 +105,32 @@ fn mean_edge_length_and_normals() {
     );
 }
 
+/// Refreshing the normals around moved vertices lists their unmoved neighbours, ascending,
+/// and leaves every normal as recomputing the moved vertices and their rings does: on each
+/// kind of mesh, with every third vertex moved.
+#[test]
+fn normals_around_moved_vertices_match_a_recompute_of_their_rings() {
+    for (name, mut mesh) in kinds() {
+        let moved: Vec<u32> = (0..mesh.vertex_count() as u32)
+            .filter(|v| v % 3 == 0 && mesh.adjacency().vertex_corner[*v as usize] != INVALID)
+            .collect();
+        for (k, &v) in moved.iter().enumerate() {
+            mesh.positions_mut()[v as usize] += Vec3::new(0.01, -0.02, 0.03) * (k % 4) as f32;
+        }
+        let mut expected = mesh.clone();
+        let mut rim: Vec<u32> = moved.iter().flat_map(|&v| mesh.neighbours(v)).collect();
+        rim.retain(|w| !moved.contains(w));
+        rim.sort_unstable();
+        rim.dedup();
+        let mut all: Vec<u32> = moved.iter().chain(&rim).copied().collect();
+        all.sort_unstable();
+        expected.recompute_normals_at(&all);
+        let listed = mesh.recompute_normals_around(&moved, |w| moved.contains(&w));
+        assert_eq!(listed, rim, "{name}: the rim");
+        assert_eq!(mesh.normals(), expected.normals(), "{name}: the normals");
+    }
+}
+
 /// Each kind of change gives its part of the version a new stamp and leaves the others;
 /// another mesh never shows the same version (a pipeline or GPU copy keyed by it cannot take
 /// one mesh for another).

@@ -105,6 +105,27 @@ impl LocalFaceGrid {
         cell: f32,
     ) {
         debug_assert_eq!(boxes.len(), swept.len(), "one swept face per box");
+        self.build_swept_of((boxes, swept, None), region, cell);
+    }
+
+    /// [`LocalFaceGrid::build_swept`] of some local faces: `boxes[i]` and `swept[i]` are
+    /// local face `ids[i]`'s.
+    pub fn build_some_swept(
+        &mut self,
+        (boxes, swept, ids): (&[Aabb], &[SweptTriangle], &[u32]),
+        region: Aabb,
+        cell: f32,
+    ) {
+        debug_assert!(boxes.len() == ids.len() && swept.len() == ids.len());
+        self.build_swept_of((boxes, swept, Some(ids)), region, cell);
+    }
+
+    fn build_swept_of(
+        &mut self,
+        (boxes, swept, ids): (&[Aabb], &[SweptTriangle], Option<&[u32]>),
+        region: Aabb,
+        cell: f32,
+    ) {
         self.size(boxes.len(), region, cell);
         let mut spill = std::mem::take(&mut self.spill);
         let mut ends = std::mem::take(&mut self.spill_ends);
@@ -120,8 +141,9 @@ impl LocalFaceGrid {
         let mut cursor = self.counted();
         let mut start = 0;
         for (i, &end) in ends.iter().enumerate() {
+            let id = ids.map_or(i as u32, |ids| ids[i]);
             for &c in &spill[start..end as usize] {
-                self.entries[cursor[c as usize] as usize] = i as u32;
+                self.entries[cursor[c as usize] as usize] = id;
                 cursor[c as usize] += 1;
             }
             start = end as usize;

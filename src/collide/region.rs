@@ -11,6 +11,7 @@ use super::sheet::{FaceSlope, Sheet};
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps, SweptTriangle};
 use crate::geom::Aabb;
+use crate::grow::grow_to;
 use crate::mesh::{INVALID, Mesh};
 
 /// A step's moves: the selection, each selected vertex's target, and per vertex its index in
@@ -56,9 +57,11 @@ pub struct Region {
     grid: LocalFaceGrid,
     use_grid: bool,
     /// The local grid's cell side (none without a global grid), and whether the faces are
-    /// filed in it yet.
+    /// filed in it yet: all of them, or only those near a few searched vertices
+    /// ([`Region::file_faces_near`]).
     cell: Option<f32>,
     filed: bool,
+    filed_near: bool,
     vertices: Vec<u32>,
     /// Mesh faces already in `faces`, and their index there.
     gathered: Stamps,
@@ -83,6 +86,8 @@ pub struct Region {
     no_sheet_this_step: bool,
     /// Mesh faces met already, for the phases that list each face once.
     face_marks: Stamps,
+    /// Mesh faces filed already by [`Region::file_faces_near`].
+    near_marks: Stamps,
     /// The moving vertices' exclusion rings, kept from step to step.
     pub(super) rings: RingCache,
     /// The faces the last Jacobi pass changed, filed apart ([`Region::file_changed`]).
@@ -112,7 +117,8 @@ impl Region {
     pub fn size_for(&mut self, mesh: &Mesh) {
         self.gathered.size_for(mesh.face_count());
         self.face_marks.size_for(mesh.face_count());
-        crate::grow::grow_to(&mut self.local_index, mesh.face_count(), 0);
+        self.near_marks.size_for(mesh.face_count());
+        grow_to(&mut self.local_index, mesh.face_count(), 0);
         self.rings.size_for(mesh.vertex_count());
     }
 
@@ -173,7 +179,7 @@ impl Region {
         // Faces of those vertices, each once. Their order does not matter: every result below
         // is a minimum or a sorted set.
         self.gathered.start(mesh.face_count());
-        crate::grow::grow_to(&mut self.local_index, mesh.face_count(), 0);
+        grow_to(&mut self.local_index, mesh.face_count(), 0);
         self.faces.clear();
         for &v in &self.vertices {
             for f in mesh.faces_around(v) {
@@ -196,6 +202,7 @@ impl Region {
         self.use_grid = state.grid.is_some();
         self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
         self.filed = false;
+        self.filed_near = false;
         self.changed.filed = false;
     }
 
@@ -206,34 +213,97 @@ impl Region {
         if self.filed {
             return;
         }
-        let (_, targets, target_of) = moves;
-        let positions = mesh.positions();
         self.boxes.clear();
         self.swept.clear();
         for &f in &self.faces {
-            let mut corners = [Vec3::ZERO; 3];
-            let mut moves = SweptTriangle::NO_MOVE;
-            let mut swept_box = Aabb::EMPTY;
-            for (corner, &v) in corners.iter_mut().zip(&mesh.faces()[f as usize]) {
-                *corner = match target_of[v as usize] {
-                    INVALID => positions[v as usize],
-                    slot => {
-                        let (start, target) = (before[slot as usize], targets[slot as usize]);
-                        swept_box = swept_box.including(target);
-                        moves = moves.including(target - start);
-                        start
-                    }
-                };
-                swept_box = swept_box.including(*corner);
-            }
+            let (swept_box, swept) = sweep_of(mesh, f, moves, before);
             self.boxes.push(swept_box);
-            self.swept.push(SweptTriangle { corners, moves });
+            self.swept.push(swept);
         }
         if let Some(cell) = self.cell {
             self.grid
                 .build_swept(&self.boxes, &self.swept, self.reach, cell);
         }
         self.filed = true;
+        self.filed_near = false;
+    }
+
+    /// Files every face, where [`Region::file_faces_near`] filed only some.
+    pub(super) fn file_the_rest(&mut self, mesh: &Mesh, moves: StepMoves<'_>, before: &[Vec3]) {
+        if self.filed_near {
+            self.file_faces(mesh, moves, before);
+        }
+    }
+
+    /// Files, for the first pass's searches of the selection's vertices at `searched` (slots),
+    /// only the faces those can meet: where a few vertices of a ridge's flanks are left to
+    /// search in a region of thousands of faces, boxing and filing them all cost more than
+    /// the searches. Later searches file the rest ([`Region::file_faces`]).
+    ///
+    /// A vertex's search meets the faces whose box overlaps the box of its move grown by `d`.
+    /// A face's box lies within `max_edge` and the step's longest move (per axis) of each
+    /// corner's start, where the global grid files the corner during the step; so the grid's
+    /// vertices in the search box grown by those two hold a corner of every such face.
+    pub(super) fn file_faces_near(
+        &mut self,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+        moves: StepMoves<'_>,
+        (before, searched): (&[Vec3], &[usize]),
+    ) {
+        let Some(grid) = state.grid.filter(|_| self.use_grid) else {
+            return self.file_faces(mesh, moves, before);
+        };
+        if self.filed || self.filed_near {
+            return;
+        }
+        // Past this share of the region's faces per searched vertex, filing them all is as
+        // cheap.
+        if searched.len() * FACES_NEAR_ONE_SEARCH > self.faces.len() {
+            return self.file_faces(mesh, moves, before);
+        }
+        let (_, targets, _) = moves;
+        let step = before
+            .iter()
+            .zip(targets)
+            .fold(0.0f32, |m, (p, q)| m.max((*q - *p).abs().max_element()));
+        let scale = self.reach.min.abs().max(self.reach.max.abs()).max_element();
+        let grown = state.collision_distance
+            + state.max_edge * 1.001
+            + step
+            + 4.0 * f32::EPSILON * scale;
+        self.near_marks.start(mesh.face_count());
+        let mut near: Vec<u32> = Vec::new();
+        for &slot in searched {
+            let search = Aabb::of_points(&[before[slot], targets[slot]]).expanded(grown);
+            let (marks, gathered) = (&mut self.near_marks, &self.gathered);
+            grid.for_each_in_box(search.min, search.max, |y| {
+                for f in mesh.faces_around(y) {
+                    if gathered.contains(f as usize) && marks.insert(f as usize) {
+                        near.push(self.local_index[f as usize]);
+                    }
+                }
+            });
+        }
+        near.sort_unstable();
+        // Only these faces' entries are read (the searches meet no other): the rest keep
+        // what an earlier step left until the whole region is filed.
+        let sweeps: Vec<(Aabb, SweptTriangle)> = (near.iter())
+            .map(|&l| sweep_of(mesh, self.faces[l as usize], moves, before))
+            .collect();
+        grow_to(&mut self.boxes, self.faces.len(), Aabb::EMPTY);
+        grow_to(&mut self.swept, self.faces.len(), SweptTriangle::at_rest([Vec3::ZERO; 3]));
+        for (&l, &(swept_box, swept)) in near.iter().zip(&sweeps) {
+            self.boxes[l as usize] = swept_box;
+            self.swept[l as usize] = swept;
+        }
+        let (boxes, swept): (Vec<Aabb>, Vec<SweptTriangle>) = sweeps.into_iter().unzip();
+        // Coarser cells than all the faces would get: the searches meet the same faces in
+        // another order, which their results do not depend on ([`super::pull_back`]).
+        let cell = self.cell.expect("a global grid gives the local one a cell");
+        self.grid
+            .build_some_swept((&boxes, &swept, &near), self.reach, cell);
+        self.filed_near = true;
     }
 
     /// Whether the proximity clamp's search of the region could find anything where the mesh
@@ -353,6 +423,7 @@ impl Region {
     /// Files the local faces `marks` holds (those a Jacobi pass changed) apart, for
     /// [`Region::changed_candidates`]; without the region's faces filed, forgets any.
     pub(super) fn file_changed(&mut self, marks: &[bool]) {
+        debug_assert!(!self.filed_near, "changed faces filed before all the faces were");
         let changed = &mut self.changed;
         changed.filed = self.filed;
         if !self.filed {
@@ -415,7 +486,7 @@ impl Region {
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
-        debug_assert!(self.filed, "a search before the faces were filed");
+        debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
         let query = Aabb::of_points(&triangle);
         if !self.use_grid {
             return self.candidates(&query, scratch, f);
@@ -436,7 +507,7 @@ impl Region {
 
     /// Local faces whose box overlaps `query`, each once.
     pub(super) fn candidates(&self, query: &Aabb, scratch: &mut Scratch, mut f: impl FnMut(usize)) {
-        debug_assert!(self.filed, "a search before the faces were filed");
+        debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
         if self.use_grid {
             scratch.seen.start(self.faces.len());
             self.grid.for_each_candidate(query, |local| {
@@ -453,6 +524,33 @@ impl Region {
             }
         }
     }
+}
+
+/// A vertex's search meets fewer faces than this, about: the box of its move grown by `d`,
+/// a longest edge and the step's longest move, a few cells a side ([`Region::file_faces_near`]).
+const FACES_NEAR_ONE_SEARCH: usize = 64;
+
+/// The box of face `f` over the step (its corners where they start and, for those that move,
+/// their targets; `before` holds the selection's starts) and its sweep.
+fn sweep_of(mesh: &Mesh, f: u32, moves: StepMoves<'_>, before: &[Vec3]) -> (Aabb, SweptTriangle) {
+    let (_, targets, target_of) = moves;
+    let positions = mesh.positions();
+    let mut corners = [Vec3::ZERO; 3];
+    let mut moved = SweptTriangle::NO_MOVE;
+    let mut swept_box = Aabb::EMPTY;
+    for (corner, &v) in corners.iter_mut().zip(&mesh.faces()[f as usize]) {
+        *corner = match target_of[v as usize] {
+            INVALID => positions[v as usize],
+            slot => {
+                let (start, target) = (before[slot as usize], targets[slot as usize]);
+                swept_box = swept_box.including(target);
+                moved = moved.including(target - start);
+                start
+            }
+        };
+        swept_box = swept_box.including(*corner);
+    }
+    (swept_box, SweptTriangle { corners, moves: moved })
 }
 
 /// Cell side of the per-step face grid, in edge lengths: a face box then covers one to two
@@ -480,4 +578,71 @@ fn layers_among(count: usize, ids: impl Iterator<Item = u32>, out: &mut Vec<u32>
     }
     out.clear();
     out.extend((0..count as u32).filter(|&l| present[l as usize]));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::SpatialHash;
+    use crate::scene::shapes;
+
+    /// The faces a search meets among a few searched vertices' faces filed alone are those it
+    /// meets among all the region's faces filed: on two sheets, the top one's middle pushed
+    /// down and sideways unevenly, for several sets of searched vertices.
+    #[test]
+    fn filing_near_a_few_searches_meets_what_filing_all_meets() {
+        let mesh = shapes::stacked_sheets(2, 24, 24, 2.0, 0.6);
+        // Cells far smaller than an edge: a face can meet a search with no corner near it.
+        let grid = SpatialHash::build(&mesh, 0.3).unwrap();
+        let active = vec![true; mesh.layer_count()];
+        let state = StrokeState {
+            grid: Some(&grid),
+            active: &active,
+            parallel: false,
+            collision_distance: 0.5,
+            ring: 1,
+            max_edge: mesh.longest_edge() * 1.01,
+            cull: true,
+        };
+        let top = mesh.layer_count() as u32 - 1;
+        let middle = Vec3::new(24.0, 24.0, 0.0);
+        let selection: Vec<(u32, f32)> = (0..mesh.vertex_count() as u32)
+            .filter(|&v| mesh.vertex_layers()[v as usize] == top)
+            .filter(|&v| (mesh.positions()[v as usize] - middle).truncate().length() < 9.0)
+            .map(|v| (v, 1.0))
+            .collect();
+        let before: Vec<Vec3> = selection.iter().map(|&(v, _)| mesh.positions()[v as usize]).collect();
+        let targets: Vec<Vec3> = (before.iter().enumerate())
+            .map(|(i, p)| *p + Vec3::new(0.1 * (i % 3) as f32, 0.0, -0.2 - 0.05 * (i % 5) as f32))
+            .collect();
+        let mut target_of = vec![INVALID; mesh.vertex_count()];
+        for (slot, &(v, _)) in selection.iter().enumerate() {
+            target_of[v as usize] = slot as u32;
+        }
+        let moves = (&selection[..], &targets[..], &target_of[..]);
+        let mut all = Region::default();
+        all.size_for(&mesh);
+        all.gather(&state, &mesh, &selection, &targets, &target_of);
+        let slots: Vec<usize> = (0..selection.len()).collect();
+        for searched in [vec![0], vec![5, 6, 7], slots.iter().step_by(7).copied().collect()] {
+            let mut near = Region::default();
+            near.size_for(&mesh);
+            near.gather_unfiled(&state, &mesh, &selection, &targets);
+            near.file_faces_near(&state, &mesh, moves, (&before, &searched));
+            assert!(near.filed_near, "{} searches filed alone", searched.len());
+            let mut scratch = Scratch::default();
+            for &slot in &searched {
+                let query = Aabb::of_points(&[before[slot], targets[slot]]).expanded(0.5);
+                let met = |region: &Region, scratch: &mut Scratch| {
+                    let mut met = Vec::new();
+                    region.candidates(&query, scratch, |local| met.push(region.faces[local]));
+                    met.sort_unstable();
+                    met
+                };
+                let (from_near, from_all) = (met(&near, &mut scratch), met(&all, &mut scratch));
+                assert!(!from_all.is_empty(), "slot {slot} meets faces");
+                assert_eq!(from_near, from_all, "slot {slot} of {searched:?}");
+            }
+        }
+    }
 }

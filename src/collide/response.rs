@@ -373,7 +373,10 @@ pub fn clamp_moves(
             moving = without_cleared(state, region, mesh, selection, moving);
         }
         if region.worth_searching_near() && !moving.is_empty() {
-            region.file_faces(mesh, moves, before);
+            match pass {
+                0 => region.file_faces_near(state, mesh, moves, (before, &moving)),
+                _ => region.file_faces(mesh, moves, before),
+            }
         }
         let region_view: &Region = region;
         let mesh_view: &Mesh = mesh;
@@ -408,6 +411,8 @@ pub fn clamp_moves(
         if moved_back.is_empty() {
             break;
         }
+        // The faces the pass changed are filed apart from all the region's faces' boxes.
+        region.file_the_rest(mesh, moves, before);
         region.positions_changed();
         let mut marks = vec![false; region.faces.len()];
         for &v in &moved_back {
