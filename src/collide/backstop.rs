@@ -339,7 +339,9 @@ fn crossings(
         if in_sheet(f) && region.single_layer() {
             return found;
         }
-        region.candidates_along(tri_f, scratch, |local| {
+        // Faces of `f`'s own sheet are skipped below: they are not even listed.
+        let skip = in_sheet(f).then_some(layer);
+        region.candidates_along((tri_f, skip), scratch, |local| {
             let g = region.faces[local];
             if g == f || (g < f && is_moving(g)) || in_sheet(g) || share_a_vertex(mesh, f, g) {
                 return;

@@ -63,6 +63,8 @@ pub struct Region {
     filed: bool,
     filed_near: bool,
     vertices: Vec<u32>,
+    /// Per local face: its layer (read where a search skips one).
+    local_layers: Vec<u32>,
     /// Mesh faces already in `faces`, and their index there.
     gathered: Stamps,
     local_index: Vec<u32>,
@@ -189,7 +191,9 @@ impl Region {
                 }
             }
         }
-        let face_layers = self.faces.iter().map(|&f| mesh.face_layers()[f as usize]);
+        self.local_layers.clear();
+        (self.local_layers).extend(self.faces.iter().map(|&f| mesh.face_layers()[f as usize]));
+        let face_layers = self.local_layers.iter().copied();
         layers_among(mesh.layer_count(), face_layers, &mut self.layers);
         // Only a moving vertex's own layer is ever skipped: only those layers are tested.
         let moving = selection
@@ -450,79 +454,91 @@ impl Region {
         self.changed.filed = false;
     }
 
-    /// The local faces [`Region::file_changed`] filed whose box overlaps `query`, each once;
-    /// all of [`Region::candidates`] when none were filed.
+    /// The local faces [`Region::file_changed`] filed whose box overlaps `query`, each once,
+    /// but those of the layer `skip`; all of [`Region::candidates`] when none were filed.
     pub(super) fn changed_candidates(
         &self,
-        query: &Aabb,
+        (query, skip): (&Aabb, Option<u32>),
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
         let changed = &self.changed;
         if !changed.filed {
-            return self.candidates(query, scratch, f);
+            return self.candidates((query, skip), scratch, f);
         }
+        let wanted = |k: u32| {
+            let local = changed.faces[k as usize];
+            Some(self.local_layers[local as usize]) != skip
+                && changed.boxes[k as usize].overlaps(query)
+        };
         if self.use_grid {
             scratch.seen.start(changed.faces.len());
             changed.grid.for_each_candidate(query, |k| {
-                if scratch.seen.insert(k as usize) && changed.boxes[k as usize].overlaps(query) {
+                if scratch.seen.insert(k as usize) && wanted(k) {
                     f(changed.faces[k as usize] as usize);
                 }
             });
         } else {
-            for (k, b) in changed.boxes.iter().enumerate() {
-                if b.overlaps(query) {
-                    f(changed.faces[k] as usize);
+            for k in 0..changed.faces.len() as u32 {
+                if wanted(k) {
+                    f(changed.faces[k as usize] as usize);
                 }
             }
         }
     }
 
     /// Local faces whose box overlaps `triangle`'s box and that are filed where `triangle`
-    /// passes, each once: those that can cross it.
+    /// passes, each once, but those of the layer `skip`: those that can cross it.
     pub(super) fn candidates_along(
         &self,
-        triangle: [Vec3; 3],
+        (triangle, skip): ([Vec3; 3], Option<u32>),
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
         debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
         let query = Aabb::of_points(&triangle);
         if !self.use_grid {
-            return self.candidates(&query, scratch, f);
+            return self.candidates((&query, skip), scratch, f);
         }
         let swept = SweptTriangle::at_rest(triangle);
         scratch.seen.start(self.faces.len());
         let mut cells = std::mem::take(&mut scratch.cells);
         self.grid
             .for_each_candidate_along(&query, &swept, &mut cells, |local| {
-                if scratch.seen.insert(local as usize)
-                    && self.boxes[local as usize].overlaps(&query)
-                {
+                if self.wanted(local, (&query, skip)) && scratch.seen.insert(local as usize) {
                     f(local as usize);
                 }
             });
         scratch.cells = cells;
     }
 
-    /// Local faces whose box overlaps `query`, each once.
-    pub(super) fn candidates(&self, query: &Aabb, scratch: &mut Scratch, mut f: impl FnMut(usize)) {
+    /// Local faces whose box overlaps `query`, each once, but those of the layer `skip` (a
+    /// search that skips a clear sheet's own faces leaves them before looking them up).
+    pub(super) fn candidates(
+        &self,
+        (query, skip): (&Aabb, Option<u32>),
+        scratch: &mut Scratch,
+        mut f: impl FnMut(usize),
+    ) {
         debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
         if self.use_grid {
             scratch.seen.start(self.faces.len());
             self.grid.for_each_candidate(query, |local| {
-                if scratch.seen.insert(local as usize) && self.boxes[local as usize].overlaps(query)
-                {
+                if self.wanted(local, (query, skip)) && scratch.seen.insert(local as usize) {
                     f(local as usize);
                 }
             });
         } else {
-            for (local, b) in self.boxes.iter().enumerate() {
-                if b.overlaps(query) {
-                    f(local);
+            for local in 0..self.faces.len() as u32 {
+                if self.wanted(local, (query, skip)) {
+                    f(local as usize);
                 }
             }
         }
+    }
+
+    fn wanted(&self, local: u32, (query, skip): (&Aabb, Option<u32>)) -> bool {
+        Some(self.local_layers[local as usize]) != skip && self.boxes[local as usize].overlaps(query)
     }
 }
 
@@ -635,7 +651,8 @@ mod tests {
                 let query = Aabb::of_points(&[before[slot], targets[slot]]).expanded(0.5);
                 let met = |region: &Region, scratch: &mut Scratch| {
                     let mut met = Vec::new();
-                    region.candidates(&query, scratch, |local| met.push(region.faces[local]));
+                    let met_one = |local| met.push(region.faces[local]);
+                    region.candidates((&query, None), scratch, met_one);
                     met.sort_unstable();
                     met
                 };

@@ -54,10 +54,12 @@ pub fn pull_back(
     let mut nearby = std::mem::take(&mut scratch.nearby);
     nearby.clear();
     let gather = |local| nearby.push(local as u32);
+    // A clear layer's own faces are skipped below: they are not even listed.
+    let skip = own_clear.then_some(own_layer);
     match changed {
         // Only the faces the last pass changed are tested: those filed apart, if they are.
-        Some(_) => region.changed_candidates(&query, scratch, gather),
-        None => region.candidates(&query, scratch, gather),
+        Some(_) => region.changed_candidates((&query, skip), scratch, gather),
+        None => region.candidates((&query, skip), scratch, gather),
     }
     let mut t = 1.0f32;
     for &local in &nearby {
