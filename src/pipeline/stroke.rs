@@ -713,6 +713,7 @@ fn refresh_normals(
     call: &mut SamplesReport,
 ) {
     let started = Instant::now();
+    // A sample's steps may list a vertex once each.
     marks.start(mesh.vertex_count());
     let on_a_face = |v: u32| mesh.adjacency().vertex_corner[v as usize] != INVALID;
     let movers: Vec<u32> = moved
