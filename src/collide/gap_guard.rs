@@ -257,15 +257,7 @@ mod tests {
         let mesh = shapes::stacked_sheets(2, 16, 16, 1.0, gap);
         let grid = SpatialHash::build(&mesh, 1.0).unwrap();
         let active = vec![true; mesh.layer_count()];
-        let state = StrokeState {
-            grid: Some(&grid),
-            active: &active,
-            parallel: false,
-            collision_distance: 0.5,
-            ring: 1,
-            max_edge: mesh.longest_edge() * 1.1,
-            cull: true,
-        };
+        let state = StrokeState::for_tests(&grid, &active, mesh.longest_edge() * 1.1);
         let selection: Vec<(u32, f32)> = [7 * 17 + 7, 7 * 17 + 8, 8 * 17 + 7, 8 * 17 + 8]
             .iter()
             .map(|&v| (v, 1.0))

@@ -611,15 +611,7 @@ mod tests {
         // Cells far smaller than an edge: a face can meet a search with no corner near it.
         let grid = SpatialHash::build(&mesh, 0.3).unwrap();
         let active = vec![true; mesh.layer_count()];
-        let state = StrokeState {
-            grid: Some(&grid),
-            active: &active,
-            parallel: false,
-            collision_distance: 0.5,
-            ring: 1,
-            max_edge: mesh.longest_edge() * 1.01,
-            cull: true,
-        };
+        let state = StrokeState::for_tests(&grid, &active, mesh.longest_edge() * 1.01);
         let top = mesh.layer_count() as u32 - 1;
         let middle = Vec3::new(24.0, 24.0, 0.0);
         let selection: Vec<(u32, f32)> = (0..mesh.vertex_count() as u32)

@@ -518,13 +518,9 @@ mod tests {
         let grid = SpatialHash::build(mesh, 1.0).unwrap();
         let active = [true];
         let state = StrokeState {
-            grid: Some(&grid),
-            active: &active,
-            parallel: false,
             collision_distance: d,
             ring,
-            max_edge: mesh.longest_edge() * 1.01,
-            cull: true,
+            ..StrokeState::for_tests(&grid, &active, mesh.longest_edge() * 1.01)
         };
         let row = CELLS + 1;
         let block: Vec<u32> = BLOCK

@@ -21,3 +21,20 @@ pub struct StrokeState<'a> {
     /// compare: the results are the same either way.
     pub cull: bool,
 }
+
+#[cfg(test)]
+impl<'a> StrokeState<'a> {
+    /// The unit tests' stroke: on one thread, culling, `d` = 0.5, a ring of 1, every layer of
+    /// `active` brushed, `max_edge` as given.
+    pub(super) fn for_tests(grid: &'a SpatialHash, active: &'a [bool], max_edge: f32) -> Self {
+        StrokeState {
+            grid: Some(grid),
+            active,
+            parallel: false,
+            collision_distance: 0.5,
+            ring: 1,
+            max_edge,
+            cull: true,
+        }
+    }
+}
