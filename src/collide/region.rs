@@ -12,7 +12,7 @@ use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps, SweptTriangle};
 use crate::geom::Aabb;
 use crate::grow::grow_to;
-use crate::mesh::{INVALID, Mesh};
+use crate::mesh::{INVALID, Mesh, MeshVersion};
 
 /// A step's moves: the selection, each selected vertex's target, and per vertex its index in
 /// the selection (`INVALID` for the others).
@@ -97,6 +97,11 @@ pub struct Region {
     /// Moving vertices whose own neighbourhood cleared them of a search this step
     /// (`super::sheet::clear_around`).
     pub(super) cleared_vertices: usize,
+    /// Where the mesh stood when a step that gathered this region ended
+    /// ([`Region::step_ended`]): while it still stands there, the region is still whole.
+    whole_at: Option<(MeshVersion, bool)>,
+    /// The last gathering kept the vertices and faces it found before.
+    pub(super) kept_last: bool,
 }
 
 /// The local faces a Jacobi pass of the clamp changed (around the vertices it pulled back),
@@ -160,8 +165,56 @@ impl Region {
         // A face within d of a moving point has a vertex within d + longest edge; a face that
         // crosses a moving face has a vertex within two longest edges of the moving vertex.
         let reach = state.collision_distance + 2.0 * state.max_edge;
-        let region = bounds.expanded(reach);
         self.bounds = bounds;
+        let whole_at = self.whole_at.take();
+        self.kept_last = self.still_whole(whole_at, state, mesh)
+            && self.covers_box(&bounds.expanded(reach));
+        if !self.kept_last {
+            // Room for a next step of the same sample, which moves on about as far again.
+            let step = selection.iter().zip(targets).map(|(&(v, _), &q)| {
+                (q - positions[v as usize]).abs().max_element()
+            });
+            self.list_around(state, mesh, bounds.expanded(reach + step.fold(0.0, f32::max)));
+        }
+        // Only a moving vertex's own layer is ever skipped: only those layers are tested.
+        let moving = selection
+            .iter()
+            .map(|&(v, _)| mesh.vertex_layers()[v as usize]);
+        layers_among(mesh.layer_count(), moving, &mut self.moving_layers);
+        self.sheets = None;
+        self.no_sheet_this_step = false;
+        self.ready = true;
+        self.use_grid = state.grid.is_some();
+        self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
+        self.filed = false;
+        self.filed_near = false;
+        self.changed.filed = false;
+    }
+
+    /// Whether the vertices and faces listed last are still those around the reach: the mesh
+    /// stands where a step that gathered them left it (`whole_at`), listed the same way. That
+    /// step moved only its selection, which the listing holds; no vertex outside it moved, so
+    /// none entered the reach, and the faces are as they were.
+    fn still_whole(
+        &self,
+        whole_at: Option<(MeshVersion, bool)>,
+        state: &StrokeState<'_>,
+        mesh: &Mesh,
+    ) -> bool {
+        whole_at == Some((mesh.version(), state.grid.is_some()))
+    }
+
+    /// The step under way ends with the mesh where it is now: if it gathered this region, a
+    /// next step whose reach lies within this one's may keep its listing
+    /// ([`Region::gather_unfiled`]).
+    pub(super) fn step_ended(&mut self, mesh: &Mesh) {
+        self.whole_at = self.ready.then(|| (mesh.version(), self.use_grid));
+    }
+
+    /// Lists the vertices filed in a cell that overlaps `region` (or, without a grid, lying in
+    /// it) and their faces.
+    fn list_around(&mut self, state: &StrokeState<'_>, mesh: &Mesh, region: Aabb) {
+        let positions = mesh.positions();
         self.reach = region;
         self.vertices.clear();
         match state.grid {
@@ -195,19 +248,6 @@ impl Region {
         (self.local_layers).extend(self.faces.iter().map(|&f| mesh.face_layers()[f as usize]));
         let face_layers = self.local_layers.iter().copied();
         layers_among(mesh.layer_count(), face_layers, &mut self.layers);
-        // Only a moving vertex's own layer is ever skipped: only those layers are tested.
-        let moving = selection
-            .iter()
-            .map(|&(v, _)| mesh.vertex_layers()[v as usize]);
-        layers_among(mesh.layer_count(), moving, &mut self.moving_layers);
-        self.sheets = None;
-        self.no_sheet_this_step = false;
-        self.ready = true;
-        self.use_grid = state.grid.is_some();
-        self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
-        self.filed = false;
-        self.filed_near = false;
-        self.changed.filed = false;
     }
 
     /// Boxes the faces (around where each vertex starts the step and, if it moves, its
@@ -388,7 +428,11 @@ impl Region {
 
     /// Whether a query of the grid over `query` finds only vertices this region gathered.
     pub(super) fn covers(&self, query: &Aabb) -> bool {
-        self.ready && query.min.cmpge(self.reach.min).all() && query.max.cmple(self.reach.max).all()
+        self.ready && self.covers_box(query)
+    }
+
+    fn covers_box(&self, query: &Aabb) -> bool {
+        query.min.cmpge(self.reach.min).all() && query.max.cmple(self.reach.max).all()
     }
 
     /// The vertices gathered (those the grid files in a cell overlapping the reach).
@@ -653,5 +697,78 @@ mod tests {
                 assert_eq!(from_near, from_all, "slot {slot} of {searched:?}");
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod keeping {
+    use super::*;
+    use crate::grid::SpatialHash;
+    use crate::scene::shapes;
+
+    /// The vertices of the top sheet within `radius` of its middle, pushed down by `by`.
+    fn step(mesh: &Mesh, radius: f32, by: f32) -> (Vec<(u32, f32)>, Vec<Vec3>) {
+        let top = mesh.layer_count() as u32 - 1;
+        let middle = Vec3::new(12.0, 12.0, 0.0);
+        let selection: Vec<(u32, f32)> = (0..mesh.vertex_count() as u32)
+            .filter(|&v| mesh.vertex_layers()[v as usize] == top)
+            .filter(|&v| (mesh.positions()[v as usize] - middle).truncate().length() < radius)
+            .map(|v| (v, 1.0))
+            .collect();
+        let targets = (selection.iter())
+            .map(|&(v, _)| mesh.positions()[v as usize] - Vec3::Z * by)
+            .collect();
+        (selection, targets)
+    }
+
+    fn move_to(mesh: &mut Mesh, (selection, targets): &(Vec<(u32, f32)>, Vec<Vec3>)) {
+        for (&(v, _), &q) in selection.iter().zip(targets) {
+            mesh.positions_mut()[v as usize] = q;
+        }
+    }
+
+    /// A step keeps the last step's listing where the mesh stands as that step left it and its
+    /// reach fits (then it holds every face a fresh gathering finds), and not after a vertex
+    /// it did not list moved, nor where its reach leaves the listing's.
+    #[test]
+    fn a_region_is_kept_only_while_nothing_outside_it_moved() {
+        let mut mesh = shapes::stacked_sheets(2, 24, 24, 1.0, 0.6);
+        let grid = SpatialHash::build(&mesh, 1.0).unwrap();
+        let active = vec![true; mesh.layer_count()];
+        let state = StrokeState::for_tests(&grid, &active, mesh.longest_edge() * 1.01);
+        let mut region = Region::default();
+        region.size_for(&mesh);
+        type Step = (Vec<(u32, f32)>, Vec<Vec3>);
+        let gather = |region: &mut Region, mesh: &Mesh, (selection, targets): &Step| {
+            region.forget();
+            region.gather_unfiled(&state, mesh, selection, targets);
+            region.kept_last
+        };
+        // The listing leaves room for a move as long again: 0.2 down in all.
+        let first = step(&mesh, 4.0, 0.1);
+        assert!(!gather(&mut region, &mesh, &first), "nothing to keep at first");
+        move_to(&mut mesh, &first);
+        region.step_ended(&mesh);
+
+        let second = step(&mesh, 4.0, 0.05);
+        assert!(gather(&mut region, &mesh, &second), "a next step within reach keeps it");
+        let mut fresh = Region::default();
+        fresh.size_for(&mesh);
+        gather(&mut fresh, &mesh, &second);
+        let kept: std::collections::HashSet<u32> = region.faces.iter().copied().collect();
+        assert!(fresh.faces.iter().all(|f| kept.contains(f)), "a kept listing misses a face");
+        move_to(&mut mesh, &second);
+        region.step_ended(&mesh);
+
+        // Within reach again, but a vertex it did not list moved (the lower sheet's corner).
+        mesh.positions_mut()[0].z -= 0.1;
+        let third = step(&mesh, 4.0, 0.02);
+        assert!(!gather(&mut region, &mesh, &third), "kept after a vertex outside moved");
+        move_to(&mut mesh, &third);
+        region.step_ended(&mesh);
+
+        // A wider brush reaches past the listing.
+        let wider = step(&mesh, 8.0, 0.0);
+        assert!(!gather(&mut region, &mesh, &wider), "kept for a reach past the listing");
     }
 }

@@ -245,6 +245,7 @@ pub fn collide_with(
             break;
         }
     }
+    region.step_ended(mesh);
     let positions = selection
         .iter()
         .map(|&(v, _)| mesh.positions()[v as usize])
