@@ -10,7 +10,7 @@ use super::rings::RingCache;
 use super::sheet::{FaceSlope, Sheet};
 use super::state::StrokeState;
 use super::{LocalFaceGrid, Stamps, SweptTriangle};
-use crate::geom::Aabb;
+use crate::geom::{Aabb, largest_move};
 use crate::grow::grow_to;
 use crate::mesh::{INVALID, Mesh, MeshVersion};
 
@@ -56,12 +56,10 @@ pub struct Region {
     swept: Vec<SweptTriangle>,
     grid: LocalFaceGrid,
     use_grid: bool,
-    /// The local grid's cell side (none without a global grid), and whether the faces are
-    /// filed in it yet: all of them, or only those near a few searched vertices
-    /// ([`Region::file_faces_near`]).
+    /// The local grid's cell side (none without a global grid), and which faces are filed in
+    /// it yet.
     cell: Option<f32>,
-    filed: bool,
-    filed_near: bool,
+    filed: Filing,
     vertices: Vec<u32>,
     /// Per local face: its layer (read where a search skips one).
     local_layers: Vec<u32>,
@@ -97,11 +95,24 @@ pub struct Region {
     /// Moving vertices whose own neighbourhood cleared them of a search this step
     /// (`super::sheet::clear_around`).
     pub(super) cleared_vertices: usize,
-    /// Where the mesh stood when a step that gathered this region ended
-    /// ([`Region::step_ended`]): while it still stands there, the region is still whole.
+    /// Where the mesh stood, and whether the listing went through a grid, when a step that
+    /// gathered this region ended ([`Region::step_ended`]). While the mesh stands there and
+    /// lists the same way, the vertices and faces listed are still those around the reach:
+    /// that step moved only its selection, which the listing holds; no vertex outside it
+    /// moved, so none entered the reach, and the faces are as they were.
     whole_at: Option<(MeshVersion, bool)>,
     /// The last gathering kept the vertices and faces it found before.
     pub(super) kept_last: bool,
+}
+
+/// Which of a region's faces its local grid holds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+enum Filing {
+    #[default]
+    None,
+    /// Only those a few searched vertices can meet ([`Region::file_faces_near`]).
+    Near,
+    All,
 }
 
 /// The local faces a Jacobi pass of the clamp changed (around the vertices it pulled back),
@@ -166,15 +177,19 @@ impl Region {
         // crosses a moving face has a vertex within two longest edges of the moving vertex.
         let reach = state.collision_distance + 2.0 * state.max_edge;
         self.bounds = bounds;
-        let whole_at = self.whole_at.take();
-        self.kept_last = self.still_whole(whole_at, state, mesh)
-            && self.covers_box(&bounds.expanded(reach));
+        let whole = self.whole_at.take() == Some((mesh.version(), state.grid.is_some()));
+        self.kept_last = whole && self.covers_box(&bounds.expanded(reach));
         if !self.kept_last {
             // Room for a next step of the same sample, which moves on about as far again.
-            let step = selection.iter().zip(targets).map(|(&(v, _), &q)| {
-                (q - positions[v as usize]).abs().max_element()
-            });
-            self.list_around(state, mesh, bounds.expanded(reach + step.fold(0.0, f32::max)));
+            let step = selection
+                .iter()
+                .zip(targets)
+                .map(|(&(v, _), &q)| (q - positions[v as usize]).abs().max_element());
+            self.list_around(
+                state,
+                mesh,
+                bounds.expanded(reach + step.fold(0.0, f32::max)),
+            );
         }
         // Only a moving vertex's own layer is ever skipped: only those layers are tested.
         let moving = selection
@@ -186,22 +201,8 @@ impl Region {
         self.ready = true;
         self.use_grid = state.grid.is_some();
         self.cell = state.grid.map(|g| LOCAL_CELL_EDGES * g.cell_size());
-        self.filed = false;
-        self.filed_near = false;
+        self.filed = Filing::None;
         self.changed.filed = false;
-    }
-
-    /// Whether the vertices and faces listed last are still those around the reach: the mesh
-    /// stands where a step that gathered them left it (`whole_at`), listed the same way. That
-    /// step moved only its selection, which the listing holds; no vertex outside it moved, so
-    /// none entered the reach, and the faces are as they were.
-    fn still_whole(
-        &self,
-        whole_at: Option<(MeshVersion, bool)>,
-        state: &StrokeState<'_>,
-        mesh: &Mesh,
-    ) -> bool {
-        whole_at == Some((mesh.version(), state.grid.is_some()))
     }
 
     /// The step under way ends with the mesh where it is now: if it gathered this region, a
@@ -254,7 +255,7 @@ impl Region {
     /// target; `before` holds the selection's starts) and files them in the local grid, once
     /// per gathering.
     pub(super) fn file_faces(&mut self, mesh: &Mesh, moves: StepMoves<'_>, before: &[Vec3]) {
-        if self.filed {
+        if self.filed == Filing::All {
             return;
         }
         self.boxes.clear();
@@ -268,13 +269,12 @@ impl Region {
             self.grid
                 .build_swept(&self.boxes, &self.swept, self.reach, cell);
         }
-        self.filed = true;
-        self.filed_near = false;
+        self.filed = Filing::All;
     }
 
     /// Files every face, where [`Region::file_faces_near`] filed only some.
     pub(super) fn file_the_rest(&mut self, mesh: &Mesh, moves: StepMoves<'_>, before: &[Vec3]) {
-        if self.filed_near {
+        if self.filed == Filing::Near {
             self.file_faces(mesh, moves, before);
         }
     }
@@ -298,7 +298,7 @@ impl Region {
         let Some(grid) = state.grid.filter(|_| self.use_grid) else {
             return self.file_faces(mesh, moves, before);
         };
-        if self.filed || self.filed_near {
+        if self.filed != Filing::None {
             return;
         }
         // Past this share of the region's faces per searched vertex, filing them all is as
@@ -307,15 +307,10 @@ impl Region {
             return self.file_faces(mesh, moves, before);
         }
         let (_, targets, _) = moves;
-        let step = before
-            .iter()
-            .zip(targets)
-            .fold(0.0f32, |m, (p, q)| m.max((*q - *p).abs().max_element()));
+        let step = largest_move(before, targets);
         let scale = self.reach.min.abs().max(self.reach.max.abs()).max_element();
-        let grown = state.collision_distance
-            + state.max_edge * 1.001
-            + step
-            + 4.0 * f32::EPSILON * scale;
+        let grown =
+            state.collision_distance + state.max_edge * 1.001 + step + 4.0 * f32::EPSILON * scale;
         self.near_marks.start(mesh.face_count());
         let mut near: Vec<u32> = Vec::new();
         for &slot in searched {
@@ -336,7 +331,11 @@ impl Region {
             .map(|&l| sweep_of(mesh, self.faces[l as usize], moves, before))
             .collect();
         grow_to(&mut self.boxes, self.faces.len(), Aabb::EMPTY);
-        grow_to(&mut self.swept, self.faces.len(), SweptTriangle::at_rest([Vec3::ZERO; 3]));
+        grow_to(
+            &mut self.swept,
+            self.faces.len(),
+            SweptTriangle::at_rest([Vec3::ZERO; 3]),
+        );
         for (&l, &(swept_box, swept)) in near.iter().zip(&sweeps) {
             self.boxes[l as usize] = swept_box;
             self.swept[l as usize] = swept;
@@ -347,7 +346,7 @@ impl Region {
         let cell = self.cell.expect("a global grid gives the local one a cell");
         self.grid
             .build_some_swept((&boxes, &swept, &near), self.reach, cell);
-        self.filed_near = true;
+        self.filed = Filing::Near;
     }
 
     /// Whether the proximity clamp's search of the region could find anything where the mesh
@@ -471,10 +470,13 @@ impl Region {
     /// Files the local faces `marks` holds (those a Jacobi pass changed) apart, for
     /// [`Region::changed_candidates`]; without the region's faces filed, forgets any.
     pub(super) fn file_changed(&mut self, marks: &[bool]) {
-        debug_assert!(!self.filed_near, "changed faces filed before all the faces were");
+        debug_assert!(
+            self.filed != Filing::Near,
+            "changed faces filed before all the faces were"
+        );
         let changed = &mut self.changed;
-        changed.filed = self.filed;
-        if !self.filed {
+        changed.filed = self.filed == Filing::All;
+        if !changed.filed {
             return;
         }
         changed.faces.clear();
@@ -539,7 +541,10 @@ impl Region {
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
-        debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
+        debug_assert!(
+            self.filed != Filing::None,
+            "a search before the faces were filed"
+        );
         let query = Aabb::of_points(&triangle);
         if !self.use_grid {
             return self.candidates((&query, skip), scratch, f);
@@ -564,7 +569,10 @@ impl Region {
         scratch: &mut Scratch,
         mut f: impl FnMut(usize),
     ) {
-        debug_assert!(self.filed || self.filed_near, "a search before the faces were filed");
+        debug_assert!(
+            self.filed != Filing::None,
+            "a search before the faces were filed"
+        );
         if self.use_grid {
             scratch.seen.start(self.faces.len());
             self.grid.for_each_candidate(query, |local| {
@@ -582,7 +590,8 @@ impl Region {
     }
 
     fn wanted(&self, local: u32, (query, skip): (&Aabb, Option<u32>)) -> bool {
-        Some(self.local_layers[local as usize]) != skip && self.boxes[local as usize].overlaps(query)
+        Some(self.local_layers[local as usize]) != skip
+            && self.boxes[local as usize].overlaps(query)
     }
 }
 
@@ -610,7 +619,13 @@ fn sweep_of(mesh: &Mesh, f: u32, moves: StepMoves<'_>, before: &[Vec3]) -> (Aabb
         };
         swept_box = swept_box.including(*corner);
     }
-    (swept_box, SweptTriangle { corners, moves: moved })
+    (
+        swept_box,
+        SweptTriangle {
+            corners,
+            moves: moved,
+        },
+    )
 }
 
 /// Cell side of the per-step face grid, in edge lengths: a face box then covers one to two
@@ -663,7 +678,10 @@ mod tests {
             .filter(|&v| (mesh.positions()[v as usize] - middle).truncate().length() < 9.0)
             .map(|v| (v, 1.0))
             .collect();
-        let before: Vec<Vec3> = selection.iter().map(|&(v, _)| mesh.positions()[v as usize]).collect();
+        let before: Vec<Vec3> = selection
+            .iter()
+            .map(|&(v, _)| mesh.positions()[v as usize])
+            .collect();
         let targets: Vec<Vec3> = (before.iter().enumerate())
             .map(|(i, p)| *p + Vec3::new(0.1 * (i % 3) as f32, 0.0, -0.2 - 0.05 * (i % 5) as f32))
             .collect();
@@ -676,12 +694,17 @@ mod tests {
         all.size_for(&mesh);
         all.gather(&state, &mesh, &selection, &targets, &target_of);
         let slots: Vec<usize> = (0..selection.len()).collect();
-        for searched in [vec![0], vec![5, 6, 7], slots.iter().step_by(7).copied().collect()] {
+        for searched in [
+            vec![0],
+            vec![5, 6, 7],
+            slots.iter().step_by(7).copied().collect(),
+        ] {
             let mut near = Region::default();
             near.size_for(&mesh);
             near.gather_unfiled(&state, &mesh, &selection, &targets);
             near.file_faces_near(&state, &mesh, moves, (&before, &searched));
-            assert!(near.filed_near, "{} searches filed alone", searched.len());
+            let filed_near = near.filed == Filing::Near;
+            assert!(filed_near, "{} searches filed alone", searched.len());
             let mut scratch = Scratch::default();
             for &slot in &searched {
                 let query = Aabb::of_points(&[before[slot], targets[slot]]).expanded(0.5);
@@ -746,29 +769,44 @@ mod keeping {
         };
         // The listing leaves room for a move as long again: 0.2 down in all.
         let first = step(&mesh, 4.0, 0.1);
-        assert!(!gather(&mut region, &mesh, &first), "nothing to keep at first");
+        assert!(
+            !gather(&mut region, &mesh, &first),
+            "nothing to keep at first"
+        );
         move_to(&mut mesh, &first);
         region.step_ended(&mesh);
 
         let second = step(&mesh, 4.0, 0.05);
-        assert!(gather(&mut region, &mesh, &second), "a next step within reach keeps it");
+        assert!(
+            gather(&mut region, &mesh, &second),
+            "a next step within reach keeps it"
+        );
         let mut fresh = Region::default();
         fresh.size_for(&mesh);
         gather(&mut fresh, &mesh, &second);
         let kept: std::collections::HashSet<u32> = region.faces.iter().copied().collect();
-        assert!(fresh.faces.iter().all(|f| kept.contains(f)), "a kept listing misses a face");
+        assert!(
+            fresh.faces.iter().all(|f| kept.contains(f)),
+            "a kept listing misses a face"
+        );
         move_to(&mut mesh, &second);
         region.step_ended(&mesh);
 
         // Within reach again, but a vertex it did not list moved (the lower sheet's corner).
         mesh.positions_mut()[0].z -= 0.1;
         let third = step(&mesh, 4.0, 0.02);
-        assert!(!gather(&mut region, &mesh, &third), "kept after a vertex outside moved");
+        assert!(
+            !gather(&mut region, &mesh, &third),
+            "kept after a vertex outside moved"
+        );
         move_to(&mut mesh, &third);
         region.step_ended(&mesh);
 
         // A wider brush reaches past the listing.
         let wider = step(&mesh, 8.0, 0.0);
-        assert!(!gather(&mut region, &mesh, &wider), "kept for a reach past the listing");
+        assert!(
+            !gather(&mut region, &mesh, &wider),
+            "kept for a reach past the listing"
+        );
     }
 }
