@@ -10,10 +10,6 @@ use glam::Vec3;
 
 use super::{INVALID, Mesh, VertexFlags, face_of, next, prev};
 
-/// The longest vertex ring [`Mesh::is_collapse_ok`] gathers on the stack; longer ones (rare)
-/// go to the heap.
-const STACK_RING: usize = 32;
-
 impl Mesh {
     /// The two end vertices of the edge opposite `corner`.
     pub fn edge_vertices(&self, corner: u32) -> (u32, u32) {
@@ -232,8 +228,7 @@ impl Mesh {
         }
         // Most fans are short: their rings are gathered on the stack, where this test runs
         // millions of times in a whole-mesh remesh.
-        let (ring_a, ring_b) = (Ring::of(self, a), Ring::of(self, b));
-        let (ring_a, ring_b) = (ring_a.as_slice(), ring_b.as_slice());
+        let (ring_a, ring_b) = (self.neighbours(a), self.neighbours(b));
         let shared = ring_a.iter().filter(|v| ring_b.contains(v)).count();
         let expected = if boundary_edge { 1 } else { 2 };
         if shared != expected || !ring_a.contains(&x) || (!boundary_edge && !ring_a.contains(&y)) {
@@ -337,33 +332,5 @@ impl Mesh {
         }
         self.version.topology = super::next_stamp();
         a
-    }
-}
-
-/// A vertex's ring ([`Mesh::ring`]), on the stack when it fits in [`STACK_RING`].
-enum Ring {
-    Stack([u32; STACK_RING], usize),
-    Heap(Vec<u32>),
-}
-
-impl Ring {
-    fn of(mesh: &Mesh, vertex: u32) -> Ring {
-        let mut stack = [0; STACK_RING];
-        let mut count = 0;
-        for u in mesh.ring(vertex) {
-            let Some(slot) = stack.get_mut(count) else {
-                return Ring::Heap(mesh.neighbours(vertex));
-            };
-            *slot = u;
-            count += 1;
-        }
-        Ring::Stack(stack, count)
-    }
-
-    fn as_slice(&self) -> &[u32] {
-        match self {
-            Ring::Stack(stack, count) => &stack[..*count],
-            Ring::Heap(ring) => ring,
-        }
     }
 }

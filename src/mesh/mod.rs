@@ -19,6 +19,7 @@ mod measure;
 mod patch;
 mod raw;
 mod repair;
+mod ring;
 mod slit;
 mod stitch;
 mod validate;
@@ -34,6 +35,7 @@ pub use measure::EdgeLengthStats;
 pub use patch::{Patch, PutBackError};
 pub use raw::RawMeshError;
 pub use repair::{Repaired, Repairs, Soup, repair, without_unreferenced};
+pub use ring::{Ring, RingIter};
 pub use vertex_faces::VertexFaces;
 
 use glam::Vec3;
@@ -370,10 +372,8 @@ impl Mesh {
 
     /// The one-ring of a vertex, in fan order. On a boundary it runs from one boundary
     /// neighbour to the other.
-    pub fn neighbours(&self, vertex: u32) -> Vec<u32> {
-        let mut ring = Vec::with_capacity(8);
-        ring.extend(self.ring(vertex));
-        ring
+    pub fn neighbours(&self, vertex: u32) -> Ring {
+        Ring::of(self, vertex)
     }
 
     /// [`Self::neighbours`] without gathering them.

@@ -292,10 +292,23 @@ impl Remesher<'_> {
             return None;
         }
         let layer = self.mesh.vertex_layers()[v as usize];
-        let near_old = |p: Vec3| self.surface.is_near(p, layer, tolerance);
+        // Faces around `at` share their edges' midpoints: each point is asked once.
+        // (A fan too large for the list asks its last points again.)
+        let mut asked = [Vec3::NAN; 48];
+        let mut count = 0;
+        let mut near_old = |p: Vec3| {
+            if asked[..count].contains(&p) {
+                return true;
+            }
+            if let Some(slot) = asked.get_mut(count) {
+                *slot = p;
+                count += 1;
+            }
+            self.surface.is_near(p, layer, tolerance)
+        };
         after
             .iter()
-            .all(|t| samples(t, at).all(near_old))
+            .all(|t| samples(t, at).all(&mut near_old))
             .then_some(delta)
     }
 }
