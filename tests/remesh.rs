@@ -480,3 +480,34 @@ fn remeshing_per_sample_keeps_the_mesh_sound() {
         strokes.len()
     );
 }
+
+/// An evenly stretched grid is a fixed point of Botsch & Kobbelt's four edits: every valence
+/// is 6, no edge is past 4/3·L, and collapsing a short edge would leave one past it. The
+/// issue's torus (quads twice as long around as across, split in two) kept a third of the
+/// edges on its top short that way. The first iteration's collapses may leave edges up to
+/// 1.5·L, which the next iteration's splits take: few edges stay short, the spread falls, and
+/// the edges stay about L long.
+#[test]
+fn a_stretched_grid_loses_its_short_edges() {
+    let mut torus = common::torus(200, 100, (1.0, 0.35));
+    let target = torus.mean_edge_length();
+    let report = remesh_all(&mut torus, &RemeshSettings::new(target)).unwrap();
+    eprintln!("{report:?}");
+    torus.validate().unwrap();
+    assert_eq!(find_intersections(&torus).total(), 0);
+    let p = torus.positions();
+    let lengths: Vec<f32> = (torus.edges().iter())
+        .map(|&[a, b]| p[a as usize].distance(p[b as usize]) / target)
+        .collect();
+    let short = lengths.iter().filter(|&&l| l < 0.8).count() as f32 / lengths.len() as f32;
+    let mean = lengths.iter().sum::<f32>() / lengths.len() as f32;
+    let cv = torus.edge_length_stats().coefficient_of_variation();
+    // Before: 9.4 % short, cv 0.146.
+    assert!(
+        short < 0.06,
+        "{:.1} % of the edges are short",
+        100.0 * short
+    );
+    assert!(cv < 0.14, "edge cv {cv}");
+    assert!((0.95..1.1).contains(&mean), "mean edge {mean} L");
+}

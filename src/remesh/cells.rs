@@ -5,11 +5,12 @@
 //! one sheet and nothing else settles its edits' safety checks once (`zone`).
 //!
 //! Edges between two cells belong to neither region. A second round over cells shifted by half
-//! a cell takes them where they are still out of band, and a third, shifted by a quarter, what
-//! lies on both earlier rounds' seams (near where their planes cross) and what the second left
-//! out of band. A round's cells are remeshed slab by slab on every core (`slabs`), or, on a
-//! mesh too short for that, one after another in place; either way what runs in what order
-//! follows from the mesh alone, never from the thread count.
+//! a cell takes them where they are still out of band, with what the first left out of band
+//! inside cells: its regions start at those edges' ends and take a ring around them, which
+//! reaches across its own seams, so every edge out of band as it begins is in some region. A
+//! round's cells are remeshed slab by slab on every core (`slabs`), or, on a mesh too short for
+//! that, one after another in place; either way what runs in what order follows from the mesh
+//! alone, never from the thread count.
 
 use glam::{IVec3, Vec3};
 
@@ -34,6 +35,11 @@ const CELLS_FROM_VERTICES: usize = 20_000;
 /// queries span dozens of edges (its reference surface, its zone), and a grid of edge-sized
 /// cells spent most of their time walking empty ones.
 const GRID_EDGES: f32 = 4.0;
+/// Iterations of the second round at most: it mends seams and stragglers on a mesh the first
+/// has evened out. On the 1M-face torus a third iteration there took edge cv from 0.134 to
+/// 0.130 for 4 % more time, and a third round (shifted by a quarter cell) on top to 0.125 for
+/// 22 % more.
+const SECOND_ROUND_ITERATIONS: usize = 2;
 
 /// Remeshes every vertex of `mesh`: a small mesh as one region, a larger one cell by cell (the
 /// module's rounds). `start` says which vertices the (first round's) regions begin at; the
@@ -94,13 +100,17 @@ fn remesh_by_cells(
     };
     let width = CELL_EDGES * settings.target_edge;
     let rounds = [
-        (0.0, start),
-        (0.5, Start::Subdivided),
-        (0.25, Start::Subdivided),
+        (0.0, start, settings.iterations),
+        (
+            0.5,
+            Start::Subdivided,
+            settings.iterations.min(SECOND_ROUND_ITERATIONS),
+        ),
     ];
-    for (round, (shift, start)) in rounds.into_iter().enumerate() {
+    for (round, (shift, start, iterations)) in rounds.into_iter().enumerate() {
         let settings = RemeshSettings {
             region_rings: rings(start),
+            iterations,
             ..*settings
         };
         let mut cells = cells(mesh, width, shift);

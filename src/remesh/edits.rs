@@ -82,7 +82,7 @@ impl Remesher<'_> {
 
     pub(super) fn collapse_short_edges(&mut self) {
         let short = COLLAPSE_BELOW * self.settings.target_edge;
-        let long = SPLIT_ABOVE * self.settings.target_edge;
+        let long = self.collapse_limit * self.settings.target_edge;
         for c in self.region_edges() {
             if self.mesh.is_face_dead((c / 3) as usize) || self.length(c) >= short {
                 continue;

@@ -47,6 +47,14 @@ use zone::Zone;
 
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
 pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
+/// How long an edge (× L) the collapses of a whole-mesh remesh's first iteration may leave at
+/// their survivor; later ones, like Botsch & Kobbelt's, leave none past [`SPLIT_ABOVE`]. An
+/// evenly stretched grid (a torus's top: edges of 0.72, 1.02 and 1.25·L, every valence 6) is a
+/// fixed point of the four edits under 4/3: no edge is long, no flip betters a valence,
+/// relaxation leaves a regular grid where it is, and collapsing a short edge would leave one of
+/// 1.49·L. A third of such a mesh's edges stayed short. The next iteration's splits take what
+/// this leaves past 4/3·L.
+const FIRST_COLLAPSE_LIMIT: f32 = 1.5;
 /// Where along an edge a split puts its new vertex.
 const SPLIT_AT: f32 = 0.5;
 pub const COLLAPSE_BELOW: f32 = 4.0 / 5.0;
@@ -278,6 +286,12 @@ fn remesh(
     remesher.lone_sheet = matches!(pass.zone, Zoning::LoneSheet) && remesher.zone.is_some();
     remesher.zone_keeps_own_gap = matches!(pass.zone, Zoning::Region(_));
     for round in 0..settings.iterations {
+        let opening = round == 0 && pass.start == Start::Everywhere && settings.iterations > 1;
+        remesher.collapse_limit = if opening {
+            FIRST_COLLAPSE_LIMIT
+        } else {
+            SPLIT_ABOVE
+        };
         let edits = remesher.edit_count();
         remesher.renew_zone();
         remesher.split_long_edges();
@@ -404,6 +418,8 @@ struct Remesher<'a> {
     /// remesh, which `PipelineSettings::cull` must not change. A whole-mesh remesh lets the
     /// zone settle that too (a sheet's second ring within `d` of a vertex is no crossing).
     zone_keeps_own_gap: bool,
+    /// The longest edge (× L) a collapse may leave at its survivor this iteration.
+    collapse_limit: f32,
 }
 
 impl<'a> Remesher<'a> {
@@ -469,6 +485,7 @@ impl<'a> Remesher<'a> {
             zone: None,
             lone_sheet: false,
             zone_keeps_own_gap: false,
+            collapse_limit: SPLIT_ABOVE,
         };
         for v in starting {
             remesher.mark_dirty(v);
