@@ -405,6 +405,8 @@ struct Remesher<'a> {
     report: RemeshReport,
     scratch: Vec<u32>,
     near: Vec<NearFace>,
+    /// The faces around a moving vertex and what they become ([`Remesher::move_is_safe`]).
+    move_lists: (Vec<u32>, Vec<([u32; 3], [Vec3; 3])>),
     /// A whole-mesh remesh ([`Start::Everywhere`], [`Start::Subdivided`]): relaxation passes
     /// over vertices whose move is short before projecting them.
     whole: bool,
@@ -481,6 +483,7 @@ impl<'a> Remesher<'a> {
             closed,
             scratch: Vec::new(),
             near: Vec::new(),
+            move_lists: Default::default(),
             whole: start != Start::OutOfBand,
             zone: None,
             lone_sheet: false,

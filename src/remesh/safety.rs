@@ -15,32 +15,30 @@ impl Remesher<'_> {
     /// face outside its neighbourhood gets closer than the collision distance (or than it
     /// already was), and its faces at the new position cross no other layer.
     pub(super) fn move_is_safe(&mut self, v: u32, target: Vec3, merged: Option<u32>) -> bool {
-        let positions = self.mesh.positions();
-        let faces = self.mesh.faces();
-        let carrying: Vec<u32> = [Some(v), merged]
-            .into_iter()
-            .flatten()
-            .flat_map(|w| self.mesh.faces_around(w).collect::<Vec<_>>())
-            .collect();
+        // Lists kept between edits: a pass asks this of every collapse and relaxation.
+        let (mut carrying, mut moved) = std::mem::take(&mut self.move_lists);
+        carrying.clear();
+        moved.clear();
+        for w in [Some(v), merged].into_iter().flatten() {
+            carrying.extend(self.mesh.faces_around(w));
+        }
         // The faces that will carry the vertex, at their new positions.
-        let moved: Vec<([u32; 3], [Vec3; 3])> = carrying
-            .iter()
-            .filter_map(|&f| {
-                let tri = faces[f as usize];
-                if merged.is_some_and(|m| tri.contains(&m) && tri.contains(&v)) {
-                    return None;
+        let (positions, faces) = (self.mesh.positions(), self.mesh.faces());
+        moved.extend(carrying.iter().filter_map(|&f| {
+            let tri = faces[f as usize];
+            if merged.is_some_and(|m| tri.contains(&m) && tri.contains(&v)) {
+                return None;
+            }
+            let ids = tri.map(|w| if Some(w) == merged { v } else { w });
+            let at = ids.map(|w| {
+                if w == v {
+                    target
+                } else {
+                    positions[w as usize]
                 }
-                let ids = tri.map(|w| if Some(w) == merged { v } else { w });
-                let at = ids.map(|w| {
-                    if w == v {
-                        target
-                    } else {
-                        positions[w as usize]
-                    }
-                });
-                Some((ids, at))
-            })
-            .collect();
+            });
+            Some((ids, at))
+        }));
         // The rim stays as it is unless a rim vertex moves or is merged away (asked only
         // where a zone could vouch: a stroke's remesh has none).
         let rim = |w: u32| self.mesh.is_boundary_vertex(w);
@@ -48,13 +46,15 @@ impl Remesher<'_> {
             && merged.is_none_or(|m| !rim(m))
             && (!rim(v) || positions[v as usize] == target);
         let in_zone = |remesher: &mut Self| remesher.clear_in_zone(v, target, merged);
-        self.unless_vouched(
+        let safe = self.unless_vouched(
             &moved,
             keeps_rim,
             (in_zone, |remesher| {
                 remesher.move_checks(v, (target, merged), &carrying, &moved)
             }),
-        )
+        );
+        self.move_lists = (carrying, moved);
+        safe
     }
 
     /// A move the sheet zone vouches for: safe, unless the pass keeps the zone's moves from
@@ -249,34 +249,38 @@ impl Remesher<'_> {
         let m = mesh.vertex_count() as u32;
         let p = |v: u32| mesh.positions()[v as usize];
         let at_m = p(a).lerp(p(b), SPLIT_AT);
-        let mut halves = vec![
+        let o = mesh.adjacency().opposite[c as usize];
+        // The faces across the edge, where it has them (the last two halves otherwise unused).
+        let y = if o == INVALID {
+            x
+        } else {
+            mesh.corner_vertex(o)
+        };
+        let all_halves = [
             ([x, a, m], [p(x), p(a), at_m]),
             ([x, m, b], [p(x), at_m, p(b)]),
+            ([y, b, m], [p(y), p(b), at_m]),
+            ([y, m, a], [p(y), at_m, p(a)]),
         ];
-        let mut replaced = vec![c / 3];
-        let o = mesh.adjacency().opposite[c as usize];
-        if o != INVALID {
-            let y = mesh.corner_vertex(o);
-            halves.push(([y, b, m], [p(y), p(b), at_m]));
-            halves.push(([y, m, a], [p(y), at_m, p(a)]));
-            replaced.push(o / 3);
-        }
+        let all_replaced = [c / 3, o / 3];
+        let sides = if o == INVALID { 1 } else { 2 };
+        let (halves, replaced) = (&all_halves[..2 * sides], &all_replaced[..sides]);
         let (ends, layer) = ((p(a), p(b)), mesh.vertex_layers()[a as usize]);
         self.unless_vouched(
-            &halves,
+            halves,
             o != INVALID,
             (
                 |_| true,
                 |remesher| {
                     // The halves lie on the faces they replace: only the new vertex needs the wider
                     // reach.
-                    let mut reach = bounds_of(&halves);
+                    let mut reach = bounds_of(halves);
                     if remesher.mesh.layer_count() > 1 {
                         let d = remesher.settings.collision_distance;
                         reach = reach.including_box(&Aabb::of_points(&[at_m]).expanded(d));
                     }
                     let near = remesher.gather_near(&reach);
-                    let clear = remesher.faces_clear_among(&halves, &[], &replaced, &near)
+                    let clear = remesher.faces_clear_among(halves, &[], replaced, &near)
                         && remesher.midpoint_keeps_gap(layer, ends, at_m, &near);
                     remesher.near = near;
                     clear

@@ -140,12 +140,16 @@ fn area(mesh: &Mesh) -> f64 {
 
 fn print_summary(s: &Summary) {
     let (before, after, report) = (&s.before, &s.after, &s.remesh);
+    let threads = match s.threads {
+        1 => "1 thread".to_string(),
+        n => format!("{n} threads"),
+    };
     let subdivided = match report.subdivisions {
         0 => String::new(),
         n => format!("{n} levels of subdivision, then "),
     };
     println!(
-        "remeshed to L = {}: edge cv {:.3} -> {:.3}, {} -> {} faces ({subdivided}{} splits, {} collapses, {} flips, {} relaxed; {} refused to keep the shape) in {:.0} ms on {} threads -> {}",
+        "remeshed to L = {}: edge cv {:.3} -> {:.3}, {} -> {} faces ({subdivided}{} splits, {} collapses, {} flips, {} relaxed; {} refused to keep the shape) in {:.0} ms on {threads} -> {}",
         s.target_edge,
         before.edge_cv,
         after.edge_cv,
@@ -157,7 +161,6 @@ fn print_summary(s: &Summary) {
         report.relaxed,
         report.shape_refused,
         report.millis,
-        s.threads,
         s.output
     );
     let (a, b) = (&before.smallest_angle, &after.smallest_angle);
