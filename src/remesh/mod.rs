@@ -48,7 +48,8 @@ use zone::Zone;
 /// Edge band of Botsch & Kobbelt: split above 4/3·L, collapse below 4/5·L.
 pub const SPLIT_ABOVE: f32 = 4.0 / 3.0;
 /// How long an edge (× L) the collapses of a whole-mesh remesh's first iteration may leave at
-/// their survivor; later ones, like Botsch & Kobbelt's, leave none past [`SPLIT_ABOVE`]. An
+/// their survivor, where it starts everywhere (a subdivided mesh is as even as its input);
+/// later ones, like Botsch & Kobbelt's, and a stroke's, leave none past [`SPLIT_ABOVE`]. An
 /// evenly stretched grid (a torus's top: edges of 0.72, 1.02 and 1.25·L, every valence 6) is a
 /// fixed point of the four edits under 4/3: no edge is long, no flip betters a valence,
 /// relaxation leaves a regular grid where it is, and collapsing a short edge would leave one of
