@@ -407,7 +407,7 @@ struct Remesher<'a> {
     scratch: Vec<u32>,
     near: Vec<NearFace>,
     /// The faces around a moving vertex and what they become ([`Remesher::move_is_safe`]).
-    move_lists: (Vec<u32>, Vec<([u32; 3], [Vec3; 3])>),
+    move_lists: (Vec<u32>, Vec<IdTriangle>),
     /// A whole-mesh remesh ([`Start::Everywhere`], [`Start::Subdivided`]): relaxation passes
     /// over vertices whose move is short before projecting them.
     whole: bool,
@@ -642,6 +642,9 @@ fn out_of_band(mesh: &Mesh, v: u32, target_edge: f32) -> bool {
         .into_iter()
         .any(|u| !band.contains(&p.distance(mesh.positions()[u as usize])))
 }
+
+/// A face as its vertex ids and their positions: what an edit would make.
+type IdTriangle = ([u32; 3], [Vec3; 3]);
 
 /// A face near an edit, as it is now.
 #[derive(Debug, Clone, Copy)]

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use super::{NearFace, Remesher, SPLIT_AT};
+use super::{IdTriangle, NearFace, Remesher, SPLIT_AT};
 use crate::collide::neighbourhood::{in_ring, ring_vertices};
 use crate::geom::{Aabb, neighbours_overlap, point_triangle_distance, triangles_intersect};
 use crate::mesh::INVALID;
@@ -117,7 +117,7 @@ impl Remesher<'_> {
         v: u32,
         (target, merged): (Vec3, Option<u32>),
         carrying: &[u32],
-        moved: &[([u32; 3], [Vec3; 3])],
+        moved: &[IdTriangle],
     ) -> bool {
         let d = self.settings.collision_distance;
         let from = self.mesh.positions()[v as usize];
@@ -150,7 +150,7 @@ impl Remesher<'_> {
     /// leave the zone no longer a sheet.
     fn unless_vouched(
         &mut self,
-        triangles: &[([u32; 3], [Vec3; 3])],
+        triangles: &[IdTriangle],
         keeps_rim: bool,
         (vouched, check): (
             impl FnOnce(&mut Self) -> bool,
@@ -173,7 +173,7 @@ impl Remesher<'_> {
     /// and keep the layer gap.
     pub(super) fn flip_is_clear(
         &mut self,
-        after: &[([u32; 3], [Vec3; 3])],
+        after: &[IdTriangle],
         replaced: [u32; 2],
         before: &[[Vec3; 3]],
     ) -> bool {
@@ -205,7 +205,7 @@ impl Remesher<'_> {
         &self,
         layer: crate::mesh::LayerId,
         before: &[[Vec3; 3]],
-        after: &[([u32; 3], [Vec3; 3])],
+        after: &[IdTriangle],
     ) -> bool {
         if self.mesh.layer_count() < 2 {
             return true;
@@ -344,7 +344,7 @@ impl Remesher<'_> {
     /// out.
     fn faces_clear_among(
         &self,
-        triangles: &[([u32; 3], [Vec3; 3])],
+        triangles: &[IdTriangle],
         moving: &[u32],
         replaced: &[u32],
         near: &[NearFace],
@@ -386,7 +386,7 @@ impl Remesher<'_> {
 }
 
 /// The box around triangles given as (vertex ids, positions).
-fn bounds_of(triangles: &[([u32; 3], [Vec3; 3])]) -> Aabb {
+fn bounds_of(triangles: &[IdTriangle]) -> Aabb {
     triangles.iter().fold(Aabb::EMPTY, |b, (_, t)| {
         b.including(t[0]).including(t[1]).including(t[2])
     })
