@@ -296,7 +296,11 @@ impl Remesher<'_> {
         let mut movable = std::mem::take(&mut self.sets.movable);
         movable.start(self.mesh.vertex_count());
         let mut live: Vec<u32> = Vec::new();
-        for &v in &self.dirty_list {
+        let dirty = match self.relax_round_only {
+            true => &self.round_dirty,
+            false => &self.dirty_list,
+        };
+        for &v in dirty {
             if !self.mesh.is_vertex_live(v) {
                 continue;
             }
@@ -309,7 +313,7 @@ impl Remesher<'_> {
         self.sets.movable = movable;
         let proposals: Vec<(u32, Vec3)> = live
             .iter()
-            .filter(|&&v| !self.mesh.is_boundary_vertex(v))
+            .filter(|&&v| !self.mesh.is_boundary_vertex(v) && !self.refused_relax.contains(&v))
             .filter_map(|&v| {
                 let p = self.mesh.positions()[v as usize];
                 let ring = self.mesh.neighbours(v);
@@ -347,10 +351,12 @@ impl Remesher<'_> {
             let lost = [self.mesh.positions()[v as usize]];
             let Some(volume) = self.shape_kept(v, (&before, &after), (&lost, target)) else {
                 self.report.shape_refused += 1;
+                self.refuse_relax(v);
                 continue;
             };
             if !self.move_is_safe(v, target, None) {
                 self.report.refused += 1;
+                self.refuse_relax(v);
                 continue;
             }
             self.closed.record(v, volume, 0);
@@ -362,6 +368,13 @@ impl Remesher<'_> {
     }
 
     /// Moving `v` to `target` flips no face around it.
+    /// Remembers, after a stroke, that `v`'s relaxation was refused (`refused_relax`).
+    fn refuse_relax(&mut self, v: u32) {
+        if !self.whole {
+            self.refused_relax.insert(v);
+        }
+    }
+
     fn relax_shape_ok(&self, v: u32, target: Vec3) -> bool {
         let p = self.mesh.positions();
         self.mesh.faces_around(v).all(|f| {
