@@ -6,6 +6,7 @@
 //! (counting sort, no hashing), so a query reads only the few cells its own box covers.
 
 use glam::{IVec3, Vec3};
+use rayon::prelude::*;
 
 use crate::geom::{Aabb, Polygon};
 
@@ -15,6 +16,9 @@ const MAX_CELLS_PER_AXIS: f32 = 64.0;
 /// files every face; held to 64 cells an axis, a 1M-face torus had cells 7 edges wide and
 /// every query read hundreds of faces.
 const MAX_CELLS_PER_FACE: usize = 8;
+/// Faces one job of a parallel filing takes at least: listing a face's cells is well under a
+/// microsecond.
+const FACES_PER_JOB: usize = 1024;
 
 #[derive(Debug, Clone, Default)]
 pub struct LocalFaceGrid {
@@ -131,9 +135,24 @@ impl LocalFaceGrid {
         let mut ends = std::mem::take(&mut self.spill_ends);
         spill.clear();
         ends.clear();
-        for (b, s) in boxes.iter().zip(swept) {
-            self.swept_cells(b, s, &mut spill);
-            ends.push(spill.len() as u32);
+        if boxes.len() <= FACES_PER_JOB {
+            self.spill_cells((boxes, swept), &mut spill, &mut ends);
+        } else {
+            // Which cells a face reaches is its own: listed on every core, chunk by chunk,
+            // then joined in face order.
+            let chunks: Vec<(Vec<u32>, Vec<u32>)> = (boxes.par_chunks(FACES_PER_JOB))
+                .zip(swept.par_chunks(FACES_PER_JOB))
+                .map(|chunk| {
+                    let (mut cells, mut chunk_ends) = (Vec::new(), Vec::new());
+                    self.spill_cells(chunk, &mut cells, &mut chunk_ends);
+                    (cells, chunk_ends)
+                })
+                .collect();
+            for (cells, chunk_ends) in chunks {
+                let base = spill.len() as u32;
+                spill.extend_from_slice(&cells);
+                ends.extend(chunk_ends.iter().map(|end| base + end));
+            }
         }
         for &c in &spill {
             self.offsets[c as usize + 1] += 1;
@@ -151,6 +170,20 @@ impl LocalFaceGrid {
         self.cursor = cursor;
         self.spill = spill;
         self.spill_ends = ends;
+    }
+
+    /// The cells each face can reach ([`LocalFaceGrid::swept_cells`]), face after face into
+    /// `spill`, and where each face's cells end into `ends`.
+    fn spill_cells(
+        &self,
+        (boxes, swept): (&[Aabb], &[SweptTriangle]),
+        spill: &mut Vec<u32>,
+        ends: &mut Vec<u32>,
+    ) {
+        for (b, s) in boxes.iter().zip(swept) {
+            self.swept_cells(b, s, spill);
+            ends.push(spill.len() as u32);
+        }
     }
 
     /// The cells of `b` (the box of `swept`) that the swept face can reach, into `out`. A
@@ -436,6 +469,34 @@ mod tests {
                 box_cells += span.x * span.y * span.z;
             }
             prop_assert!(grid.entries.len() <= box_cells as usize);
+        }
+    }
+
+    /// Enough faces to be listed chunk by chunk on several threads are filed as one thread
+    /// files them: every cell holds, in ascending order, exactly the faces whose cells include it.
+    #[test]
+    fn faces_listed_in_parallel_are_filed_in_face_order() {
+        use proptest::strategy::ValueTree;
+        let mut runner = proptest::test_runner::TestRunner::deterministic();
+        let faces: Vec<SweptTriangle> = (0..3 * FACES_PER_JOB + 17)
+            .map(|_| swept_face().new_tree(&mut runner).unwrap().current())
+            .collect();
+        let boxes: Vec<Aabb> = faces.iter().map(swept_box).collect();
+        let region = boxes.iter().fold(Aabb::EMPTY, |b, f| b.including_box(f));
+        let mut grid = LocalFaceGrid::default();
+        grid.build_swept(&boxes, &faces, region, 0.05);
+        let mut expected = vec![Vec::new(); grid.offsets.len() - 1];
+        let mut cells = Vec::new();
+        for (i, (b, face)) in boxes.iter().zip(&faces).enumerate() {
+            cells.clear();
+            grid.swept_cells(b, face, &mut cells);
+            for &c in &cells {
+                expected[c as usize].push(i as u32);
+            }
+        }
+        for (c, want) in expected.iter().enumerate() {
+            let filed = &grid.entries[grid.offsets[c] as usize..grid.offsets[c + 1] as usize];
+            assert_eq!(filed, &want[..], "cell {c}");
         }
     }
 

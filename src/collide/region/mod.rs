@@ -258,13 +258,12 @@ impl Region {
         if self.filed == Filing::All {
             return;
         }
-        self.boxes.clear();
-        self.swept.clear();
-        for &f in &self.faces {
-            let (swept_box, swept) = sweep_of(mesh, f, moves, before);
-            self.boxes.push(swept_box);
-            self.swept.push(swept);
-        }
+        // Each face's sweep is its own: worked out on every core (bark files 7,400 faces a
+        // step, and this ran on one while the other waited).
+        (self.faces.par_iter())
+            .with_min_len(FACES_PER_JOB)
+            .map(|&f| sweep_of(mesh, f, moves, before))
+            .unzip_into_vecs(&mut self.boxes, &mut self.swept);
         if let Some(cell) = self.cell {
             self.grid
                 .build_swept(&self.boxes, &self.swept, self.reach, cell);
@@ -627,6 +626,10 @@ fn sweep_of(mesh: &Mesh, f: u32, moves: StepMoves<'_>, before: &[Vec3]) -> (Aabb
         },
     )
 }
+
+/// Faces one job of a parallel filing takes at least: a face's sweep is well under a
+/// microsecond.
+const FACES_PER_JOB: usize = 512;
 
 /// Cell side of the per-step face grid, in edge lengths: a face box then covers one to two
 /// cells per axis and a proximity query a handful.
