@@ -367,14 +367,14 @@ impl Remesher<'_> {
         }
     }
 
-    /// Moving `v` to `target` flips no face around it.
-    /// Remembers, after a stroke, that `v`'s relaxation was refused (`refused_relax`).
+    /// Remembers, in a remesh of a region, that `v`'s relaxation was refused (`refused_relax`).
     fn refuse_relax(&mut self, v: u32) {
         if !self.whole {
             self.refused_relax.insert(v);
         }
     }
 
+    /// Moving `v` to `target` flips no face around it.
     fn relax_shape_ok(&self, v: u32, target: Vec3) -> bool {
         let p = self.mesh.positions();
         self.mesh.faces_around(v).all(|f| {

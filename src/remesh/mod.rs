@@ -399,15 +399,16 @@ struct Remesher<'a> {
     /// Region vertices (grows with splits; dead ones are skipped).
     region: Vec<u32>,
     dirty_list: Vec<u32>,
-    /// The vertices the round under way marked dirty (some more than once), and whether its
-    /// relaxation moves only those and their neighbours: after a stroke's first round, which
-    /// relaxes the whole region, the later rounds' few edits are what is left to settle.
+    /// In a remesh of a region (a stroke's, a layer tool's new piece's: not `whole`), the
+    /// vertices the round under way marked dirty (some more than once), and whether its
+    /// relaxation moves only those and their neighbours: after the first round, which relaxes
+    /// the whole region, the later rounds' few edits are what is left to settle.
     round_dirty: Vec<u32>,
     relax_round_only: bool,
-    /// After a stroke, vertices whose relaxation was refused (for the shape or for another
+    /// In a remesh of a region, vertices whose relaxation was refused (for the shape or for another
     /// surface): as with collapses, what refused it stays, so later rounds do not propose it
-    /// again. Plaster's second and third rounds refused about 7,000 relaxations each over 40
-    /// strokes, the same vertices every round.
+    /// again. Before, plaster's second and third rounds each refused about 7,000 relaxations
+    /// over the bench's 40 strokes.
     refused_relax: rustc_hash::FxHashSet<u32>,
     /// Collapses refused for coming too close to another surface, by vertex pair: what stopped
     /// them does not go away by remeshing, so later rounds do not retry them.
@@ -538,7 +539,9 @@ impl<'a> Remesher<'a> {
     }
 
     fn mark_dirty(&mut self, v: u32) {
-        self.round_dirty.push(v);
+        if !self.whole {
+            self.round_dirty.push(v);
+        }
         self.sets.dirty.size_for(v as usize + 1);
         if self.sets.dirty.insert(v as usize) {
             self.dirty_list.push(v);

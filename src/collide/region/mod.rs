@@ -261,7 +261,7 @@ impl Region {
         // Each face's sweep is its own: worked out on every core (bark files 7,400 faces a
         // step, and this ran on one while the other waited).
         (self.faces.par_iter())
-            .with_min_len(FACES_PER_JOB)
+            .with_min_len(SWEEPS_PER_JOB)
             .map(|&f| sweep_of(mesh, f, moves, before))
             .unzip_into_vecs(&mut self.boxes, &mut self.swept);
         if let Some(cell) = self.cell {
@@ -627,9 +627,9 @@ fn sweep_of(mesh: &Mesh, f: u32, moves: StepMoves<'_>, before: &[Vec3]) -> (Aabb
     )
 }
 
-/// Faces one job of a parallel filing takes at least: a face's sweep is well under a
+/// Faces one job sweeps at least ([`Region::file_faces`]): a face's sweep is well under a
 /// microsecond.
-const FACES_PER_JOB: usize = 512;
+const SWEEPS_PER_JOB: usize = 512;
 
 /// Cell side of the per-step face grid, in edge lengths: a face box then covers one to two
 /// cells per axis and a proximity query a handful.
