@@ -296,11 +296,7 @@ impl Remesher<'_> {
         let mut movable = std::mem::take(&mut self.sets.movable);
         movable.start(self.mesh.vertex_count());
         let mut live: Vec<u32> = Vec::new();
-        let dirty = match self.relax_round_only {
-            true => &self.round_dirty,
-            false => &self.dirty_list,
-        };
-        for &v in dirty {
+        for &v in &self.dirty_list {
             if !self.mesh.is_vertex_live(v) {
                 continue;
             }
@@ -313,7 +309,7 @@ impl Remesher<'_> {
         self.sets.movable = movable;
         let proposals: Vec<(u32, Vec3)> = live
             .iter()
-            .filter(|&&v| !self.mesh.is_boundary_vertex(v) && !self.refused_relax.contains(&v))
+            .filter(|&&v| !self.mesh.is_boundary_vertex(v))
             .filter_map(|&v| {
                 let p = self.mesh.positions()[v as usize];
                 let ring = self.mesh.neighbours(v);
@@ -351,12 +347,10 @@ impl Remesher<'_> {
             let lost = [self.mesh.positions()[v as usize]];
             let Some(volume) = self.shape_kept(v, (&before, &after), (&lost, target)) else {
                 self.report.shape_refused += 1;
-                self.refuse_relax(v);
                 continue;
             };
             if !self.move_is_safe(v, target, None) {
                 self.report.refused += 1;
-                self.refuse_relax(v);
                 continue;
             }
             self.closed.record(v, volume, 0);
@@ -364,13 +358,6 @@ impl Remesher<'_> {
             self.grid.move_to(v, target);
             self.refile_faces_around(v);
             self.report.relaxed += 1;
-        }
-    }
-
-    /// Remembers, in a remesh of a region, that `v`'s relaxation was refused (`refused_relax`).
-    fn refuse_relax(&mut self, v: u32) {
-        if !self.whole {
-            self.refused_relax.insert(v);
         }
     }
 
