@@ -296,11 +296,7 @@ impl Remesher<'_> {
         let mut movable = std::mem::take(&mut self.sets.movable);
         movable.start(self.mesh.vertex_count());
         let mut live: Vec<u32> = Vec::new();
-        let dirty = match self.relax_round_only {
-            true => &self.round_dirty,
-            false => &self.dirty_list,
-        };
-        for &v in dirty {
+        for &v in &self.dirty_list {
             if !self.mesh.is_vertex_live(v) {
                 continue;
             }

@@ -294,8 +294,6 @@ fn remesh(
             SPLIT_ABOVE
         };
         let edits = remesher.edit_count();
-        remesher.relax_round_only = round > 0 && !remesher.whole;
-        remesher.round_dirty.clear();
         remesher.renew_zone();
         remesher.split_long_edges();
         remesher.renew_zone();
@@ -399,12 +397,6 @@ struct Remesher<'a> {
     /// Region vertices (grows with splits; dead ones are skipped).
     region: Vec<u32>,
     dirty_list: Vec<u32>,
-    /// In a remesh of a region (a stroke's, a layer tool's new piece's: not `whole`), the
-    /// vertices the round under way marked dirty (some more than once), and whether its
-    /// relaxation moves only those and their neighbours: after the first round, which relaxes
-    /// the whole region, the later rounds' few edits are what is left to settle.
-    round_dirty: Vec<u32>,
-    relax_round_only: bool,
     /// Collapses refused for coming too close to another surface, by vertex pair: what stopped
     /// them does not go away by remeshing, so later rounds do not retry them.
     refused_collapses: rustc_hash::FxHashSet<(u32, u32)>,
@@ -487,8 +479,6 @@ impl<'a> Remesher<'a> {
             region,
             sets,
             dirty_list: Vec::new(),
-            round_dirty: Vec::new(),
-            relax_round_only: false,
             refused_collapses: Default::default(),
             surface,
             closed,
@@ -533,9 +523,6 @@ impl<'a> Remesher<'a> {
     }
 
     fn mark_dirty(&mut self, v: u32) {
-        if !self.whole {
-            self.round_dirty.push(v);
-        }
         self.sets.dirty.size_for(v as usize + 1);
         if self.sets.dirty.insert(v as usize) {
             self.dirty_list.push(v);
